@@ -1,0 +1,3 @@
+//! Analyses over the reference models: the paper reproduction.
+pub mod methods;
+pub mod paper;

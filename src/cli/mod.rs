@@ -1,0 +1,62 @@
+//! Command-line front end: clap definitions, dispatch, exit codes and file output.
+//!
+//! Exit codes: 0 success, 1 the command ran but a check it performs failed, 2 bad input or an
+//! I/O error (one line on stderr). A closed stdout (broken pipe) is not an error.
+
+mod output;
+mod paper;
+mod reference;
+mod report;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Models a division-free fixed-point specular datapath bit for bit against an f64 reference.
+#[derive(Debug, Parser)]
+#[command(name = "specfx", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Runs the main job on built-in defaults and writes everything under ./specfx-out/.
+    Report(report::ReportArgs),
+    /// Reproduces every number the paper prints and says which ones hold.
+    Paper(paper::PaperArgs),
+    /// Prints the normalisation coefficient coef(n) of a form.
+    Coef(reference::CoefArgs),
+    /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
+    Minimax(reference::MinimaxArgs),
+}
+
+/// What a command reports back besides errors.
+pub enum Outcome {
+    /// Everything ran and every check passed.
+    Ok,
+    /// The command ran, but a check it performs failed (exit code 1).
+    #[allow(dead_code)] // the checking commands of the datapath issue return it
+    CheckFailed,
+}
+
+/// Parses the arguments, runs the command and maps the result to an exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Report(args) => report::run(&args),
+        Command::Paper(args) => paper::run(&args),
+        Command::Coef(args) => reference::run_coef(&args),
+        Command::Minimax(args) => reference::run_minimax(&args),
+    };
+    match result {
+        Ok(Outcome::Ok) => ExitCode::SUCCESS,
+        Ok(Outcome::CheckFailed) => ExitCode::from(1),
+        Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("specfx: error: {err:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,50 @@
+//! File and terminal output shared by the commands: atomic writes, stdout, broken pipes.
+
+use std::fs;
+use std::io::{self, Write};
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+/// Whether an error is (caused by) a closed stdout, which is not an error for a CLI.
+pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| {
+        e.downcast_ref::<io::Error>()
+            .is_some_and(|io| io.kind() == io::ErrorKind::BrokenPipe)
+    })
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so
+/// an interrupted run never leaves a half-written file under the final name.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
+    let file_name = path
+        .file_name()
+        .with_context(|| format!("{}: not a file path", path.display()))?;
+    let tmp = match dir {
+        Some(d) => d.join(format!(".{}.tmp", file_name.to_string_lossy())),
+        None => Path::new(&format!(".{}.tmp", file_name.to_string_lossy())).to_path_buf(),
+    };
+    fs::write(&tmp, bytes).with_context(|| format!("cannot write {}", tmp.display()))?;
+    fs::rename(&tmp, path)
+        .with_context(|| format!("cannot rename {} to {}", tmp.display(), path.display()))
+}
+
+/// Renders into a buffer with a writer function, then prints it to stdout in one go.
+pub fn print_with(render: impl FnOnce(&mut Vec<u8>) -> io::Result<()>) -> Result<()> {
+    let mut buf = Vec::new();
+    render(&mut buf)?;
+    let mut out = io::stdout().lock();
+    out.write_all(&buf)?;
+    out.flush()?;
+    Ok(())
+}
+
+/// Prints a value as pretty JSON on stdout, with a trailing newline.
+pub fn print_json(value: &impl serde::Serialize) -> Result<()> {
+    print_with(|buf| {
+        serde_json::to_writer_pretty(&mut *buf, value).map_err(io::Error::other)?;
+        buf.push(b'\n');
+        Ok(())
+    })
+}

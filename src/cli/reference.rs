@@ -1,0 +1,179 @@
+//! `specfx coef` and `specfx minimax`: the reference models on the command line.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+
+use super::output::{print_json, print_with, write_atomic};
+use super::Outcome;
+use specfx::nset::NSet;
+use specfx::reference::lobe::{m_of_k, K_RANGE};
+use specfx::reference::minimax::{self, MinimaxFit, TABLE_HEADER, TABLE_N_MAX};
+use specfx::reference::normalisation::{coefficient, CoefSource, Form};
+
+fn parse_k(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(k) if K_RANGE.contains(&k) => Ok(k),
+        _ => Err(format!(
+            "expected a number of squarings k in 1..=7, got '{s}'"
+        )),
+    }
+}
+
+/// Arguments of `specfx coef`.
+#[derive(Debug, Args)]
+pub struct CoefArgs {
+    /// Normalisation form: phong, phong_modified, blinn_phong, blinn_phong_modified,
+    /// blinn_phong_ndf, blinn_phong_heightfield.
+    #[arg(long, default_value = "phong")]
+    form: Form,
+    /// Coefficient source: classic (cos^n), paper (Table 1 as printed), exact (cs_m).
+    #[arg(long, default_value = "exact")]
+    source: CoefSource,
+    /// Exponents, e.g. 64 or 16..=1024 or 1,2,16..32.
+    #[arg(long, default_value = "16,64,256,1024")]
+    n: NSet,
+    /// Number of squarings k (m = 2^k); used by the exact source.
+    #[arg(long, default_value = "4", value_parser = parse_k)]
+    k: u32,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(serde::Serialize)]
+struct CoefRow {
+    n: u32,
+    coef: f64,
+}
+
+/// Runs `specfx coef`.
+pub fn run_coef(args: &CoefArgs) -> Result<Outcome> {
+    let rows: Vec<CoefRow> = args
+        .n
+        .values()
+        .iter()
+        .map(|&n| CoefRow {
+            n,
+            coef: coefficient(args.form, args.source, f64::from(n), args.k),
+        })
+        .collect();
+    if args.json {
+        #[derive(serde::Serialize)]
+        struct Out<'a> {
+            form: Form,
+            source: CoefSource,
+            k: u32,
+            m: u32,
+            coefficients: &'a [CoefRow],
+        }
+        print_json(&Out {
+            form: args.form,
+            source: args.source,
+            k: args.k,
+            m: m_of_k(args.k),
+            coefficients: &rows,
+        })?;
+    } else {
+        print_with(|buf| {
+            use std::io::Write;
+            writeln!(
+                buf,
+                "# coef(n), form {}, source {}, m = {}",
+                args.form,
+                args.source,
+                m_of_k(args.k)
+            )?;
+            for r in &rows {
+                writeln!(buf, "{:>6} {:.17e}", r.n, r.coef)?;
+            }
+            Ok(())
+        })?;
+    }
+    Ok(Outcome::Ok)
+}
+
+/// Arguments of `specfx minimax`.
+#[derive(Debug, Args)]
+pub struct MinimaxArgs {
+    /// Exponents to show (from the cached table, n <= 4096).
+    #[arg(long, default_value = "16,64,256,1024")]
+    n: NSet,
+    /// Numbers of squarings to show, e.g. 4 or 1..=7.
+    #[arg(long, default_value = "4")]
+    k: NSet,
+    /// Recompute the whole table (n = 1..=N_MAX, k = 1..=7) and write it to this CSV file
+    /// (the library embeds data/minimax.csv).
+    #[arg(long, value_name = "FILE")]
+    write: Option<PathBuf>,
+    /// Largest n of a recomputed table.
+    #[arg(long, default_value_t = TABLE_N_MAX)]
+    n_max: u32,
+    /// Print JSON instead of CSV.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `specfx minimax`.
+pub fn run_minimax(args: &MinimaxArgs) -> Result<Outcome> {
+    if let Some(path) = &args.write {
+        return write_table(path, args.n_max);
+    }
+    if let Some(&k) = args.k.values().iter().find(|k| !K_RANGE.contains(k)) {
+        bail!("--k: expected numbers of squarings in 1..=7, got {k}");
+    }
+    let mut fits: Vec<MinimaxFit> = Vec::new();
+    for &k in args.k.values() {
+        for &n in args.n.values() {
+            fits.push(minimax::constants(n, k).with_context(|| "--n".to_string())?);
+        }
+    }
+    if args.json {
+        print_json(&fits)?;
+    } else {
+        print_with(|buf| {
+            use std::io::Write;
+            writeln!(buf, "{TABLE_HEADER}")?;
+            for f in &fits {
+                writeln!(buf, "{}", f.csv_row())?;
+            }
+            Ok(())
+        })?;
+    }
+    Ok(Outcome::Ok)
+}
+
+fn write_table(path: &std::path::Path, n_max: u32) -> Result<Outcome> {
+    if n_max == 0 {
+        bail!("--n-max: expected at least 1, got 0");
+    }
+    let jobs: Vec<(u32, u32)> = K_RANGE
+        .flat_map(|k| (1..=n_max).map(move |n| (k, n)))
+        .collect();
+    let bar = ProgressBar::with_draw_target(Some(jobs.len() as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("minimax fits {bar:40} {pos}/{len} eta {eta}")
+            .expect("valid template"),
+    );
+    let fits: Vec<MinimaxFit> = jobs
+        .par_iter()
+        .map(|&(k, n)| {
+            let f = minimax::fit(n, k);
+            bar.inc(1);
+            f
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut text = String::new();
+    writeln!(text, "{TABLE_HEADER}").expect("write to String");
+    for f in &fits {
+        writeln!(text, "{}", f.csv_row()).expect("write to String");
+    }
+    write_atomic(path, text.as_bytes())?;
+    eprintln!("wrote {} fits to {}", fits.len(), path.display());
+    Ok(Outcome::Ok)
+}

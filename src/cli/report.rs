@@ -1,0 +1,115 @@
+//! `specfx report`: the main job on built-in defaults.
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use super::output::write_atomic;
+use super::Outcome;
+use specfx::analysis::methods::{max_errors, report_methods};
+use specfx::analysis::paper::reproduce;
+use specfx::report::csv::{write_coefficients, write_method_errors};
+use specfx::report::paper::write_paper_table;
+
+/// Arguments of `specfx report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Output directory (created if missing; files in it are replaced).
+    #[arg(long, default_value = "specfx-out")]
+    out: PathBuf,
+}
+
+/// Renders into a buffer and writes it atomically to `dir/name`; returns the path.
+fn emit(
+    dir: &Path,
+    name: &str,
+    render: impl FnOnce(&mut Vec<u8>) -> std::io::Result<()>,
+) -> Result<PathBuf> {
+    let mut buf = Vec::new();
+    render(&mut buf).with_context(|| format!("cannot render {name}"))?;
+    let path = dir.join(name);
+    write_atomic(&path, &buf)?;
+    Ok(path)
+}
+
+fn step(msg: &str) {
+    eprintln!("specfx report: {msg}");
+}
+
+/// Runs `specfx report`.
+pub fn run(args: &ReportArgs) -> Result<Outcome> {
+    let dir = &args.out;
+    fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut written = Vec::new();
+
+    step("reproducing the paper's claims");
+    let paper = reproduce();
+    written.push(emit(dir, "paper.txt", |b| write_paper_table(b, &paper))?);
+    written.push(emit(dir, "paper.json", |b| {
+        serde_json::to_writer_pretty(&mut *b, &paper).map_err(std::io::Error::other)?;
+        b.push(b'\n');
+        Ok(())
+    })?);
+
+    step("measuring every reference method against cos^n, n = 16..=1024");
+    let ns: Vec<u32> = (16..=1024).collect();
+    let methods = report_methods();
+    let errs = max_errors(&methods, &ns);
+    written.push(emit(dir, "methods.csv", |b| {
+        write_method_errors(b, &ns, &errs)
+    })?);
+    let all_n: Vec<u32> = (1..=1024).collect();
+    written.push(emit(dir, "coefficients.csv", |b| {
+        write_coefficients(b, &all_n, 4)
+    })?);
+
+    let n_claims = paper.forms.len() + 2;
+    let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
+        + usize::from(paper.delta.reproduced_max)
+        + usize::from(paper.delta.reproduced_min);
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "specfx report: results in {}", dir.display())?;
+    writeln!(
+        out,
+        "  paper: {n_ok} of {n_claims} printed claims reproduce (details: paper.txt)"
+    )?;
+    for f in paper.forms.iter().filter(|f| !f.reproduced) {
+        writeln!(
+            out,
+            "    {}: printed res {:.1e}, computed {:.2e}",
+            f.form, f.claim_res_max, f.paper_res_max
+        )?;
+    }
+    if !paper.delta.reproduced_min {
+        writeln!(
+            out,
+            "    Delta min: printed {:.1e}, computed {:.1e} (cs16 <= cos^n for n >= 16)",
+            paper.delta.claim_min, paper.delta.min
+        )?;
+    }
+    let worst_exact = paper
+        .forms
+        .iter()
+        .map(|f| f.exact_res_max)
+        .fold(0.0, f64::max);
+    writeln!(
+        out,
+        "  exact coefficients: max res {worst_exact:.1e} over every form, n = 16..=1024"
+    )?;
+    writeln!(out, "  max |error| against cos^n over n = 16..=1024:")?;
+    for e in &errs {
+        writeln!(
+            out,
+            "    {:<14} {:.3e}  (n = {}, c = {:.6})",
+            e.method, e.max_abs_err, e.argmax_n, e.argmax_c
+        )?;
+    }
+    writeln!(out, "  files:")?;
+    for p in &written {
+        writeln!(out, "    {}", p.display())?;
+    }
+    Ok(Outcome::Ok)
+}

@@ -1,0 +1,150 @@
+//! Sets of specular exponents n, written like `16..=1024`, `16..1024` or `1,2,16..32`.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::Error;
+
+/// The largest exponent any command accepts.
+pub const N_MAX: u32 = 65_535;
+
+/// A sorted, duplicate-free set of exponents n >= 1, with the text it was parsed from.
+///
+/// Ranges are inclusive at both ends whether written `a..b` or `a..=b` (hardware documents
+/// say "n = 16..1024" for both ends included).
+///
+/// # Examples
+/// ```
+/// use specfx::nset::NSet;
+/// let s: NSet = "1,4..=6,16..17".parse().unwrap();
+/// assert_eq!(s.values(), &[1, 4, 5, 6, 16, 17]);
+/// assert_eq!(s.to_string(), "1,4..=6,16..17");
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct NSet {
+    text: String,
+    values: Vec<u32>,
+}
+
+impl NSet {
+    /// The inclusive range `lo..=hi`.
+    pub fn range(lo: u32, hi: u32) -> Result<NSet, Error> {
+        format!("{lo}..={hi}").parse()
+    }
+
+    /// The exponents, ascending.
+    pub fn values(&self) -> &[u32] {
+        &self.values
+    }
+
+    /// The smallest exponent.
+    pub fn min(&self) -> u32 {
+        self.values[0]
+    }
+
+    /// The largest exponent.
+    pub fn max(&self) -> u32 {
+        self.values[self.values.len() - 1]
+    }
+
+    /// How many exponents.
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Always false: a set holds at least one exponent.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+}
+
+fn parse_n(s: &str, whole: &str) -> Result<u32, Error> {
+    let out_of_range = || Error::OutOfRange {
+        what: "an exponent n",
+        expected: format!("a whole number in 1..={N_MAX} (in n set '{whole}')"),
+        got: format!("'{s}'"),
+    };
+    let n: u32 = s.trim().parse().map_err(|_| out_of_range())?;
+    if (1..=N_MAX).contains(&n) {
+        Ok(n)
+    } else {
+        Err(out_of_range())
+    }
+}
+
+impl FromStr for NSet {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
+        let mut values = Vec::new();
+        for part in s.split(',') {
+            let part = part.trim();
+            if let Some((lo, hi)) = part.split_once("..") {
+                let hi = hi.strip_prefix('=').unwrap_or(hi);
+                let (lo, hi) = (parse_n(lo, s)?, parse_n(hi, s)?);
+                if lo > hi {
+                    return Err(Error::OutOfRange {
+                        what: "a range of n",
+                        expected: "written low..high".to_string(),
+                        got: format!("'{part}'"),
+                    });
+                }
+                values.extend(lo..=hi);
+            } else {
+                values.push(parse_n(part, s)?);
+            }
+        }
+        values.sort_unstable();
+        values.dedup();
+        Ok(NSet {
+            text: s.trim().to_string(),
+            values,
+        })
+    }
+}
+
+impl fmt::Display for NSet {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+impl TryFrom<String> for NSet {
+    type Error = Error;
+    fn try_from(s: String) -> Result<Self, Error> {
+        s.parse()
+    }
+}
+
+impl From<NSet> for String {
+    fn from(s: NSet) -> String {
+        s.text
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_are_inclusive_and_merged() {
+        let s: NSet = "16..18, 17..=19,3".parse().unwrap();
+        assert_eq!(s.values(), &[3, 16, 17, 18, 19]);
+        assert_eq!((s.min(), s.max(), s.len()), (3, 19, 5));
+    }
+
+    #[test]
+    fn bad_sets_are_refused_with_the_culprit() {
+        let e = "16..x".parse::<NSet>().unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "an exponent n must be a whole number in 1..=65535 (in n set '16..x'), got 'x'"
+        );
+        assert!("0".parse::<NSet>().is_err());
+        assert!("".parse::<NSet>().is_err());
+        assert!("20..10".parse::<NSet>().is_err());
+        assert!("70000".parse::<NSet>().is_err());
+    }
+}

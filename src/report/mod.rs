@@ -1,0 +1,3 @@
+//! Renders results as text tables and CSV into any writer; never opens files.
+pub mod csv;
+pub mod paper;
