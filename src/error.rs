@@ -1,4 +1,4 @@
-//! The library's error type: every way a user's input can be refused.
+//! The library's error types: every way a user's input can be refused.
 
 use thiserror::Error;
 
@@ -25,6 +25,9 @@ pub enum Error {
         /// What was given.
         got: String,
     },
+    /// A fixed-point format or mode that cannot be built or parsed.
+    #[error(transparent)]
+    Fixed(#[from] FixedError),
     /// The minimax table has no entry for this (n, k).
     #[error("no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..=7")]
     NoMinimaxEntry {
@@ -34,5 +37,68 @@ pub enum Error {
         k: u32,
         /// The largest n in the table.
         n_max: u32,
+    },
+}
+
+/// Why a [`Format`](crate::fixed::Format), [`Rounding`](crate::fixed::Rounding) or
+/// [`Overflow`](crate::fixed::Overflow) could not be built or parsed.
+///
+/// Only construction and parsing return this error. Arithmetic and quantization never do:
+/// an overflow in the datapath is an [`Event`](crate::fixed::Event), not an error.
+///
+/// # Examples
+///
+/// ```
+/// use specfx::error::FixedError;
+/// use specfx::fixed::Format;
+///
+/// let err = "x1.2".parse::<Format>().unwrap_err();
+/// assert_eq!(err, FixedError::BadNotation { got: "x1.2".to_string() });
+/// assert_eq!(err.to_string(), "format must look like u1.15 or s2.16, got 'x1.2'");
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum FixedError {
+    /// The text is not in the `u<int>.<frac>` / `s<int>.<frac>` notation.
+    #[error("format must look like u1.15 or s2.16, got '{got}'")]
+    BadNotation {
+        /// The text that was given.
+        got: String,
+    },
+    /// The total width (int bits + frac bits) is outside `1..=64`.
+    #[error("width (int bits + frac bits) of {notation} must be in 1..=64, got {got}")]
+    Width {
+        /// The format as it was given, in the usual notation.
+        notation: String,
+        /// The total width that was given.
+        got: i64,
+    },
+    /// An unsigned format is 64 bits wide: its largest raw value would not fit in `i64`.
+    #[error("width (int bits + frac bits) of unsigned {notation} must be at most 63 so that raws fit in i64, got {got}")]
+    UnsignedWidth {
+        /// The format as it was given, in the usual notation.
+        notation: String,
+        /// The total width that was given.
+        got: i64,
+    },
+    /// The number of fraction bits is outside the supported range.
+    #[error("frac bits of {notation} must be in -512..=512, got {got}")]
+    FracBits {
+        /// The format as it was given, in the usual notation.
+        notation: String,
+        /// The number of fraction bits that was given.
+        got: i64,
+    },
+    /// The text is not the name of a quantization (rounding) mode.
+    #[error("rounding mode must be one of TRN, TRN_ZERO, RND, RND_ZERO, RND_INF, RND_MIN_INF, RND_CONV, RND_CONV_ODD (upper or lower case), got '{got}'")]
+    BadRounding {
+        /// The text that was given.
+        got: String,
+    },
+    /// The text is not the name of an overflow mode.
+    #[error("overflow mode must be one of WRAP, SAT, SAT_ZERO, SAT_SYM (upper or lower case), got '{got}'")]
+    BadOverflow {
+        /// The text that was given.
+        got: String,
     },
 }

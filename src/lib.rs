@@ -18,6 +18,7 @@
 
 pub mod analysis;
 pub mod error;
+pub mod fixed;
 pub mod nset;
 pub mod reference;
 pub mod report;
