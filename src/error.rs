@@ -28,6 +28,22 @@ pub enum Error {
     /// A fixed-point format or mode that cannot be built or parsed.
     #[error(transparent)]
     Fixed(#[from] FixedError),
+    /// A configuration key whose value cannot be used.
+    #[error("{key}: {problem}")]
+    Config {
+        /// The key, e.g. `t.format` or `square[2].rounding`.
+        key: String,
+        /// What is wrong, with what was expected and what was given.
+        problem: String,
+    },
+    /// A configuration text that is not valid TOML or has unknown keys.
+    #[error("line {line}: {message}")]
+    Toml {
+        /// The 1-based line of the problem.
+        line: usize,
+        /// The parser's message, on one line.
+        message: String,
+    },
     /// The minimax table has no entry for this (n, k).
     #[error("no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..=7")]
     NoMinimaxEntry {

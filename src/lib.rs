@@ -20,6 +20,7 @@ pub mod analysis;
 pub mod error;
 pub mod fixed;
 pub mod nset;
+pub mod pipeline;
 pub mod reference;
 pub mod report;
 

@@ -1,3 +1,5 @@
-//! Analyses over the reference models: the paper reproduction.
+//! Analyses over the reference and the datapath: the paper reproduction, method errors, and
+//! exhaustive accuracy checks.
+pub mod check;
 pub mod methods;
 pub mod paper;

@@ -3,6 +3,8 @@
 //! Exit codes: 0 success, 1 the command ran but a check it performs failed, 2 bad input or an
 //! I/O error (one line on stderr). A closed stdout (broken pipe) is not an error.
 
+mod check;
+mod datapath;
 mod output;
 mod paper;
 mod reference;
@@ -26,6 +28,8 @@ enum Command {
     Report(report::ReportArgs),
     /// Reproduces every number the paper prints and says which ones hold.
     Paper(paper::PaperArgs),
+    /// Checks a datapath exhaustively against f64: every input code, every n.
+    Check(check::CheckArgs),
     /// Prints the normalisation coefficient coef(n) of a form.
     Coef(reference::CoefArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -47,6 +51,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Report(args) => report::run(&args),
         Command::Paper(args) => paper::run(&args),
+        Command::Check(args) => check::run(&args),
         Command::Coef(args) => reference::run_coef(&args),
         Command::Minimax(args) => reference::run_minimax(&args),
     };

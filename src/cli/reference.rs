@@ -123,7 +123,7 @@ pub fn run_minimax(args: &MinimaxArgs) -> Result<Outcome> {
     if let Some(path) = &args.write {
         return write_table(path, args.n_max);
     }
-    if let Some(&k) = args.k.values().iter().find(|k| !K_RANGE.contains(k)) {
+    if let Some(&k) = args.k.values().iter().find(|&&k| !K_RANGE.contains(&k)) {
         bail!("--k: expected numbers of squarings in 1..=7, got {k}");
     }
     let mut fits: Vec<MinimaxFit> = Vec::new();

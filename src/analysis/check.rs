@@ -1,0 +1,666 @@
+//! Exhaustive accuracy check of a datapath against f64, on every input code and every n.
+//!
+//! For each stage the fixed-point value is compared with the f64 value of the same algorithm
+//! (same constants before quantization, no rounding anywhere); the lobe before the coefficient
+//! is also compared with cos^n itself, which splits its error into quantization and
+//! approximation. Work is split by n across threads and merged in n order, so every figure is
+//! deterministic.
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::pipeline::datapath::{STAGE_B, STAGE_D, STAGE_T};
+use crate::pipeline::fast::EventCounts;
+use crate::pipeline::{Datapath, NConstants, ProbeColumns, MAX_STAGES};
+use crate::reference::lobe::Cutoff;
+
+/// An input where a figure is reached.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Input {
+    /// The exponent.
+    pub n: u32,
+    /// The raw input code.
+    pub c_raw: i64,
+    /// The input value.
+    pub c: f64,
+}
+
+/// Accuracy figures of one stage.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StageStats {
+    /// Stage name (`d`, `t`, `b`, `sq1`.., `coef`, `out`).
+    pub stage: String,
+    /// The stage's format.
+    pub format: String,
+    /// max |fixed - f64|.
+    pub max_abs_err: f64,
+    /// Mean of fixed - f64 (the bias).
+    pub mean_err: f64,
+    /// Mean of |fixed - f64|.
+    pub mean_abs_err: f64,
+    /// Root mean square of fixed - f64.
+    pub rms_err: f64,
+    /// max |fixed - f64| in units of the stage's LSB.
+    pub max_ulp: f64,
+    /// Share of evaluations within 1/2 LSB of the f64 value (correctly rounded).
+    pub correctly_rounded: f64,
+    /// Share within 1 LSB (faithfully rounded: one of the two neighbouring codes).
+    pub faithfully_rounded: f64,
+    /// Where max_abs_err is reached.
+    pub worst: Input,
+    /// Smallest raw value seen.
+    pub raw_min: i64,
+    /// Largest raw value seen.
+    pub raw_max: i64,
+    /// Quantizations that wrapped.
+    pub wrapped: u64,
+    /// Quantizations that saturated.
+    pub saturated: u64,
+    /// Quantizations that overflowed to zero (SAT_ZERO).
+    pub zeroed: u64,
+}
+
+/// One place where the output decreases as c increases.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct MonotonicityViolation {
+    /// The exponent.
+    pub n: u32,
+    /// The input code where the output is lower than at the code before it.
+    pub c_raw: i64,
+    /// Output raw at the code before.
+    pub out_before: i64,
+    /// Output raw here.
+    pub out_here: i64,
+}
+
+/// The result of an exhaustive check.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CheckReport {
+    /// The configuration's name.
+    pub config: String,
+    /// The n set, as written.
+    pub n_set: String,
+    /// Number of exponents.
+    pub n_exponents: usize,
+    /// Input codes evaluated per exponent (codes above 1.0 clamp to the code of 1.0 and are
+    /// not evaluated again).
+    pub n_input_codes: u64,
+    /// Input codes above 1.0 per exponent, all equal to 1.0 after the input clamp.
+    pub n_codes_above_one: u64,
+    /// Evaluations in all.
+    pub n_evaluations: u64,
+    /// Per stage, in pipeline order.
+    pub stages: Vec<StageStats>,
+    /// max |fixed lobe - f64 lobe of the same algorithm| (before the coefficient).
+    pub shape_quant_max_abs: f64,
+    /// Where it is reached.
+    pub shape_quant_worst: Input,
+    /// max |f64 lobe - cos^n|: the approximation alone.
+    pub shape_approx_max_abs: f64,
+    /// Where it is reached.
+    pub shape_approx_worst: Input,
+    /// max |fixed lobe - cos^n|: both together.
+    pub shape_total_max_abs: f64,
+    /// Where it is reached.
+    pub shape_total_worst: Input,
+    /// max output error in output LSBs.
+    pub out_max_ulp: f64,
+    /// Whether the output is non-decreasing in c for every n.
+    pub monotonic: bool,
+    /// Number of monotonicity violations.
+    pub n_monotonicity_violations: u64,
+    /// The first violations (at most 100), in n then c order.
+    pub monotonicity_violations: Vec<MonotonicityViolation>,
+    /// Evaluations where the cutoff forced the base to zero.
+    pub n_cut: u64,
+}
+
+/// How many violations are listed in full.
+const MAX_LISTED_VIOLATIONS: usize = 100;
+
+#[derive(Debug, Clone, Copy)]
+struct Acc {
+    max_abs: f64,
+    worst: (u32, i64),
+    sum: f64,
+    sum_abs: f64,
+    sum_sq: f64,
+    n_correct: u64,
+    n_faithful: u64,
+    raw_min: i64,
+    raw_max: i64,
+    wrapped: u64,
+    saturated: u64,
+    zeroed: u64,
+}
+
+impl Acc {
+    fn new() -> Acc {
+        Acc {
+            max_abs: -1.0,
+            worst: (0, 0),
+            sum: 0.0,
+            sum_abs: 0.0,
+            sum_sq: 0.0,
+            n_correct: 0,
+            n_faithful: 0,
+            raw_min: i64::MAX,
+            raw_max: i64::MIN,
+            wrapped: 0,
+            saturated: 0,
+            zeroed: 0,
+        }
+    }
+
+    /// Adds a column of one stage's raw values against their f64 references.
+    ///
+    /// The errors go to a scratch column first; each figure is then one short pass with four
+    /// independent lanes (combined in a fixed order, so results stay deterministic), which the
+    /// compiler turns into SIMD instead of one long dependency chain.
+    fn add_column(
+        &mut self,
+        raws: &[i64],
+        lsb: f64,
+        refs: &[f64],
+        codes: &[i64],
+        n: u32,
+        errs: &mut Vec<f64>,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above. No FMA: the results are the
+            // same bits with or without it.
+            return unsafe { self.add_column_avx2(raws, lsb, refs, codes, n, errs) };
+        }
+        self.add_column_any(raws, lsb, refs, codes, n, errs)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn add_column_avx2(
+        &mut self,
+        raws: &[i64],
+        lsb: f64,
+        refs: &[f64],
+        codes: &[i64],
+        n: u32,
+        errs: &mut Vec<f64>,
+    ) {
+        self.add_column_any(raws, lsb, refs, codes, n, errs)
+    }
+
+    #[inline(always)]
+    fn add_column_any(
+        &mut self,
+        raws: &[i64],
+        lsb: f64,
+        refs: &[f64],
+        codes: &[i64],
+        n: u32,
+        errs: &mut Vec<f64>,
+    ) {
+        errs.clear();
+        errs.extend(raws.iter().zip(refs).map(|(&r, &x)| r as f64 * lsb - x));
+        let errs = &errs[..];
+        // A hair of slack for the f64 reference's own rounding.
+        let half = 0.5 * lsb * (1.0 + 1e-9);
+        let one = lsb * (1.0 - 1e-12);
+        let chunk_max = lanes(errs, f64::NEG_INFINITY, |m, e| m.max(e.abs()), f64::max);
+        if chunk_max > self.max_abs {
+            let i = errs
+                .iter()
+                .position(|e| e.abs() == chunk_max)
+                .expect("the maximum is reached");
+            self.max_abs = chunk_max;
+            self.worst = (n, codes[i]);
+        }
+        self.sum += lanes(errs, 0.0, |a, e| a + e, |a, b| a + b);
+        self.sum_abs += lanes(errs, 0.0, |a, e| a + e.abs(), |a, b| a + b);
+        self.sum_sq += lanes(errs, 0.0, |a, e| a + e * e, |a, b| a + b);
+        self.n_correct += errs.iter().map(|e| u64::from(e.abs() <= half)).sum::<u64>();
+        self.n_faithful += errs.iter().map(|e| u64::from(e.abs() < one)).sum::<u64>();
+        self.raw_min = raws.iter().copied().fold(self.raw_min, i64::min);
+        self.raw_max = raws.iter().copied().fold(self.raw_max, i64::max);
+    }
+
+    /// Adds `count` evaluations of a constant (the coefficient) against its f64 value.
+    fn add_constant(&mut self, raw: i64, lsb: f64, reference: f64, count: u64, at: (u32, i64)) {
+        let err = raw as f64 * lsb - reference;
+        let abs = err.abs();
+        if abs > self.max_abs {
+            self.max_abs = abs;
+            self.worst = at;
+        }
+        let w = count as f64;
+        self.sum += w * err;
+        self.sum_abs += w * abs;
+        self.sum_sq += w * err * err;
+        self.n_correct += count * u64::from(abs <= 0.5 * lsb * (1.0 + 1e-9));
+        self.n_faithful += count * u64::from(abs < lsb * (1.0 - 1e-12));
+        self.raw_min = self.raw_min.min(raw);
+        self.raw_max = self.raw_max.max(raw);
+    }
+
+    /// Adds `count` evaluations whose value and reference are both exactly 0.
+    fn add_exact_zeros(&mut self, count: u64) {
+        if count > 0 {
+            if self.max_abs < 0.0 {
+                self.max_abs = 0.0;
+            }
+            self.n_correct += count;
+            self.n_faithful += count;
+            self.raw_min = self.raw_min.min(0);
+            self.raw_max = self.raw_max.max(0);
+        }
+    }
+
+    fn add_events(&mut self, counts: &EventCounts) {
+        self.wrapped += counts[0];
+        self.saturated += counts[1];
+        self.zeroed += counts[2];
+    }
+
+    fn merge(&mut self, o: &Acc) {
+        if o.max_abs > self.max_abs {
+            self.max_abs = o.max_abs;
+            self.worst = o.worst;
+        }
+        self.sum += o.sum;
+        self.sum_abs += o.sum_abs;
+        self.sum_sq += o.sum_sq;
+        self.n_correct += o.n_correct;
+        self.n_faithful += o.n_faithful;
+        self.raw_min = self.raw_min.min(o.raw_min);
+        self.raw_max = self.raw_max.max(o.raw_max);
+        self.wrapped += o.wrapped;
+        self.saturated += o.saturated;
+        self.zeroed += o.zeroed;
+    }
+}
+
+/// Folds a column in four interleaved lanes, then combines the lanes pairwise.
+#[inline(always)]
+fn lanes(
+    xs: &[f64],
+    init: f64,
+    step: impl Fn(f64, f64) -> f64,
+    join: impl Fn(f64, f64) -> f64,
+) -> f64 {
+    let mut acc = [init; 4];
+    let mut quads = xs.chunks_exact(4);
+    for q in &mut quads {
+        for lane in 0..4 {
+            acc[lane] = step(acc[lane], q[lane]);
+        }
+    }
+    for &x in quads.remainder() {
+        acc[0] = step(acc[0], x);
+    }
+    join(join(acc[0], acc[1]), join(acc[2], acc[3]))
+}
+
+/// The running maximum of one shape error.
+#[derive(Debug, Clone, Copy)]
+struct MaxAt {
+    value: f64,
+    at: (u32, i64),
+}
+
+impl MaxAt {
+    fn new() -> MaxAt {
+        MaxAt {
+            value: -1.0,
+            at: (0, 0),
+        }
+    }
+    #[inline]
+    fn add(&mut self, v: f64, at: (u32, i64)) {
+        if v > self.value {
+            self.value = v;
+            self.at = at;
+        }
+    }
+    fn merge(&mut self, o: &MaxAt) {
+        if o.value > self.value {
+            *self = *o;
+        }
+    }
+}
+
+/// Everything gathered for one n.
+struct PerN {
+    stages: Vec<Acc>,
+    quant: MaxAt,
+    approx: MaxAt,
+    total: MaxAt,
+    n_violations: u64,
+    violations: Vec<MonotonicityViolation>,
+    n_cut: u64,
+}
+
+/// The f64 value of every stage for one input, by the same algorithm without rounding.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::check::reference_probes;
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let nc = dp.constants_for(16).unwrap();
+/// let r = reference_probes(&dp, nc, 0.5);
+/// assert_eq!(r[0], -0.5); // d = c - 1
+/// assert_eq!(r[1], -0.5); // t = (16/16) d
+/// assert_eq!(r[2], 0.5); // b = t + 1
+/// assert_eq!(r[6], 0.5f64.powi(16)); // sq4 = b^16
+/// ```
+pub fn reference_probes(dp: &Datapath, nc: &NConstants, c: f64) -> [f64; MAX_STAGES] {
+    let cfg = dp.config();
+    let mut r = [0.0; MAX_STAGES];
+    let c = c.min(1.0);
+    r[STAGE_D] = c - 1.0;
+    r[STAGE_T] = nc.slope * r[STAGE_D];
+    let sum = r[STAGE_T] + nc.offset;
+    r[STAGE_B] = match cfg.cutoff {
+        Cutoff::Clamp => sum.max(0.0),
+        Cutoff::Paper => {
+            let code = c * dp.one_code() as f64;
+            if nc.threshold.is_some_and(|thr| code < thr as f64) {
+                0.0
+            } else {
+                sum
+            }
+        }
+        Cutoff::None => sum,
+    };
+    let mut s = r[STAGE_B];
+    for i in 0..cfg.k as usize {
+        s *= s;
+        r[STAGE_B + 1 + i] = s;
+    }
+    r[dp.stage_coef()] = nc.coef;
+    r[dp.stage_out()] = nc.coef * s;
+    r
+}
+
+/// Codes evaluated per batch: small enough for the columns to stay in cache.
+const CHUNK: usize = 2048;
+
+fn check_one_n(dp: &Datapath, nc: &NConstants, codes: &[i64], ln_c: &[f64]) -> PerN {
+    let cfg = dp.config();
+    let stages = dp.stages();
+    let n_stages = stages.len();
+    let lsb: Vec<f64> = stages.iter().map(|s| s.format.lsb()).collect();
+    let c_lsb = cfg.c.format.lsb();
+    let one = dp.one_code();
+    let last_sq = dp.stage_last_square();
+    let coef_idx = dp.stage_coef();
+    let out = dp.stage_out();
+    let nf = f64::from(nc.n);
+    let threshold = nc.threshold.unwrap_or(i64::MIN);
+    let mut acc = vec![Acc::new(); n_stages];
+    let mut quant = MaxAt::new();
+    let mut approx = MaxAt::new();
+    let mut total = MaxAt::new();
+    let mut violations = Vec::new();
+    let mut n_violations = 0;
+    let mut n_cut = 0;
+    let mut prev_out: Option<i64> = None;
+    // The largest code whose fixed and f64 lobes are both 0: cos^n is increasing in c, so
+    // its error there is the largest of all such codes and needs one evaluation at the end.
+    let mut zero_lobe_code: Option<(i64, f64)> = None;
+    let mut cols = ProbeColumns::default();
+    let mut refs: Vec<Vec<f64>> = vec![Vec::new(); n_stages];
+    let mut errs: Vec<f64> = Vec::with_capacity(CHUNK);
+    // Compacted columns of the inputs whose base is not 0 in both models ("live").
+    let mut live: Vec<usize> = Vec::with_capacity(CHUNK);
+    let mut live_codes: Vec<i64> = Vec::with_capacity(CHUNK);
+    let mut live_raws: Vec<i64> = Vec::with_capacity(CHUNK);
+    let mut live_refs: Vec<f64> = Vec::with_capacity(CHUNK);
+    for (chunk, ln_chunk) in codes.chunks(CHUNK).zip(ln_c.chunks(CHUNK)) {
+        dp.eval_batch(nc, chunk, &mut cols);
+        for (a, counts) in acc.iter_mut().zip(&cols.event_counts) {
+            a.add_events(counts);
+        }
+        // The f64 value of d, t and b by the same algorithm (see `reference_probes`).
+        for r in refs.iter_mut() {
+            r.clear();
+        }
+        refs[STAGE_D].extend(chunk.iter().map(|&k| (k.min(one) as f64 * c_lsb) - 1.0));
+        let (head, tail) = refs.split_at_mut(STAGE_T);
+        tail[0].extend(head[STAGE_D].iter().map(|&d| nc.slope * d));
+        let (head, tail) = refs.split_at_mut(STAGE_B);
+        tail[0].extend(head[STAGE_T].iter().zip(chunk).map(|(&t, &k)| {
+            let sum = t + nc.offset;
+            match cfg.cutoff {
+                Cutoff::Clamp => sum.max(0.0),
+                Cutoff::Paper if k.min(one) < threshold => 0.0,
+                Cutoff::Paper | Cutoff::None => sum,
+            }
+        }));
+        for stage_idx in [STAGE_D, STAGE_T] {
+            acc[stage_idx].add_column(
+                &cols.values[stage_idx],
+                lsb[stage_idx],
+                &refs[stage_idx],
+                chunk,
+                nc.n,
+                &mut errs,
+            );
+        }
+        acc[coef_idx].add_constant(
+            nc.coef_raw,
+            lsb[coef_idx],
+            nc.coef,
+            chunk.len() as u64,
+            (nc.n, chunk[0]),
+        );
+
+        // From b on, an input whose base is 0 in both models stays exactly 0 in both: such
+        // inputs count as exact without being looked at again.
+        live.clear();
+        live.extend(
+            (0..chunk.len()).filter(|&i| cols.values[STAGE_B][i] != 0 || refs[STAGE_B][i] != 0.0),
+        );
+        let n_dead = (chunk.len() - live.len()) as u64;
+        if n_dead > 0 {
+            let largest_dead = (0..chunk.len())
+                .rev()
+                .find(|&i| cols.values[STAGE_B][i] == 0 && refs[STAGE_B][i] == 0.0)
+                .expect("a dead input exists");
+            if zero_lobe_code.is_none_or(|(k, _)| chunk[largest_dead] > k) {
+                zero_lobe_code = Some((chunk[largest_dead], ln_chunk[largest_dead]));
+            }
+        }
+        live_codes.clear();
+        live_codes.extend(live.iter().map(|&i| chunk[i]));
+        live_refs.clear();
+        live_refs.extend(live.iter().map(|&i| refs[STAGE_B][i]));
+        for stage_idx in (STAGE_B..=last_sq).chain([out]) {
+            if stage_idx == out {
+                // live_refs holds the last squaring's references here.
+                for r in &mut live_refs {
+                    *r *= nc.coef;
+                }
+            } else if stage_idx > STAGE_B {
+                for r in &mut live_refs {
+                    *r *= *r;
+                }
+            }
+            live_raws.clear();
+            live_raws.extend(live.iter().map(|&i| cols.values[stage_idx][i]));
+            acc[stage_idx].add_column(
+                &live_raws,
+                lsb[stage_idx],
+                &live_refs,
+                &live_codes,
+                nc.n,
+                &mut errs,
+            );
+            acc[stage_idx].add_exact_zeros(n_dead);
+            if stage_idx == last_sq {
+                // The lobe against cos^n, on the live inputs.
+                for (j, &i) in live.iter().enumerate() {
+                    let at = (nc.n, chunk[i]);
+                    let s_fixed = live_raws[j] as f64 * lsb[last_sq];
+                    let s_ref = live_refs[j];
+                    let c = chunk[i] as f64 * c_lsb;
+                    let cos_n = if c <= 0.0 {
+                        0.0
+                    } else {
+                        (nf * ln_chunk[i]).exp()
+                    };
+                    quant.add((s_fixed - s_ref).abs(), at);
+                    approx.add((s_ref - cos_n).abs(), at);
+                    total.add((s_fixed - cos_n).abs(), at);
+                }
+            }
+        }
+
+        n_cut += cols.cut.iter().filter(|&&c| c).count() as u64;
+        for (&o, &code) in cols.values[out].iter().zip(chunk) {
+            if let Some(prev) = prev_out {
+                if o < prev {
+                    n_violations += 1;
+                    if violations.len() < MAX_LISTED_VIOLATIONS {
+                        violations.push(MonotonicityViolation {
+                            n: nc.n,
+                            c_raw: code,
+                            out_before: prev,
+                            out_here: o,
+                        });
+                    }
+                }
+            }
+            prev_out = Some(o);
+        }
+    }
+    if let Some((code, lnc)) = zero_lobe_code {
+        let at = (nc.n, code);
+        let cos_n = if code <= 0 { 0.0 } else { (nf * lnc).exp() };
+        quant.add(0.0, at);
+        approx.add(cos_n, at);
+        total.add(cos_n, at);
+    }
+    PerN {
+        stages: acc,
+        quant,
+        approx,
+        total,
+        n_violations,
+        violations,
+        n_cut,
+    }
+}
+
+/// The largest number of input codes an exhaustive check evaluates per exponent.
+pub const MAX_CHECK_CODES: u64 = 1 << 24;
+
+/// Checks a datapath exhaustively: every input code up to 1.0, every n of its set.
+///
+/// Returns an error message when the input format has more than [`MAX_CHECK_CODES`] codes.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::check::check;
+/// use specfx::pipeline::{Config, Datapath};
+/// let mut cfg = Config::baseline();
+/// cfg.n = "64".parse().unwrap();
+/// let r = check(&Datapath::new(cfg).unwrap()).unwrap();
+/// assert_eq!(r.n_evaluations, 32769);
+/// assert!(r.monotonic);
+/// ```
+pub fn check(dp: &Datapath) -> Result<CheckReport, String> {
+    let codes_all = dp.input_codes();
+    let last = (*codes_all.end()).min(dp.one_code());
+    let n_codes = (last - codes_all.start() + 1) as u64;
+    if n_codes > MAX_CHECK_CODES {
+        return Err(format!(
+            "c.format {} has {n_codes} input codes up to 1.0; an exhaustive check evaluates at most {MAX_CHECK_CODES}",
+            dp.config().c.format
+        ));
+    }
+    let codes: Vec<i64> = (*codes_all.start()..=last).collect();
+    let c_lsb = dp.config().c.format.lsb();
+    let ln_c: Vec<f64> = codes.iter().map(|&k| (k as f64 * c_lsb).ln()).collect();
+    let per_n: Vec<PerN> = dp
+        .constants()
+        .par_iter()
+        .map(|nc| check_one_n(dp, nc, &codes, &ln_c))
+        .collect();
+
+    let stages = dp.stages();
+    let mut acc = vec![Acc::new(); stages.len()];
+    let mut quant = MaxAt::new();
+    let mut approx = MaxAt::new();
+    let mut total = MaxAt::new();
+    let mut violations = Vec::new();
+    let mut n_violations = 0;
+    let mut n_cut = 0;
+    for p in &per_n {
+        for (a, b) in acc.iter_mut().zip(&p.stages) {
+            a.merge(b);
+        }
+        quant.merge(&p.quant);
+        approx.merge(&p.approx);
+        total.merge(&p.total);
+        n_violations += p.n_violations;
+        for v in &p.violations {
+            if violations.len() < MAX_LISTED_VIOLATIONS {
+                violations.push(*v);
+            }
+        }
+        n_cut += p.n_cut;
+    }
+    let n_eval = n_codes * per_n.len() as u64;
+    let count = n_eval as f64;
+    let input = |at: (u32, i64)| Input {
+        n: at.0,
+        c_raw: at.1,
+        c: at.1 as f64 * c_lsb,
+    };
+    let stage_stats: Vec<StageStats> = stages
+        .iter()
+        .zip(&acc)
+        .map(|(s, a)| {
+            let lsb = s.format.lsb();
+            StageStats {
+                stage: s.name.clone(),
+                format: s.format.to_string(),
+                max_abs_err: a.max_abs,
+                mean_err: a.sum / count,
+                mean_abs_err: a.sum_abs / count,
+                rms_err: (a.sum_sq / count).sqrt(),
+                max_ulp: a.max_abs / lsb,
+                correctly_rounded: a.n_correct as f64 / count,
+                faithfully_rounded: a.n_faithful as f64 / count,
+                worst: input(a.worst),
+                raw_min: a.raw_min,
+                raw_max: a.raw_max,
+                wrapped: a.wrapped,
+                saturated: a.saturated,
+                zeroed: a.zeroed,
+            }
+        })
+        .collect();
+    let out_max_ulp = stage_stats[dp.stage_out()].max_ulp;
+    let above = (*codes_all.end() - last).max(0) as u64;
+    Ok(CheckReport {
+        config: dp.config().name.clone(),
+        n_set: dp.config().n.to_string(),
+        n_exponents: per_n.len(),
+        n_input_codes: n_codes,
+        n_codes_above_one: above,
+        n_evaluations: n_eval,
+        stages: stage_stats,
+        shape_quant_max_abs: quant.value,
+        shape_quant_worst: input(quant.at),
+        shape_approx_max_abs: approx.value,
+        shape_approx_worst: input(approx.at),
+        shape_total_max_abs: total.value,
+        shape_total_worst: input(total.at),
+        out_max_ulp,
+        monotonic: n_violations == 0,
+        n_monotonicity_violations: n_violations,
+        monotonicity_violations: violations,
+        n_cut,
+    })
+}

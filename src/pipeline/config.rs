@@ -1,0 +1,382 @@
+//! Datapath configuration: the TOML schema, the built-in `baseline`, and merging a file onto it.
+//!
+//! A configuration file only states what differs from `baseline`: every key it leaves out
+//! takes the baseline's value. The result is a complete [`Config`], which
+//! [`crate::pipeline::Datapath::new`] validates once.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::Error;
+use crate::fixed::{Format, Overflow, Rounding};
+use crate::nset::NSet;
+use crate::reference::lobe::Cutoff;
+use crate::reference::normalisation::{CoefSource, Form};
+
+/// Which constants drive the base `slope * (c - 1) + offset`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Variant {
+    /// slope n/m (a product with n and a shift by k), offset 1.
+    Plain,
+    /// slope A(n), offset A(n) + B(n) from the minimax table, each quantized to a format.
+    Minimax,
+}
+
+impl Variant {
+    /// The name used in TOML and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Plain => "plain",
+            Variant::Minimax => "minimax",
+        }
+    }
+}
+
+/// A stage's output quantization: its format, rounding mode and overflow mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct StageSpec {
+    /// The stage's output format.
+    pub format: Format,
+    /// How dropped fraction bits are rounded.
+    pub rounding: Rounding,
+    /// What happens when the rounded value does not fit.
+    pub overflow: Overflow,
+}
+
+/// A format alone, for the input and the exact subtraction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct FormatSpec {
+    /// The format.
+    pub format: Format,
+}
+
+/// The energy-conserving coefficient: which one, and the format it is stored in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct CoefSpec {
+    /// The normalisation form.
+    pub form: Form,
+    /// Where the coefficient comes from.
+    pub source: CoefSource,
+    /// The format of the stored per-n constant.
+    pub format: Format,
+    /// How its f64 value is rounded into that format (it must fit: no overflow mode).
+    pub rounding: Rounding,
+}
+
+/// The per-n constants of the minimax variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct MinimaxSpec {
+    /// The format of the slope A(n).
+    pub a_format: Format,
+    /// The format of the offset A(n) + B(n) (the value of the base at c = 1).
+    pub offset_format: Format,
+    /// How both are rounded from their f64 values (they must fit).
+    pub rounding: Rounding,
+}
+
+/// A complete datapath configuration. See `docs/arithmetic.md` for the arithmetic it implies.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Config {
+    /// A name for reports and manifests.
+    pub name: String,
+    /// Plain (n/m, 1) or minimax (A(n), A(n) + B(n)) constants.
+    pub variant: Variant,
+    /// Number of squarings; m = 2^k.
+    pub k: u32,
+    /// How the base is cut: `clamp`, `paper` or `none`.
+    pub cutoff: Cutoff,
+    /// The exponents the datapath serves.
+    pub n: NSet,
+    /// The input cosine c (values above 1.0 are clamped to 1.0).
+    pub c: FormatSpec,
+    /// d = c - 1, exact.
+    pub d: FormatSpec,
+    /// t = d * slope.
+    pub t: StageSpec,
+    /// b = t + offset, then the cutoff.
+    pub b: StageSpec,
+    /// One entry per squaring stage, k in all.
+    pub square: Vec<StageSpec>,
+    /// The coefficient coef(n).
+    pub coef: CoefSpec,
+    /// out = square_k * coef.
+    pub out: StageSpec,
+    /// The minimax constants' formats (used by the minimax variant only).
+    pub minimax: MinimaxSpec,
+}
+
+fn fmt(s: &str) -> Format {
+    s.parse().expect("built-in format notation is valid")
+}
+
+impl Config {
+    /// The built-in `baseline` configuration (see `docs/arithmetic.md`).
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::Config;
+    /// let b = Config::baseline();
+    /// assert_eq!(b.t.format.to_string(), "s2.16");
+    /// assert_eq!(b.square.len(), 4);
+    /// ```
+    pub fn baseline() -> Config {
+        let rnd_sat = |f: &str| StageSpec {
+            format: fmt(f),
+            rounding: Rounding::Rnd,
+            overflow: Overflow::Sat,
+        };
+        Config {
+            name: "baseline".to_string(),
+            variant: Variant::Plain,
+            k: 4,
+            cutoff: Cutoff::Clamp,
+            n: NSet::range(16, 1024).expect("valid range"),
+            c: FormatSpec {
+                format: fmt("u1.15"),
+            },
+            d: FormatSpec {
+                format: fmt("s1.15"),
+            },
+            t: rnd_sat("s2.16"),
+            // b = t + 1 is exact in u1.16 for t in s2.16 and c <= 1: the rounding never acts.
+            b: rnd_sat("u1.16"),
+            square: vec![rnd_sat("u1.16"); 4],
+            coef: CoefSpec {
+                form: Form::Phong,
+                source: CoefSource::Exact,
+                format: fmt("u8.16"),
+                rounding: Rounding::Rnd,
+            },
+            out: rnd_sat("u8.16"),
+            minimax: MinimaxSpec {
+                a_format: fmt("u8.16"),
+                offset_format: fmt("u1.16"),
+                rounding: Rounding::Rnd,
+            },
+        }
+    }
+
+    /// A built-in configuration by name (`baseline`), if there is one.
+    pub fn builtin(name: &str) -> Option<Config> {
+        (name == "baseline").then(Config::baseline)
+    }
+
+    /// Reads a TOML text onto `baseline`: every key it gives replaces the baseline's value.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::Config;
+    /// let c = Config::from_toml("k = 5\n[t]\nformat = \"s3.20\"\n").unwrap();
+    /// assert_eq!(c.k, 5);
+    /// assert_eq!(c.square.len(), 5); // the baseline's one squaring spec, five times
+    /// assert_eq!(c.t.format.to_string(), "s3.20");
+    /// assert_eq!(c.t.rounding, Config::baseline().t.rounding);
+    /// let err = Config::from_toml("[t]\nformt = \"s3.20\"\n").unwrap_err();
+    /// assert!(err.to_string().starts_with("line 2: unknown field `formt`"));
+    /// ```
+    pub fn from_toml(text: &str) -> Result<Config, Error> {
+        let file: ConfigFile = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
+                .unwrap_or(1);
+            Error::Toml {
+                line,
+                message: e.message().replace('\n', " ").trim().to_string(),
+            }
+        })?;
+        file.onto(Config::baseline())
+    }
+
+    /// The configuration as TOML text (complete: every key).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("a Config always serialises")
+    }
+}
+
+/// A stage section of a file: any key may be left out.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StagePatch {
+    format: Option<Format>,
+    rounding: Option<Rounding>,
+    overflow: Option<Overflow>,
+}
+
+impl StagePatch {
+    fn onto(&self, base: StageSpec) -> StageSpec {
+        StageSpec {
+            format: self.format.unwrap_or(base.format),
+            rounding: self.rounding.unwrap_or(base.rounding),
+            overflow: self.overflow.unwrap_or(base.overflow),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FormatPatch {
+    format: Option<Format>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CoefPatch {
+    form: Option<Form>,
+    source: Option<CoefSource>,
+    format: Option<Format>,
+    rounding: Option<Rounding>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MinimaxPatch {
+    a_format: Option<Format>,
+    offset_format: Option<Format>,
+    rounding: Option<Rounding>,
+}
+
+/// `[square]` (one spec for every stage) or `[[square]]` (one table per stage).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum SquarePatch {
+    All(StagePatch),
+    Each(Vec<StagePatch>),
+}
+
+/// What a configuration file may say.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConfigFile {
+    name: Option<String>,
+    variant: Option<Variant>,
+    k: Option<u32>,
+    cutoff: Option<Cutoff>,
+    n: Option<NSet>,
+    c: Option<FormatPatch>,
+    d: Option<FormatPatch>,
+    t: Option<StagePatch>,
+    b: Option<StagePatch>,
+    square: Option<SquarePatch>,
+    coef: Option<CoefPatch>,
+    out: Option<StagePatch>,
+    minimax: Option<MinimaxPatch>,
+}
+
+impl ConfigFile {
+    fn onto(self, base: Config) -> Result<Config, Error> {
+        let k = self.k.unwrap_or(base.k);
+        if !crate::reference::lobe::K_RANGE.contains(&k) {
+            return Err(Error::Config {
+                key: "k".to_string(),
+                problem: format!("expected a number of squarings in 1..=7, got {k}"),
+            });
+        }
+        let base_square = base.square[0];
+        let square = match &self.square {
+            None => vec![base_square; k as usize],
+            Some(SquarePatch::All(p)) => vec![p.onto(base_square); k as usize],
+            Some(SquarePatch::Each(list)) => {
+                if list.len() != k as usize {
+                    return Err(Error::Config {
+                        key: "square".to_string(),
+                        problem: format!(
+                            "expected one [square] table for all stages or k = {k} [[square]] tables, got {}",
+                            list.len()
+                        ),
+                    });
+                }
+                list.iter().map(|p| p.onto(base_square)).collect()
+            }
+        };
+        let coef = self.coef.unwrap_or_default();
+        let mm = self.minimax.unwrap_or_default();
+        Ok(Config {
+            name: self.name.unwrap_or(base.name),
+            variant: self.variant.unwrap_or(base.variant),
+            k,
+            cutoff: self.cutoff.unwrap_or(base.cutoff),
+            n: self.n.unwrap_or(base.n),
+            c: FormatSpec {
+                format: self.c.and_then(|p| p.format).unwrap_or(base.c.format),
+            },
+            d: FormatSpec {
+                format: self.d.and_then(|p| p.format).unwrap_or(base.d.format),
+            },
+            t: self.t.unwrap_or_default().onto(base.t),
+            b: self.b.unwrap_or_default().onto(base.b),
+            square,
+            coef: CoefSpec {
+                form: coef.form.unwrap_or(base.coef.form),
+                source: coef.source.unwrap_or(base.coef.source),
+                format: coef.format.unwrap_or(base.coef.format),
+                rounding: coef.rounding.unwrap_or(base.coef.rounding),
+            },
+            out: self.out.unwrap_or_default().onto(base.out),
+            minimax: MinimaxSpec {
+                a_format: mm.a_format.unwrap_or(base.minimax.a_format),
+                offset_format: mm.offset_format.unwrap_or(base.minimax.offset_format),
+                rounding: mm.rounding.unwrap_or(base.minimax.rounding),
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_file_is_baseline() {
+        let mut c = Config::from_toml("").unwrap();
+        assert_eq!(c, Config::baseline());
+        c.name = "x".into();
+        assert_ne!(c, Config::baseline());
+    }
+
+    #[test]
+    fn full_toml_round_trips() {
+        let mut c = Config::baseline();
+        c.k = 2;
+        c.square = vec![
+            StageSpec {
+                format: fmt("u1.12"),
+                rounding: Rounding::Trn,
+                overflow: Overflow::Wrap,
+            },
+            StageSpec {
+                format: fmt("u1.10"),
+                rounding: Rounding::RndConv,
+                overflow: Overflow::SatSym,
+            },
+        ];
+        c.variant = Variant::Minimax;
+        c.cutoff = Cutoff::Paper;
+        let text = c.to_toml();
+        assert_eq!(Config::from_toml(&text).unwrap(), c);
+    }
+
+    #[test]
+    fn per_stage_squares_must_number_k() {
+        let text = "k = 3\n[[square]]\nformat = \"u1.10\"\n[[square]]\nformat = \"u1.9\"\n";
+        let e = Config::from_toml(text).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "square: expected one [square] table for all stages or k = 3 [[square]] tables, got 2"
+        );
+    }
+
+    #[test]
+    fn bad_values_name_their_line() {
+        let e = Config::from_toml("k = 4\n[t]\nrounding = \"ROUND\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("line 3: rounding mode must be one of"), "{e}");
+        let e = Config::from_toml("[b]\nformat = \"q1.2\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("line 2: format must look like"), "{e}");
+        let e = Config::from_toml("k = 9\n").unwrap_err().to_string();
+        assert_eq!(e, "k: expected a number of squarings in 1..=7, got 9");
+    }
+}

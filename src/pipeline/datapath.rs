@@ -1,0 +1,670 @@
+//! The validated datapath and its bit-accurate evaluation: per-n constants, stages and probes.
+//!
+//! [`Datapath::new`] validates a [`Config`] once (every format can hold what it must, every
+//! exact intermediate fits in `i128`, every per-n constant fits its format). After that,
+//! [`Datapath::eval`] cannot fail: overflow is modelled by each stage's mode and reported as an
+//! [`Event`] in the [`Probes`].
+
+use crate::error::Error;
+use crate::fixed::{quantize, quantize_i64, Event, Exact, Format, Overflow, Quantized};
+use crate::pipeline::config::{Config, StageSpec, Variant};
+use crate::pipeline::fast::{run_stage, EventCounts, FastPlan, Pre, StageQ};
+use crate::reference::lobe::{m_of_k, Cutoff, PAPER_CUTOFF_CONSTANT};
+use crate::reference::minimax;
+use crate::reference::normalisation::coefficient;
+
+/// The most stages a datapath can have: d, t, b, seven squarings, coef and out.
+pub const MAX_STAGES: usize = 12;
+
+/// Index of the d = c - 1 probe.
+pub const STAGE_D: usize = 0;
+/// Index of the t = d * slope probe.
+pub const STAGE_T: usize = 1;
+/// Index of the b = t + offset (after the cutoff) probe.
+pub const STAGE_B: usize = 2;
+/// Index of the first squaring's probe; squaring i (0-based) is at `STAGE_SQ0 + i`.
+pub const STAGE_SQ0: usize = 3;
+
+/// Widest exact intermediate the model computes, in bits (it lives in an `i128`).
+const MAX_EXACT_BITS: u32 = 126;
+
+/// A stage as reports and vector files name it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StageInfo {
+    /// `d`, `t`, `b`, `sq1`..`sqk`, `coef` or `out`.
+    pub name: String,
+    /// The format of the stage's value.
+    pub format: Format,
+}
+
+/// The constants of one exponent n, as the datapath stores them, with their f64 originals.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NConstants {
+    /// The exponent.
+    pub n: u32,
+    /// Raw slope: n (plain) or A(n) quantized (minimax).
+    pub slope_raw: i64,
+    /// Fraction bits of the slope: k (plain, the shift by k) or those of A's format.
+    pub slope_frac: i32,
+    /// Raw offset: 1 (plain) or A(n) + B(n) quantized (minimax).
+    pub offset_raw: i64,
+    /// Fraction bits of the offset.
+    pub offset_frac: i32,
+    /// Paper cutoff: the base is zero when the input code is below this code.
+    pub threshold: Option<i64>,
+    /// Raw coefficient in the coefficient's format.
+    pub coef_raw: i64,
+    /// The slope before quantization (n/m, or A(n)).
+    pub slope: f64,
+    /// The offset before quantization (1, or A(n) + B(n)).
+    pub offset: f64,
+    /// The coefficient before quantization.
+    pub coef: f64,
+}
+
+/// Every stage's value for one evaluation, indexed like [`Datapath::stages`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Probes {
+    /// Raw values in each stage's format (unused slots are 0).
+    pub values: [i64; MAX_STAGES],
+    /// The overflow event of each stage's quantization.
+    pub events: [Event; MAX_STAGES],
+    /// The cutoff forced the base to zero (negative base clamped, or paper threshold).
+    pub cut: bool,
+    /// The input was above 1.0 and clamped to 1.0.
+    pub input_clamped: bool,
+}
+
+impl Default for Probes {
+    fn default() -> Probes {
+        Probes {
+            values: [0; MAX_STAGES],
+            events: [Event::None; MAX_STAGES],
+            cut: false,
+            input_clamped: false,
+        }
+    }
+}
+
+/// The probes of a batch of evaluations, one column per stage (structure of arrays).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ProbeColumns {
+    /// `values[stage_idx][i]`: raw value of stage `stage_idx` for input `i`.
+    pub values: Vec<Vec<i64>>,
+    /// `event_counts[stage_idx]`: how many quantizations of the batch wrapped, saturated and
+    /// overflowed to zero, in that order.
+    pub event_counts: Vec<EventCounts>,
+    /// Scratch space for the exact sums of the b stage.
+    scratch: Vec<i64>,
+    /// `cut[i]`: the cutoff forced the base to zero.
+    pub cut: Vec<bool>,
+    /// `input_clamped[i]`: the input was above 1.0.
+    pub input_clamped: Vec<bool>,
+}
+
+impl ProbeColumns {
+    fn reset(&mut self, n_stages: usize, len: usize) {
+        self.values.resize_with(n_stages, Vec::new);
+        self.event_counts.clear();
+        self.event_counts.resize(n_stages, [0; 3]);
+        for col in &mut self.values {
+            col.clear();
+            col.resize(len, 0);
+        }
+        self.cut.clear();
+        self.cut.resize(len, false);
+        self.input_clamped.clear();
+        self.input_clamped.resize(len, false);
+    }
+
+    /// The number of evaluations held.
+    pub fn len(&self) -> usize {
+        self.cut.len()
+    }
+
+    /// Whether no evaluation is held.
+    pub fn is_empty(&self) -> bool {
+        self.cut.is_empty()
+    }
+
+    /// The probes of evaluation `i`, as one [`Probes`] (without the events, which a batch only
+    /// counts).
+    pub fn row(&self, i: usize) -> Probes {
+        let mut p = Probes::default();
+        for (stage_idx, col) in self.values.iter().enumerate() {
+            p.values[stage_idx] = col[i];
+        }
+        p.cut = self.cut[i];
+        p.input_clamped = self.input_clamped[i];
+        p
+    }
+}
+
+/// A validated datapath: the configuration, its stages and its per-n constants.
+#[derive(Debug, Clone)]
+pub struct Datapath {
+    config: Config,
+    stages: Vec<StageInfo>,
+    constants: Vec<NConstants>,
+    one_raw: i64,
+    d_shift: u32,
+    fast: Option<FastPlan>,
+}
+
+fn config_error(key: &str, problem: String) -> Error {
+    Error::Config {
+        key: key.to_string(),
+        problem,
+    }
+}
+
+/// Bits needed for the magnitude of a product of raws of widths `a` and `b`.
+fn product_bits(a: u32, b: u32) -> u32 {
+    a + b
+}
+
+/// Width of the exact sum of two formats aligned on the larger fraction.
+fn sum_bits(a: Format, b: Format) -> u32 {
+    let frac = a.frac_bits().max(b.frac_bits());
+    let int = a.int_bits().max(b.int_bits());
+    u32::try_from(i64::from(int) + i64::from(frac) + 1).unwrap_or(u32::MAX)
+}
+
+/// Quantizes an exact value `raw * 2^-frac` to a stage's spec.
+#[inline]
+fn quantize_to(raw: i128, frac: i32, spec: &StageSpec) -> Quantized {
+    match i64::try_from(raw) {
+        Ok(r) => quantize_i64(r, frac, spec.format, spec.rounding, spec.overflow),
+        Err(_) => quantize(
+            Exact::new(raw, frac),
+            spec.format,
+            spec.rounding,
+            spec.overflow,
+        ),
+    }
+}
+
+/// Rounds an f64 constant into a format; it must fit.
+fn constant_raw(
+    value: Exact,
+    format: Format,
+    rounding: crate::fixed::Rounding,
+) -> Result<i64, String> {
+    let q = quantize(value, format, rounding, Overflow::Sat);
+    if q.event == Event::None {
+        Ok(q.raw)
+    } else {
+        Err(format!(
+            "{} does not fit {format} (range {}..={})",
+            value.to_f64(),
+            format.min_value(),
+            format.max_value()
+        ))
+    }
+}
+
+impl Datapath {
+    /// Validates a configuration and computes its per-n constants.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::{Config, Datapath};
+    /// let dp = Datapath::new(Config::baseline()).unwrap();
+    /// assert_eq!(dp.stages().len(), 9); // d, t, b, sq1..sq4, coef, out
+    /// let mut bad = Config::baseline();
+    /// bad.c.format = "u0.16".parse().unwrap();
+    /// assert_eq!(
+    ///     Datapath::new(bad).unwrap_err().to_string(),
+    ///     "c.format: must represent 1.0 exactly, got u0.16"
+    /// );
+    /// ```
+    pub fn new(config: Config) -> Result<Datapath, Error> {
+        let k = config.k;
+        if !crate::reference::lobe::K_RANGE.contains(&k) {
+            return Err(config_error(
+                "k",
+                format!("expected a number of squarings in 1..=7, got {k}"),
+            ));
+        }
+        if config.square.len() != k as usize {
+            return Err(config_error(
+                "square",
+                format!(
+                    "expected k = {k} squaring stages, got {}",
+                    config.square.len()
+                ),
+            ));
+        }
+        // The input must hold 1.0 exactly (values above it are clamped to it).
+        let cf = config.c.format;
+        if cf.frac_bits() < 0 || cf.frac_bits() > 62 || cf.max_raw() < (1i64 << cf.frac_bits()) {
+            return Err(config_error(
+                "c.format",
+                format!("must represent 1.0 exactly, got {cf}"),
+            ));
+        }
+        let one_raw = 1i64 << cf.frac_bits();
+        // d = c - 1 must be exact for every clamped input.
+        let df = config.d.format;
+        let d_shift = df.frac_bits() - cf.frac_bits();
+        let d_min = cf.min_value() - 1.0;
+        if d_shift < 0 || df.min_value() > d_min || df.max_value() < 0.0 || d_shift > 62 {
+            return Err(config_error(
+                "d.format",
+                format!(
+                    "must hold c - 1 exactly for every input of {cf} (at least {} fraction bits, range down to {d_min}), got {df}",
+                    cf.frac_bits()
+                ),
+            ));
+        }
+        let d_shift = d_shift as u32;
+        if i128::from(cf.min_raw() - one_raw) << d_shift < i128::from(df.min_raw()) {
+            return Err(config_error(
+                "d.format",
+                format!("cannot hold {d_min} exactly, got {df}"),
+            ));
+        }
+
+        let mut constants = Vec::with_capacity(config.n.len());
+        for &n in config.n.values() {
+            constants.push(Self::constants_of(&config, n, one_raw)?);
+        }
+
+        // Every exact intermediate must fit in an i128.
+        let slope_bits = match config.variant {
+            Variant::Plain => 33 - config.n.max().leading_zeros(),
+            Variant::Minimax => config.minimax.a_format.width(),
+        };
+        let offset_format = match config.variant {
+            Variant::Plain => Format::unsigned(2, 0).expect("valid"),
+            Variant::Minimax => config.minimax.offset_format,
+        };
+        let mut checks = vec![
+            ("t.format", product_bits(df.width(), slope_bits)),
+            ("b.format", sum_bits(config.t.format, offset_format)),
+        ];
+        let mut prev = config.b.format;
+        for (i, sq) in config.square.iter().enumerate() {
+            checks.push((
+                if i == 0 { "b.format" } else { "square" },
+                product_bits(prev.width(), prev.width()),
+            ));
+            prev = sq.format;
+        }
+        checks.push((
+            "coef.format",
+            product_bits(prev.width(), config.coef.format.width()),
+        ));
+        let fits_i64 = checks.iter().all(|&(_, bits)| bits <= 62);
+        for (key, bits) in checks {
+            if bits > MAX_EXACT_BITS {
+                return Err(config_error(
+                    key,
+                    format!("an exact intermediate would need {bits} bits; the model computes at most {MAX_EXACT_BITS}: narrow the formats"),
+                ));
+            }
+        }
+
+        let mut stages = vec![
+            StageInfo {
+                name: "d".into(),
+                format: df,
+            },
+            StageInfo {
+                name: "t".into(),
+                format: config.t.format,
+            },
+            StageInfo {
+                name: "b".into(),
+                format: config.b.format,
+            },
+        ];
+        for (i, sq) in config.square.iter().enumerate() {
+            stages.push(StageInfo {
+                name: format!("sq{}", i + 1),
+                format: sq.format,
+            });
+        }
+        stages.push(StageInfo {
+            name: "coef".into(),
+            format: config.coef.format,
+        });
+        stages.push(StageInfo {
+            name: "out".into(),
+            format: config.out.format,
+        });
+        let fast = fits_i64.then(|| Self::fast_plan(&config, &constants));
+        Ok(Datapath {
+            config,
+            stages,
+            constants,
+            one_raw,
+            d_shift,
+            fast,
+        })
+    }
+
+    fn fast_plan(config: &Config, constants: &[NConstants]) -> FastPlan {
+        // The slope's and offset's fraction bits are the same for every n.
+        let (slope_frac, offset_frac) = constants
+            .first()
+            .map_or((0, 0), |c| (c.slope_frac, c.offset_frac));
+        let ft = config.t.format.frac_bits();
+        let fb = ft.max(offset_frac);
+        let mut squares = Vec::with_capacity(config.square.len());
+        let mut fs = config.b.format.frac_bits();
+        for spec in &config.square {
+            squares.push(StageQ::new(2 * fs, spec));
+            fs = spec.format.frac_bits();
+        }
+        FastPlan {
+            t: StageQ::new(config.d.format.frac_bits() + slope_frac, &config.t),
+            t_align: (fb - ft) as u32,
+            offset_align: (fb - offset_frac) as u32,
+            b: StageQ::new(fb, &config.b),
+            squares,
+            out: StageQ::new(fs + config.coef.format.frac_bits(), &config.out),
+        }
+    }
+
+    fn constants_of(config: &Config, n: u32, one_raw: i64) -> Result<NConstants, Error> {
+        let k = config.k;
+        let nf = f64::from(n);
+        let (slope_raw, slope_frac, offset_raw, offset_frac, slope, offset) = match config.variant {
+            Variant::Plain => (i64::from(n), k as i32, 1, 0, nf / f64::from(m_of_k(k)), 1.0),
+            Variant::Minimax => {
+                let fit = minimax::constants(n, k).map_err(|e| {
+                    config_error(
+                        "n",
+                        format!("the minimax variant needs a cached entry: {e}"),
+                    )
+                })?;
+                let mm = &config.minimax;
+                let a = Exact::from_f64(fit.a).expect("finite table entry");
+                let b = Exact::from_f64(fit.b).expect("finite table entry");
+                let a_raw = constant_raw(a, mm.a_format, mm.rounding)
+                    .map_err(|p| config_error("minimax.a_format", format!("A(n = {n}) = {p}")))?;
+                let off_raw = constant_raw(a + b, mm.offset_format, mm.rounding).map_err(|p| {
+                    config_error(
+                        "minimax.offset_format",
+                        format!("A(n = {n}) + B(n = {n}) = {p}"),
+                    )
+                })?;
+                (
+                    a_raw,
+                    mm.a_format.frac_bits(),
+                    off_raw,
+                    mm.offset_format.frac_bits(),
+                    fit.a,
+                    fit.a + fit.b,
+                )
+            }
+        };
+        let coef = coefficient(config.coef.form, config.coef.source, nf, k);
+        let coef_exact = Exact::from_f64(coef).ok_or_else(|| {
+            config_error(
+                "coef.source",
+                format!("coef(n = {n}) is not finite: {coef}"),
+            )
+        })?;
+        let coef_raw = constant_raw(coef_exact, config.coef.format, config.coef.rounding)
+            .map_err(|p| config_error("coef.format", format!("coef(n = {n}) = {p}")))?;
+        let threshold = match config.cutoff {
+            Cutoff::Paper => Some(paper_threshold(n, config.c.format, one_raw)),
+            Cutoff::Clamp | Cutoff::None => None,
+        };
+        Ok(NConstants {
+            n,
+            slope_raw,
+            slope_frac,
+            offset_raw,
+            offset_frac,
+            threshold,
+            coef_raw,
+            slope,
+            offset,
+            coef,
+        })
+    }
+
+    /// The configuration this datapath was built from.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The stages in pipeline order: d, t, b, sq1..sqk, coef, out.
+    pub fn stages(&self) -> &[StageInfo] {
+        &self.stages
+    }
+
+    /// Index of the k-th (last) squaring's probe.
+    pub fn stage_last_square(&self) -> usize {
+        STAGE_SQ0 + self.config.k as usize - 1
+    }
+
+    /// Index of the coefficient probe.
+    pub fn stage_coef(&self) -> usize {
+        STAGE_SQ0 + self.config.k as usize
+    }
+
+    /// Index of the output probe.
+    pub fn stage_out(&self) -> usize {
+        STAGE_SQ0 + self.config.k as usize + 1
+    }
+
+    /// The per-n constants, in the order of the configuration's n set.
+    pub fn constants(&self) -> &[NConstants] {
+        &self.constants
+    }
+
+    /// The constants of one n of the set.
+    pub fn constants_for(&self, n: u32) -> Option<&NConstants> {
+        self.config
+            .n
+            .values()
+            .binary_search(&n)
+            .ok()
+            .map(|i| &self.constants[i])
+    }
+
+    /// The raw input code of 1.0.
+    pub fn one_code(&self) -> i64 {
+        self.one_raw
+    }
+
+    /// Every raw input code of the input format.
+    pub fn input_codes(&self) -> std::ops::RangeInclusive<i64> {
+        let f = self.config.c.format;
+        f.min_raw()..=f.max_raw()
+    }
+
+    /// Evaluates the datapath on one raw input code for one n, bit for bit.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::{Config, Datapath};
+    /// let dp = Datapath::new(Config::baseline()).unwrap();
+    /// let nc = dp.constants_for(64).unwrap();
+    /// // c = 1.0: the lobe is 1 and the output is the coefficient itself.
+    /// let p = dp.eval(dp.one_code(), nc);
+    /// assert_eq!(p.values[dp.stage_out()], nc.coef_raw);
+    /// ```
+    ///
+    /// This is the plain transcription of the arithmetic (exact intermediates in `i128`,
+    /// quantized by [`quantize`]); [`Datapath::eval_batch`] is its fast twin.
+    pub fn eval(&self, c_raw: i64, nc: &NConstants) -> Probes {
+        let cfg = &self.config;
+        let mut p = Probes::default();
+        let input_clamped = c_raw > self.one_raw;
+        let c = if input_clamped { self.one_raw } else { c_raw };
+        p.input_clamped = input_clamped;
+
+        // d = c - 1, exact (validated).
+        let d = (c - self.one_raw) << self.d_shift;
+        let fd = cfg.d.format.frac_bits();
+        p.values[STAGE_D] = d;
+
+        // t = d * slope: exact product, then the t stage's quantization.
+        let t = quantize_to(
+            i128::from(d) * i128::from(nc.slope_raw),
+            fd + nc.slope_frac,
+            &cfg.t,
+        );
+        p.values[STAGE_T] = t.raw;
+        p.events[STAGE_T] = t.event;
+
+        // b = t + offset, exact on the larger fraction, then the cutoff and the b stage.
+        let ft = cfg.t.format.frac_bits();
+        let fb = ft.max(nc.offset_frac);
+        let mut sum = (i128::from(t.raw) << (fb - ft) as u32)
+            + (i128::from(nc.offset_raw) << (fb - nc.offset_frac) as u32);
+        let cut = match cfg.cutoff {
+            Cutoff::Clamp => sum < 0,
+            Cutoff::Paper => nc.threshold.is_some_and(|thr| c < thr),
+            Cutoff::None => false,
+        };
+        if cut {
+            sum = 0;
+        }
+        p.cut = cut;
+        let b = quantize_to(sum, fb, &cfg.b);
+        p.values[STAGE_B] = b.raw;
+        p.events[STAGE_B] = b.event;
+
+        // k squarings, each exact then quantized by its own stage.
+        let mut s = b.raw;
+        let mut fs = cfg.b.format.frac_bits();
+        for (i, spec) in cfg.square.iter().enumerate() {
+            let q = quantize_to(i128::from(s) * i128::from(s), 2 * fs, spec);
+            p.values[STAGE_SQ0 + i] = q.raw;
+            p.events[STAGE_SQ0 + i] = q.event;
+            s = q.raw;
+            fs = spec.format.frac_bits();
+        }
+
+        // out = s_k * coef.
+        let kk = cfg.k as usize;
+        p.values[STAGE_SQ0 + kk] = nc.coef_raw;
+        let o = quantize_to(
+            i128::from(s) * i128::from(nc.coef_raw),
+            fs + cfg.coef.format.frac_bits(),
+            &cfg.out,
+        );
+        p.values[STAGE_SQ0 + kk + 1] = o.raw;
+        p.events[STAGE_SQ0 + kk + 1] = o.event;
+        p
+    }
+
+    /// Evaluates a batch of raw input codes for one n into columns, stage by stage: the same
+    /// results as [`Datapath::eval`] on each code, several times faster.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::{Config, Datapath, ProbeColumns};
+    /// let dp = Datapath::new(Config::baseline()).unwrap();
+    /// let nc = dp.constants_for(100).unwrap();
+    /// let codes: Vec<i64> = (0..=40_000).collect();
+    /// let mut cols = ProbeColumns::default();
+    /// dp.eval_batch(nc, &codes, &mut cols);
+    /// assert_eq!(cols.row(31_000), dp.eval(31_000, nc));
+    /// ```
+    pub fn eval_batch(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
+        let n_stages = self.stages.len();
+        cols.reset(n_stages, codes.len());
+        let Some(plan) = &self.fast else {
+            for (i, &code) in codes.iter().enumerate() {
+                let p = self.eval(code, nc);
+                for stage_idx in 0..n_stages {
+                    cols.values[stage_idx][i] = p.values[stage_idx];
+                    match p.events[stage_idx] {
+                        Event::None => {}
+                        Event::Wrapped => cols.event_counts[stage_idx][0] += 1,
+                        Event::Saturated => cols.event_counts[stage_idx][1] += 1,
+                        Event::Zeroed => cols.event_counts[stage_idx][2] += 1,
+                    }
+                }
+                cols.cut[i] = p.cut;
+                cols.input_clamped[i] = p.input_clamped;
+            }
+            return;
+        };
+        let one = self.one_raw;
+        let d_shift = self.d_shift;
+        for ((d, clamped), &code) in cols.values[STAGE_D]
+            .iter_mut()
+            .zip(cols.input_clamped.iter_mut())
+            .zip(codes)
+        {
+            *clamped = code > one;
+            *d = (code.min(one) - one) << d_shift;
+        }
+        let stage = |cols: &mut ProbeColumns, q: &StageQ, pre: Pre, from: usize, to: usize| {
+            let (head, tail) = cols.values.split_at_mut(to);
+            run_stage(
+                q,
+                pre,
+                &head[from],
+                &mut tail[0],
+                &mut cols.event_counts[to],
+            );
+        };
+        stage(cols, &plan.t, Pre::Mul(nc.slope_raw), STAGE_D, STAGE_T);
+        // The exact sum and the cutoff, then the b stage.
+        let offset = nc.offset_raw << plan.offset_align;
+        let t_align = plan.t_align;
+        let threshold = nc.threshold.unwrap_or(i64::MIN);
+        let cutoff = self.config.cutoff;
+        let mut sums = std::mem::take(&mut cols.scratch);
+        sums.clear();
+        sums.extend(
+            cols.values[STAGE_T]
+                .iter()
+                .zip(codes)
+                .zip(cols.cut.iter_mut())
+                .map(|((&t, &code), cut)| {
+                    let sum = (t << t_align) + offset;
+                    *cut = match cutoff {
+                        Cutoff::Clamp => sum < 0,
+                        Cutoff::Paper => code.min(one) < threshold,
+                        Cutoff::None => false,
+                    };
+                    if *cut {
+                        0
+                    } else {
+                        sum
+                    }
+                }),
+        );
+        run_stage(
+            &plan.b,
+            Pre::Identity,
+            &sums,
+            &mut cols.values[STAGE_B],
+            &mut cols.event_counts[STAGE_B],
+        );
+        cols.scratch = sums;
+        for (i, q) in plan.squares.iter().enumerate() {
+            stage(cols, q, Pre::Square, STAGE_SQ0 + i - 1, STAGE_SQ0 + i);
+        }
+        let coef_idx = STAGE_SQ0 + plan.squares.len();
+        cols.values[coef_idx].fill(nc.coef_raw);
+        stage(
+            cols,
+            &plan.out,
+            Pre::Mul(nc.coef_raw),
+            coef_idx - 1,
+            coef_idx + 1,
+        );
+    }
+}
+
+/// The paper cutoff's threshold code for n: the smallest input code whose value is at least
+/// cos(min(6/sqrt(n), pi)), so that `c < threshold` exactly when theta > 6/sqrt(n).
+pub fn paper_threshold(n: u32, c_format: Format, one_raw: i64) -> i64 {
+    let x = (PAPER_CUTOFF_CONSTANT / f64::from(n).sqrt())
+        .min(std::f64::consts::PI)
+        .cos();
+    // x * 2^frac is exact (a power-of-two scaling); its ceiling is the first code >= x.
+    let scaled = (x * one_raw as f64).ceil();
+    (scaled as i64).clamp(c_format.min_raw(), c_format.max_raw())
+}

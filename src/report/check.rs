@@ -1,0 +1,106 @@
+//! Renders an exhaustive accuracy check as a readable table.
+
+use std::io::{self, Write};
+
+use crate::analysis::check::CheckReport;
+
+/// Writes the table of a [`CheckReport`].
+pub fn write_check_table(w: &mut impl Write, r: &CheckReport) -> io::Result<()> {
+    writeln!(
+        w,
+        "check {}: n = {} ({} exponents) x {} input codes up to 1.0 = {} evaluations",
+        r.config, r.n_set, r.n_exponents, r.n_input_codes, r.n_evaluations
+    )?;
+    if r.n_codes_above_one > 0 {
+        writeln!(
+            w,
+            "  ({} codes above 1.0 per exponent clamp to 1.0 and give its result)",
+            r.n_codes_above_one
+        )?;
+    }
+    writeln!(w, "errors against the f64 value of the same algorithm:")?;
+    writeln!(
+        w,
+        "  {:<5} {:<7} {:>10} {:>10} {:>10} {:>9} {:>8} {:>8}  {:<22} {:>6} {:>6} {:>6}",
+        "stage",
+        "format",
+        "max |err|",
+        "mean err",
+        "rms err",
+        "max ulp",
+        "correct",
+        "faithful",
+        "worst input",
+        "sat",
+        "wrap",
+        "zero"
+    )?;
+    for s in &r.stages {
+        writeln!(
+            w,
+            "  {:<5} {:<7} {:>10.3e} {:>10.2e} {:>10.3e} {:>9.4} {:>7.3}% {:>7.3}%  {:<22} {:>6} {:>6} {:>6}",
+            s.stage,
+            s.format,
+            s.max_abs_err,
+            s.mean_err,
+            s.rms_err,
+            s.max_ulp,
+            100.0 * s.correctly_rounded,
+            100.0 * s.faithfully_rounded,
+            format!("n={} c_raw={}", s.worst.n, s.worst.c_raw),
+            s.saturated,
+            s.wrapped,
+            s.zeroed
+        )?;
+    }
+    writeln!(w, "normalised lobe (before the coefficient), max |error|:")?;
+    for (name, v, at) in [
+        (
+            "quantization  (fixed vs f64 lobe)",
+            r.shape_quant_max_abs,
+            r.shape_quant_worst,
+        ),
+        (
+            "approximation (f64 lobe vs cos^n)",
+            r.shape_approx_max_abs,
+            r.shape_approx_worst,
+        ),
+        (
+            "total         (fixed vs cos^n)  ",
+            r.shape_total_max_abs,
+            r.shape_total_worst,
+        ),
+    ] {
+        writeln!(
+            w,
+            "  {name} {v:.3e} = {:.3} lsb8 at n={} c={:.6}",
+            v * 256.0,
+            at.n,
+            at.c
+        )?;
+    }
+    if r.monotonic {
+        writeln!(
+            w,
+            "monotonic: yes, the output never decreases as c increases"
+        )?;
+    } else {
+        writeln!(
+            w,
+            "monotonic: NO, {} places where the output decreases as c increases; first:",
+            r.n_monotonicity_violations
+        )?;
+        for v in r.monotonicity_violations.iter().take(10) {
+            writeln!(
+                w,
+                "  n={} c_raw={}: out {} after {}",
+                v.n, v.c_raw, v.out_here, v.out_before
+            )?;
+        }
+    }
+    writeln!(
+        w,
+        "cutoff: {} evaluations had their base cut to zero",
+        r.n_cut
+    )
+}
