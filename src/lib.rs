@@ -19,6 +19,7 @@
 pub mod analysis;
 pub mod error;
 pub mod fixed;
+pub mod golden;
 pub mod nset;
 pub mod pipeline;
 pub mod reference;

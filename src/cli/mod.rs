@@ -9,6 +9,7 @@ mod output;
 mod paper;
 mod reference;
 mod report;
+pub mod vectors;
 
 use std::process::ExitCode;
 
@@ -32,6 +33,8 @@ enum Command {
     Check(check::CheckArgs),
     /// Prints the normalisation coefficient coef(n) of a form.
     Coef(reference::CoefArgs),
+    /// Writes golden vectors: CSV, $readmemh files and a manifest.
+    Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
     Minimax(reference::MinimaxArgs),
 }
@@ -54,6 +57,7 @@ pub fn main() -> ExitCode {
         Command::Check(args) => check::run(&args),
         Command::Coef(args) => reference::run_coef(&args),
         Command::Minimax(args) => reference::run_minimax(&args),
+        Command::Vectors(args) => vectors::run(&args),
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,

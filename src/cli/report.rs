@@ -66,6 +66,23 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         write_coefficients(b, &all_n, 4)
     })?);
 
+    step("checking baseline exhaustively: every input code, n = 16..=1024");
+    let dp = specfx::pipeline::Datapath::new(specfx::pipeline::Config::baseline())?;
+    let checked = specfx::analysis::check::check(&dp).map_err(anyhow::Error::msg)?;
+    written.push(emit(dir, "check_baseline.txt", |b| {
+        specfx::report::check::write_check_table(b, &checked)
+    })?);
+    written.push(emit(dir, "check_baseline.json", |b| {
+        serde_json::to_writer_pretty(&mut *b, &checked).map_err(std::io::Error::other)?;
+        b.push(b'\n');
+        Ok(())
+    })?);
+    step("writing baseline's golden vectors (corner cases and 1000 random)");
+    let vectors_dir = dir.join("vectors_baseline");
+    let selection: specfx::golden::CaseSelection = "corner,random:1000".parse()?;
+    let n_vectors = super::vectors::write_dir(&dp, &vectors_dir, &selection, 1, true)?;
+    written.push(vectors_dir.clone());
+
     let n_claims = paper.forms.len() + 2;
     let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
         + usize::from(paper.delta.reproduced_max)
@@ -98,6 +115,23 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     writeln!(
         out,
         "  exact coefficients: max res {worst_exact:.1e} over every form, n = 16..=1024"
+    )?;
+    let out_stage = &checked.stages[dp.stage_out()];
+    writeln!(
+        out,
+        "  baseline, {} evaluations: lobe error vs cos^n {:.3e} (quantization {:.3e}, approximation {:.3e}); output max {:.2} ulp, {:.2}% correctly rounded; monotonic: {}",
+        checked.n_evaluations,
+        checked.shape_total_max_abs,
+        checked.shape_quant_max_abs,
+        checked.shape_approx_max_abs,
+        checked.out_max_ulp,
+        100.0 * out_stage.correctly_rounded,
+        if checked.monotonic { "yes" } else { "NO" }
+    )?;
+    writeln!(
+        out,
+        "  golden vectors: {n_vectors} in {}",
+        vectors_dir.display()
     )?;
     writeln!(out, "  max |error| against cos^n over n = 16..=1024:")?;
     for e in &errs {

@@ -1,0 +1,146 @@
+//! `specfx vectors`: golden vectors for a testbench (CSV, `$readmemh` files, manifest).
+
+use std::collections::BTreeMap;
+use std::fs::{self, File};
+use std::io::{BufWriter, IsTerminal, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::Outcome;
+use specfx::golden::{
+    cases, csv_columns, ports, write_vectors, CaseSelection, CsvInfo, HashingWriter, Manifest,
+};
+use specfx::nset::NSet;
+use specfx::pipeline::Datapath;
+
+/// Arguments of `specfx vectors`.
+#[derive(Debug, Args)]
+pub struct VectorsArgs {
+    /// A TOML configuration file, or a built-in name: baseline.
+    #[arg(long, default_value = "baseline")]
+    config: String,
+    /// The directory to write (refused if it exists, unless --force).
+    #[arg(long)]
+    out: PathBuf,
+    /// Exponents, replacing the configuration's set.
+    #[arg(long)]
+    n: Option<NSet>,
+    /// Which cases: corner, exhaustive, random:N, comma-separated.
+    #[arg(long, default_value = "corner,random:1000")]
+    cases: CaseSelection,
+    /// Seed of the random cases.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Replace an existing directory.
+    #[arg(long)]
+    force: bool,
+}
+
+/// Runs `specfx vectors`.
+pub fn run(args: &VectorsArgs) -> Result<Outcome> {
+    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let n = write_dir(&dp, &args.out, &args.cases, args.seed, args.force)?;
+    println!(
+        "wrote {n} vectors ({}, seed {}) to {}",
+        args.cases,
+        args.seed,
+        args.out.display()
+    );
+    Ok(Outcome::Ok)
+}
+
+/// Writes a vector directory: everything goes to `<out>.partial` first, which is renamed to
+/// `out` only once complete, so an interrupted run never leaves a half-written vector file
+/// under `out`. Returns the number of vectors.
+pub fn write_dir(
+    dp: &Datapath,
+    out: &Path,
+    selection: &CaseSelection,
+    seed: u64,
+    force: bool,
+) -> Result<u64> {
+    if out.exists() && !force {
+        bail!(
+            "{} already exists: pass --force to replace it",
+            out.display()
+        );
+    }
+    let mut partial = out.as_os_str().to_owned();
+    partial.push(".partial");
+    let partial = PathBuf::from(partial);
+    if partial.exists() {
+        fs::remove_dir_all(&partial)
+            .with_context(|| format!("cannot remove {}", partial.display()))?;
+    }
+    fs::create_dir_all(&partial).with_context(|| format!("cannot create {}", partial.display()))?;
+
+    let cases = cases::select(dp, selection, seed);
+    let ports = ports(dp);
+    let open = |name: &str| -> Result<HashingWriter<BufWriter<File>>> {
+        let path = partial.join(name);
+        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+        Ok(HashingWriter::new(BufWriter::new(f)))
+    };
+    let mut csv = open("vectors.csv")?;
+    let mut hex: Vec<HashingWriter<BufWriter<File>>> = ports
+        .iter()
+        .map(|p| open(&p.file_name()))
+        .collect::<Result<_>>()?;
+    let bar = (std::io::stderr().is_terminal() && cases.len() > 200_000).then(|| {
+        let b = ProgressBar::new(cases.len() as u64);
+        b.set_style(
+            ProgressStyle::with_template("vectors {bar:40} {pos}/{len} eta {eta}")
+                .expect("valid template"),
+        );
+        b
+    });
+    {
+        let mut writers: Vec<&mut dyn Write> =
+            hex.iter_mut().map(|w| w as &mut dyn Write).collect();
+        let mut progress = |done: u64| {
+            if let Some(b) = &bar {
+                b.set_position(done);
+            }
+        };
+        write_vectors(dp, &cases, &mut csv, &mut writers, &mut progress)
+            .with_context(|| format!("cannot write vectors to {}", partial.display()))?;
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let mut sha256 = BTreeMap::new();
+    let (digest, mut w) = csv.finish();
+    w.flush()?;
+    sha256.insert("vectors.csv".to_string(), digest);
+    for (port, writer) in ports.iter().zip(hex) {
+        let (digest, mut w) = writer.finish();
+        w.flush()?;
+        sha256.insert(port.file_name(), digest);
+    }
+    let manifest = Manifest {
+        specfx_version: env!("CARGO_PKG_VERSION").to_string(),
+        config: dp.config().clone(),
+        ports,
+        csv: CsvInfo {
+            file: "vectors.csv".to_string(),
+            columns: csv_columns(dp),
+        },
+        cases: selection.to_string(),
+        seed,
+        n_vectors: cases.len() as u64,
+        sha256,
+    };
+    let mut json = serde_json::to_vec_pretty(&manifest)?;
+    json.push(b'\n');
+    fs::write(partial.join("manifest.json"), json)
+        .with_context(|| format!("cannot write {}", partial.join("manifest.json").display()))?;
+    if out.exists() {
+        fs::remove_dir_all(out).with_context(|| format!("cannot replace {}", out.display()))?;
+    }
+    fs::rename(&partial, out)
+        .with_context(|| format!("cannot rename {} to {}", partial.display(), out.display()))?;
+    Ok(cases.len() as u64)
+}
