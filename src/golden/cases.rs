@@ -24,7 +24,7 @@ use crate::pipeline::{Datapath, ProbeColumns};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct CaseSelection {
     /// Corner cases: c = 0, 1.0, codes above 1.0, the ends of the code range and the cutoff
-    /// boundary +-1 code, for every n.
+    /// boundary +-1 code, for every n. They are always included; naming them is optional.
     pub corner: bool,
     /// Every input code for every n.
     pub exhaustive: bool,
@@ -119,7 +119,8 @@ pub fn corner_codes(dp: &Datapath, n: u32, cols: &mut ProbeColumns) -> BTreeSet<
     set
 }
 
-/// The (n, c_raw) pairs of a selection, sorted by n then c, without duplicates.
+/// The (n, c_raw) pairs of a selection, sorted by n then c, without duplicates. Corner cases
+/// are always included (`corner` only says so explicitly).
 ///
 /// Random pairs are drawn from ChaCha8 seeded with `seed`, uniformly over the n set and the
 /// input codes, until `random` pairs not already selected have been added (or every pair is
@@ -133,7 +134,8 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Vec<(u32, i64)> 
         for &n in ns {
             set.extend((lo..=hi).map(|c| (n, c)));
         }
-    } else if sel.corner {
+    } else {
+        // Corner cases are always included, whatever else is selected.
         let mut cols = ProbeColumns::default();
         for &n in ns {
             set.extend(corner_codes(dp, n, &mut cols).into_iter().map(|c| (n, c)));

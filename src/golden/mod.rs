@@ -13,7 +13,6 @@ use sha2::{Digest, Sha256};
 
 use crate::fixed::Format;
 use crate::pipeline::{Config, Datapath, ProbeColumns, Variant};
-use crate::reference::lobe::Cutoff;
 
 pub use cases::CaseSelection;
 
@@ -70,16 +69,53 @@ pub fn n_format(config: &Config) -> Format {
     Format::unsigned(bits, 0).expect("1..=17 bits")
 }
 
+/// The formats of the per-n constant ports: (slope, offset). Plain datapaths take n with k
+/// fraction bits (the value n/m) and the constant 1; minimax ones take A(n) and A(n) + B(n)
+/// in their configured formats.
+pub fn constant_formats(config: &Config) -> (Format, Format) {
+    match config.variant {
+        Variant::Plain => {
+            let bits = (32 - config.n.max().leading_zeros()) as i32;
+            let k = config.k as i32;
+            (
+                Format::unsigned(bits - k, k).expect("1..=17 bits"),
+                Format::unsigned(1, 0).expect("one bit"),
+            )
+        }
+        Variant::Minimax => (config.minimax.a_format, config.minimax.offset_format),
+    }
+}
+
 /// The ports of a datapath's vector files, in the order they are written.
 ///
-/// Inputs first (`in_c`, `in_n`, then the per-n constants the datapath takes from its ROM:
-/// `in_coef`, and `in_slope`/`in_offset` for minimax, `in_threshold` for the paper cutoff),
-/// then one probe per stage before the coefficient, then `expected_out`.
+/// Inputs first: `in_c`, `in_n`, then the per-n constants a datapath reads from its ROM
+/// (`in_slope`, `in_offset`, `in_threshold`, `in_coef`; every configuration has all four,
+/// so one testbench serves them all), then one probe per stage before the coefficient, then
+/// `expected_out`.
 pub fn ports(dp: &Datapath) -> Vec<Port> {
     let cfg = dp.config();
+    let (slope_format, offset_format) = constant_formats(cfg);
     let mut v = vec![
         Port::new("in_c", cfg.c.format, Source::C, "input cosine c (raw code)"),
         Port::new("in_n", n_format(cfg), Source::N, "specular exponent n"),
+        Port::new(
+            "in_slope",
+            slope_format,
+            Source::Slope,
+            "slope: n with k fraction bits (plain) or A(n) (minimax)",
+        ),
+        Port::new(
+            "in_offset",
+            offset_format,
+            Source::Offset,
+            "offset: 1 (plain) or A(n) + B(n) (minimax)",
+        ),
+        Port::new(
+            "in_threshold",
+            cfg.c.format,
+            Source::Threshold,
+            "paper cutoff: inputs below this code give 0 (0 for the other cutoffs)",
+        ),
         Port::new(
             "in_coef",
             cfg.coef.format,
@@ -87,28 +123,6 @@ pub fn ports(dp: &Datapath) -> Vec<Port> {
             "coef(n), the per-n coefficient constant",
         ),
     ];
-    if cfg.variant == Variant::Minimax {
-        v.push(Port::new(
-            "in_slope",
-            cfg.minimax.a_format,
-            Source::Slope,
-            "A(n), the per-n slope constant",
-        ));
-        v.push(Port::new(
-            "in_offset",
-            cfg.minimax.offset_format,
-            Source::Offset,
-            "A(n) + B(n), the per-n offset constant",
-        ));
-    }
-    if cfg.cutoff == Cutoff::Paper {
-        v.push(Port::new(
-            "in_threshold",
-            cfg.c.format,
-            Source::Threshold,
-            "paper cutoff: inputs below this code give 0",
-        ));
-    }
     let coef_idx = dp.stage_coef();
     for (stage_idx, s) in dp.stages().iter().enumerate() {
         if stage_idx == coef_idx || stage_idx == dp.stage_out() {
