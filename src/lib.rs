@@ -17,9 +17,11 @@
 //! ```
 
 pub mod analysis;
+pub mod cycle;
 pub mod error;
 pub mod fixed;
 pub mod golden;
+pub mod hdl;
 pub mod nset;
 pub mod pipeline;
 pub mod reference;

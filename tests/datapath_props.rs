@@ -5,7 +5,8 @@ use proptest::prelude::*;
 use specfx::fixed::{Event, Format, Overflow, Rounding};
 use specfx::nset::NSet;
 use specfx::pipeline::{
-    CoefSpec, Config, Datapath, FormatSpec, MinimaxSpec, ProbeColumns, StageSpec, Variant,
+    CoefSpec, Config, Datapath, FormatSpec, LatencySpec, MinimaxSpec, ProbeColumns, StageSpec,
+    Variant,
 };
 use specfx::reference::lobe::Cutoff;
 use specfx::reference::normalisation::{CoefSource, Form};
@@ -48,6 +49,7 @@ prop_compose! {
         coef_frac in 2i32..=14,
         coef_rounding in prop::sample::select(Rounding::ALL.to_vec()),
         ns in prop::collection::btree_set(1u32..=300, 1..=3),
+        lat in (1u32..=4, 1u32..=4, 1u32..=4),
     ) -> Config {
         let n_text: Vec<String> = ns.iter().map(|n| n.to_string()).collect();
         let c = if signed_c { fmt(true, 2, fc) } else { fmt(false, 1, fc) };
@@ -70,6 +72,7 @@ prop_compose! {
                 offset_format: fmt(false, 2, 14),
                 rounding: Rounding::Rnd,
             },
+            latency: LatencySpec { sub: lat.0, mul: lat.1, add: lat.2 },
         }
     }
 }

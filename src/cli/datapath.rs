@@ -1,4 +1,4 @@
-//! Loading a datapath from `--config FILE|baseline` and `--n SET` on the command line.
+//! Loading a datapath from `--config FILE|baseline` (or a vector directory) and `--n SET`.
 
 use std::path::Path;
 
@@ -7,11 +7,15 @@ use anyhow::{Context, Result};
 use specfx::nset::NSet;
 use specfx::pipeline::{Config, Datapath};
 
-/// Reads a configuration: a built-in name (`baseline`) or a TOML file, then applies `--n`.
+/// Reads a configuration: a built-in name (`baseline`), a TOML file, or a vector directory
+/// (or its `manifest.json`), whose manifest holds the full configuration; then applies `--n`.
 pub fn load(arg: &str, n: Option<&NSet>) -> Result<Datapath> {
     let path = Path::new(arg);
     let mut config = match Config::builtin(arg) {
         Some(c) if !path.exists() => c,
+        _ if path.is_dir() || path.extension().is_some_and(|e| e == "json") => {
+            config_from_manifest(path)?
+        }
         _ => {
             let text = std::fs::read_to_string(path).with_context(|| {
                 format!("config {arg}: cannot read it (and it is not a built-in name: baseline)")
@@ -23,4 +27,50 @@ pub fn load(arg: &str, n: Option<&NSet>) -> Result<Datapath> {
         config.n = n.clone();
     }
     Datapath::new(config).with_context(|| format!("config {arg}"))
+}
+
+/// The configuration recorded in a vector directory's `manifest.json`.
+pub fn config_from_manifest(path: &Path) -> Result<Config> {
+    let file = if path.is_dir() {
+        path.join("manifest.json")
+    } else {
+        path.to_path_buf()
+    };
+    let text = std::fs::read_to_string(&file)
+        .with_context(|| format!("cannot read {}", file.display()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", file.display()))?;
+    let config = value
+        .get("config")
+        .with_context(|| format!("{}: no key 'config'", file.display()))?;
+    serde_json::from_value(config.clone()).with_context(|| {
+        format!(
+            "{}: key 'config' is not a specfx configuration",
+            file.display()
+        )
+    })
+}
+
+/// The (n, c_raw) pairs of a vector directory, in file order, from its `vectors.csv`.
+pub fn vector_inputs(dir: &Path) -> Result<Vec<(u32, i64)>> {
+    let file = dir.join("vectors.csv");
+    let text = std::fs::read_to_string(&file)
+        .with_context(|| format!("cannot read {}", file.display()))?;
+    let mut rows = Vec::new();
+    for (i, line) in text.lines().enumerate().skip(1) {
+        let mut fields = line.split(',');
+        let parse = |f: Option<&str>| -> Result<i64> {
+            f.and_then(|x| x.parse::<i64>().ok()).with_context(|| {
+                format!(
+                    "{} line {}: expected n,c_raw,... as integers, got '{line}'",
+                    file.display(),
+                    i + 1
+                )
+            })
+        };
+        let n = parse(fields.next())?;
+        let c = parse(fields.next())?;
+        rows.push((u32::try_from(n).unwrap_or(0), c));
+    }
+    Ok(rows)
 }

@@ -5,10 +5,12 @@
 
 mod check;
 mod datapath;
+mod hdl;
 mod output;
 mod paper;
 mod reference;
 mod report;
+mod sim;
 pub mod vectors;
 
 use std::process::ExitCode;
@@ -33,6 +35,10 @@ enum Command {
     Check(check::CheckArgs),
     /// Prints the normalisation coefficient coef(n) of a form.
     Coef(reference::CoefArgs),
+    /// Simulates the cycle-level model under random bubbles and stalls.
+    Sim(sim::SimArgs),
+    /// Reference Verilog helpers: parameter headers and co-simulation stimulus.
+    Hdl(hdl::HdlArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -44,7 +50,6 @@ pub enum Outcome {
     /// Everything ran and every check passed.
     Ok,
     /// The command ran, but a check it performs failed (exit code 1).
-    #[allow(dead_code)] // the checking commands of the datapath issue return it
     CheckFailed,
 }
 
@@ -58,6 +63,8 @@ pub fn main() -> ExitCode {
         Command::Coef(args) => reference::run_coef(&args),
         Command::Minimax(args) => reference::run_minimax(&args),
         Command::Vectors(args) => vectors::run(&args),
+        Command::Sim(args) => sim::run(&args),
+        Command::Hdl(args) => hdl::run(&args),
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,

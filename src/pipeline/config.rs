@@ -74,6 +74,17 @@ pub struct MinimaxSpec {
     pub rounding: Rounding,
 }
 
+/// Register latencies of the operations in the cycle-level model (`docs/cycle.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct LatencySpec {
+    /// Registers after the clamp-and-subtract (pipelined only).
+    pub sub: u32,
+    /// Registers of each multiplier: the t product, each squaring, the output product.
+    pub mul: u32,
+    /// Registers after the add-and-cut (pipelined only).
+    pub add: u32,
+}
+
 /// A complete datapath configuration. See `docs/arithmetic.md` for the arithmetic it implies.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Config {
@@ -103,6 +114,8 @@ pub struct Config {
     pub out: StageSpec,
     /// The minimax constants' formats (used by the minimax variant only).
     pub minimax: MinimaxSpec,
+    /// Register latencies for the cycle-level model and the RTL.
+    pub latency: LatencySpec,
 }
 
 fn fmt(s: &str) -> Format {
@@ -152,6 +165,11 @@ impl Config {
                 a_format: fmt("u8.16"),
                 offset_format: fmt("u1.16"),
                 rounding: Rounding::Rnd,
+            },
+            latency: LatencySpec {
+                sub: 1,
+                mul: 1,
+                add: 1,
             },
         }
     }
@@ -236,6 +254,14 @@ struct MinimaxPatch {
     rounding: Option<Rounding>,
 }
 
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LatencyPatch {
+    sub: Option<u32>,
+    mul: Option<u32>,
+    add: Option<u32>,
+}
+
 /// `[square]` (one spec for every stage) or `[[square]]` (one table per stage).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
@@ -261,6 +287,7 @@ struct ConfigFile {
     coef: Option<CoefPatch>,
     out: Option<StagePatch>,
     minimax: Option<MinimaxPatch>,
+    latency: Option<LatencyPatch>,
 }
 
 impl ConfigFile {
@@ -289,6 +316,24 @@ impl ConfigFile {
                 list.iter().map(|p| p.onto(base_square)).collect()
             }
         };
+        let latency = self.latency.unwrap_or_default();
+        let latency = LatencySpec {
+            sub: latency.sub.unwrap_or(base.latency.sub),
+            mul: latency.mul.unwrap_or(base.latency.mul),
+            add: latency.add.unwrap_or(base.latency.add),
+        };
+        for (key, value) in [
+            ("latency.sub", latency.sub),
+            ("latency.mul", latency.mul),
+            ("latency.add", latency.add),
+        ] {
+            if !(1..=8).contains(&value) {
+                return Err(Error::Config {
+                    key: key.to_string(),
+                    problem: format!("expected a register latency in 1..=8, got {value}"),
+                });
+            }
+        }
         let coef = self.coef.unwrap_or_default();
         let mm = self.minimax.unwrap_or_default();
         Ok(Config {
@@ -318,6 +363,7 @@ impl ConfigFile {
                 offset_format: mm.offset_format.unwrap_or(base.minimax.offset_format),
                 rounding: mm.rounding.unwrap_or(base.minimax.rounding),
             },
+            latency,
         })
     }
 }

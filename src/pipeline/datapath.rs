@@ -226,6 +226,18 @@ impl Datapath {
                 format!("expected a number of squarings in 1..=7, got {k}"),
             ));
         }
+        for (key, value) in [
+            ("latency.sub", config.latency.sub),
+            ("latency.mul", config.latency.mul),
+            ("latency.add", config.latency.add),
+        ] {
+            if !(1..=8).contains(&value) {
+                return Err(config_error(
+                    key,
+                    format!("expected a register latency in 1..=8, got {value}"),
+                ));
+            }
+        }
         if config.square.len() != k as usize {
             return Err(config_error(
                 "square",
@@ -493,30 +505,55 @@ impl Datapath {
     /// This is the plain transcription of the arithmetic (exact intermediates in `i128`,
     /// quantized by [`quantize`]); [`Datapath::eval_batch`] is its fast twin.
     pub fn eval(&self, c_raw: i64, nc: &NConstants) -> Probes {
-        let cfg = &self.config;
         let mut p = Probes::default();
-        let input_clamped = c_raw > self.one_raw;
-        let c = if input_clamped { self.one_raw } else { c_raw };
-        p.input_clamped = input_clamped;
-
-        // d = c - 1, exact (validated).
-        let d = (c - self.one_raw) << self.d_shift;
-        let fd = cfg.d.format.frac_bits();
+        let (c, d) = self.op_sub(c_raw);
+        p.input_clamped = c != c_raw;
         p.values[STAGE_D] = d;
-
-        // t = d * slope: exact product, then the t stage's quantization.
-        let t = quantize_to(
-            i128::from(d) * i128::from(nc.slope_raw),
-            fd + nc.slope_frac,
-            &cfg.t,
-        );
+        let t = self.op_mul_t(d, nc);
         p.values[STAGE_T] = t.raw;
         p.events[STAGE_T] = t.event;
+        let (b, cut) = self.op_add_b(t.raw, c, nc);
+        p.cut = cut;
+        p.values[STAGE_B] = b.raw;
+        p.events[STAGE_B] = b.event;
+        let mut s = b.raw;
+        for i in 0..self.config.k as usize {
+            let q = self.op_square(i, s);
+            p.values[STAGE_SQ0 + i] = q.raw;
+            p.events[STAGE_SQ0 + i] = q.event;
+            s = q.raw;
+        }
+        p.values[self.stage_coef()] = nc.coef_raw;
+        let o = self.op_mul_out(s, nc);
+        p.values[self.stage_out()] = o.raw;
+        p.events[self.stage_out()] = o.event;
+        p
+    }
 
-        // b = t + offset, exact on the larger fraction, then the cutoff and the b stage.
+    /// Operation `sub`: clamps the input code to 1.0 and returns it with d = c - 1, exact in
+    /// d's format.
+    pub fn op_sub(&self, c_raw: i64) -> (i64, i64) {
+        let c = c_raw.min(self.one_raw);
+        (c, (c - self.one_raw) << self.d_shift)
+    }
+
+    /// Operation `mul_t`: t = d * slope, exact (`d.frac + slope_frac` fraction bits), then
+    /// quantized by t's stage.
+    pub fn op_mul_t(&self, d: i64, nc: &NConstants) -> Quantized {
+        quantize_to(
+            i128::from(d) * i128::from(nc.slope_raw),
+            self.config.d.format.frac_bits() + nc.slope_frac,
+            &self.config.t,
+        )
+    }
+
+    /// Operation `add_b`: b = t + offset, exact on the larger fraction, then the cutoff (which
+    /// needs the clamped input code `c`), then b's stage. Returns b and whether it was cut.
+    pub fn op_add_b(&self, t: i64, c: i64, nc: &NConstants) -> (Quantized, bool) {
+        let cfg = &self.config;
         let ft = cfg.t.format.frac_bits();
         let fb = ft.max(nc.offset_frac);
-        let mut sum = (i128::from(t.raw) << (fb - ft) as u32)
+        let mut sum = (i128::from(t) << (fb - ft) as u32)
             + (i128::from(nc.offset_raw) << (fb - nc.offset_frac) as u32);
         let cut = match cfg.cutoff {
             Cutoff::Clamp => sum < 0,
@@ -526,33 +563,30 @@ impl Datapath {
         if cut {
             sum = 0;
         }
-        p.cut = cut;
-        let b = quantize_to(sum, fb, &cfg.b);
-        p.values[STAGE_B] = b.raw;
-        p.events[STAGE_B] = b.event;
+        (quantize_to(sum, fb, &cfg.b), cut)
+    }
 
-        // k squarings, each exact then quantized by its own stage.
-        let mut s = b.raw;
-        let mut fs = cfg.b.format.frac_bits();
-        for (i, spec) in cfg.square.iter().enumerate() {
-            let q = quantize_to(i128::from(s) * i128::from(s), 2 * fs, spec);
-            p.values[STAGE_SQ0 + i] = q.raw;
-            p.events[STAGE_SQ0 + i] = q.event;
-            s = q.raw;
-            fs = spec.format.frac_bits();
-        }
+    /// Operation `square` number `i` (0-based): the exact square of the previous stage's raw
+    /// value (doubled fraction bits), quantized by squaring stage `i`.
+    pub fn op_square(&self, i: usize, x: i64) -> Quantized {
+        let cfg = &self.config;
+        let f_in = if i == 0 {
+            cfg.b.format.frac_bits()
+        } else {
+            cfg.square[i - 1].format.frac_bits()
+        };
+        quantize_to(i128::from(x) * i128::from(x), 2 * f_in, &cfg.square[i])
+    }
 
-        // out = s_k * coef.
-        let kk = cfg.k as usize;
-        p.values[STAGE_SQ0 + kk] = nc.coef_raw;
-        let o = quantize_to(
+    /// Operation `mul_out`: out = sq_k * coef, exact, then quantized by the output stage.
+    pub fn op_mul_out(&self, s: i64, nc: &NConstants) -> Quantized {
+        let cfg = &self.config;
+        let fs = cfg.square[cfg.square.len() - 1].format.frac_bits();
+        quantize_to(
             i128::from(s) * i128::from(nc.coef_raw),
             fs + cfg.coef.format.frac_bits(),
             &cfg.out,
-        );
-        p.values[STAGE_SQ0 + kk + 1] = o.raw;
-        p.events[STAGE_SQ0 + kk + 1] = o.event;
-        p
+        )
     }
 
     /// Evaluates a batch of raw input codes for one n into columns, stage by stage: the same

@@ -20,5 +20,5 @@ pub mod config;
 pub mod datapath;
 pub mod fast;
 
-pub use config::{CoefSpec, Config, FormatSpec, MinimaxSpec, StageSpec, Variant};
+pub use config::{CoefSpec, Config, FormatSpec, LatencySpec, MinimaxSpec, StageSpec, Variant};
 pub use datapath::{Datapath, NConstants, ProbeColumns, Probes, StageInfo, MAX_STAGES};

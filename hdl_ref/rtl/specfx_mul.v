@@ -1,0 +1,26 @@
+// specfx_mul: the exact product of two raw codes, a * b, as a signed P_W-bit code (no
+// rounding, no overflow). P_W must hold the exact product: A_W + B_W when either operand is
+// signed, A_W + B_W + 1 when both are unsigned. The fraction bits of the product are the sum
+// of the operands' (the caller knows them). Rust: the `i128` products of
+// src/pipeline/datapath.rs `eval`.
+`default_nettype none
+
+module specfx_mul #(
+    parameter integer A_W = 8,
+    parameter integer A_S = 1,
+    parameter integer B_W = 8,
+    parameter integer B_S = 1,
+    parameter integer P_W = 16
+) (
+    input  wire [A_W-1:0] a,
+    input  wire [B_W-1:0] b,
+    output wire [P_W-1:0] p
+);
+    // Both operands as signed values one bit wider, then a signed multiply in P_W bits.
+    wire signed [A_W:0] a_x = {(A_S != 0) & a[A_W-1], a};
+    wire signed [B_W:0] b_x = {(B_S != 0) & b[B_W-1], b};
+    wire signed [P_W-1:0] product = a_x * b_x;
+    assign p = product;
+endmodule
+
+`default_nettype wire

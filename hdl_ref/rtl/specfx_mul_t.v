@@ -1,0 +1,36 @@
+// specfx_mul_t: t = Q_t(d * slope) (Rust: the t stage of src/pipeline/datapath.rs `eval`).
+// d is signed (D_W bits, D_F fraction bits); the slope has SLOPE_W bits, SLOPE_F fraction bits
+// (plain variant: n with k fraction bits, i.e. n/2^k; minimax: A(n)). The exact product has
+// D_F + SLOPE_F fraction bits and is quantized to T with T_RND and T_OVF. Combinational.
+`default_nettype none
+
+module specfx_mul_t #(
+    parameter integer D_W     = 16,
+    parameter integer D_F     = 15,
+    parameter integer SLOPE_W = 11,
+    parameter integer SLOPE_F = 4,
+    parameter integer SLOPE_S = 0,
+    parameter integer T_W     = 18,
+    parameter integer T_F     = 16,
+    parameter integer T_S     = 1,
+    parameter integer T_RND   = 2,
+    parameter integer T_OVF   = 1
+) (
+    input  wire [D_W-1:0]     d,
+    input  wire [SLOPE_W-1:0] slope,
+    output wire [T_W-1:0]     t
+);
+    localparam integer P_W = D_W + SLOPE_W;  // d is signed
+    wire [P_W-1:0] product;
+    specfx_mul #(.A_W(D_W), .A_S(1), .B_W(SLOPE_W), .B_S(SLOPE_S), .P_W(P_W)) u_mul (
+        .a(d), .b(slope), .p(product)
+    );
+    specfx_quant #(
+        .IN_W(P_W), .IN_F(D_F + SLOPE_F), .IN_S(1),
+        .OUT_W(T_W), .OUT_F(T_F), .OUT_S(T_S), .RND(T_RND), .OVF(T_OVF)
+    ) u_q (
+        .x(product), .y(t)
+    );
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,172 @@
+//! `specfx hdl`: the bridge to the reference Verilog (parameter headers, co-simulation
+//! stimulus).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand};
+
+use super::output::write_atomic;
+use super::sim::parse_probability;
+use super::Outcome;
+use specfx::cycle::sim::{simulate, Stimulus, Stop};
+use specfx::cycle::Arch;
+use specfx::hdl::params_header;
+
+/// Arguments of `specfx hdl`.
+#[derive(Debug, Args)]
+pub struct HdlArgs {
+    #[command(subcommand)]
+    command: HdlCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum HdlCommand {
+    /// Prints the `specfx_params.vh` header (Verilog `define macros) of a configuration.
+    Params(ParamsArgs),
+    /// Writes the valid/ready patterns and expected output cycles for co-simulating a vector
+    /// directory.
+    Stimulus(StimulusArgs),
+}
+
+#[derive(Debug, Args)]
+struct ParamsArgs {
+    /// A TOML configuration file, a vector directory, or a built-in name: baseline.
+    #[arg(long, default_value = "baseline", conflicts_with = "vectors")]
+    config: String,
+    /// A vector directory: use the configuration of its manifest.
+    #[arg(long)]
+    vectors: Option<PathBuf>,
+    /// Microarchitecture: pipelined or folded.
+    #[arg(long, default_value = "pipelined")]
+    arch: Arch,
+    /// Write the header here instead of printing it.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+struct StimulusArgs {
+    /// The vector directory (written by `specfx vectors`).
+    #[arg(long)]
+    vectors: PathBuf,
+    /// Microarchitecture: pipelined or folded.
+    #[arg(long, default_value = "pipelined")]
+    arch: Arch,
+    /// Seed of the bubble/stall patterns.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Probability that the source offers no input in a cycle.
+    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
+    bubble: f64,
+    /// Probability that the sink is not ready in a cycle.
+    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
+    stall: f64,
+    /// Directory for stim_valid.hex, stim_ready.hex, expected_cycle.hex and stim.json.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Runs `specfx hdl ...`.
+pub fn run(args: &HdlArgs) -> Result<Outcome> {
+    match &args.command {
+        HdlCommand::Params(a) => params(a),
+        HdlCommand::Stimulus(a) => stimulus(a),
+    }
+}
+
+fn params(args: &ParamsArgs) -> Result<Outcome> {
+    let dp = match &args.vectors {
+        Some(dir) => super::datapath::load(&dir.to_string_lossy(), None)?,
+        None => super::datapath::load(&args.config, None)?,
+    };
+    let header = params_header(&dp, args.arch);
+    match &args.out {
+        Some(path) => write_atomic(path, header.as_bytes())?,
+        None => super::output::print_with(|w| {
+            use std::io::Write;
+            w.write_all(header.as_bytes())
+        })?,
+    }
+    Ok(Outcome::Ok)
+}
+
+fn bits_file(bits: &[bool]) -> String {
+    bits.iter()
+        .map(|&b| if b { "1\n" } else { "0\n" })
+        .collect()
+}
+
+fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
+    let dir: &Path = &args.vectors;
+    let dp = super::datapath::load(&dir.to_string_lossy(), None)?;
+    let rows = super::datapath::vector_inputs(dir)?;
+    let ns = dp.config().n.values();
+    let items: Vec<(usize, i64)> = rows
+        .iter()
+        .map(|&(n, c)| {
+            ns.binary_search(&n).map(|i| (i, c)).map_err(|_| {
+                anyhow::anyhow!("{}: n = {n} is not in the manifest's n set", dir.display())
+            })
+        })
+        .collect::<Result<_>>()?;
+    let mut stim = Stimulus::new(args.seed, args.bubble, args.stall);
+    let limit = 1_000 + items.len() as u64 * 1_000;
+    let result = simulate(
+        &dp,
+        args.arch,
+        items.iter().copied(),
+        &mut stim,
+        Stop::Drained(limit),
+        0,
+    );
+    let s = &result.stats;
+    if s.n_outputs != items.len() as u64 || s.mismatches != 0 || s.order_errors != 0 {
+        bail!(
+            "the cycle model delivered {} of {} outputs with {} mismatches: this is a bug",
+            s.n_outputs,
+            items.len(),
+            s.mismatches
+        );
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut cycles = String::new();
+    for o in &result.outputs {
+        writeln!(cycles, "{:08x}", o.cycle).expect("write to String");
+    }
+    write_atomic(
+        &args.out.join("stim_valid.hex"),
+        bits_file(&result.valid_bits).as_bytes(),
+    )?;
+    write_atomic(
+        &args.out.join("stim_ready.hex"),
+        bits_file(&result.ready_bits).as_bytes(),
+    )?;
+    write_atomic(&args.out.join("expected_cycle.hex"), cycles.as_bytes())?;
+    let info = serde_json::json!({
+        "arch": args.arch.name(),
+        "latency": args.arch.latency(dp.config()),
+        "initiation_interval": args.arch.initiation_interval(dp.config()),
+        "seed": args.seed,
+        "bubble": args.bubble,
+        "stall": args.stall,
+        "n_cycles": s.n_cycles,
+        "n_vectors": items.len(),
+        "latency_min": s.latency_min,
+        "latency_max": s.latency_max,
+    });
+    let mut json = serde_json::to_vec_pretty(&info)?;
+    json.push(b'\n');
+    write_atomic(&args.out.join("stim.json"), &json)?;
+    println!(
+        "{} vectors over {} cycles ({}, latency {}..{})",
+        items.len(),
+        s.n_cycles,
+        args.arch,
+        s.latency_min,
+        s.latency_max
+    );
+    Ok(Outcome::Ok)
+}

@@ -1,0 +1,128 @@
+//! `specfx sim`: the cycle-level simulation of a configuration under random bubbles and stalls.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+
+use super::output::{print_json, print_with};
+use super::Outcome;
+use specfx::cycle::sim::{random_inputs, simulate, SimStats, Stimulus, Stop};
+use specfx::cycle::vcd::write_vcd;
+use specfx::cycle::Arch;
+use specfx::nset::NSet;
+
+/// Probability in [0, 1).
+pub fn parse_probability(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if (0.0..1.0).contains(&p) => Ok(p),
+        _ => Err(format!("expected a probability in [0, 1), got '{s}'")),
+    }
+}
+
+/// Arguments of `specfx sim`.
+#[derive(Debug, Args)]
+pub struct SimArgs {
+    /// A TOML configuration file, a vector directory, or a built-in name: baseline.
+    #[arg(long, default_value = "baseline")]
+    config: String,
+    /// Microarchitecture: pipelined or folded.
+    #[arg(long, default_value = "pipelined")]
+    arch: Arch,
+    /// Cycles to simulate.
+    #[arg(long, default_value_t = 10_000)]
+    cycles: u64,
+    /// Seed of the input stream and of the bubble/stall patterns.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Probability that the source offers no input in a cycle.
+    #[arg(long, default_value = "0.1", value_parser = parse_probability)]
+    bubble: f64,
+    /// Probability that the sink is not ready in a cycle.
+    #[arg(long, default_value = "0.1", value_parser = parse_probability)]
+    stall: f64,
+    /// Exponents, replacing the configuration's set.
+    #[arg(long)]
+    n: Option<NSet>,
+    /// Write a VCD trace of the first --vcd-cycles cycles here.
+    #[arg(long)]
+    vcd: Option<PathBuf>,
+    /// Cycles in the VCD trace.
+    #[arg(long, default_value_t = 500)]
+    vcd_cycles: u64,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `specfx sim`. Exit code 1 when any output differs from the functional model.
+pub fn run(args: &SimArgs) -> Result<Outcome> {
+    if args.cycles == 0 {
+        bail!("--cycles: expected at least 1, got 0");
+    }
+    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let mut stim = Stimulus::new(args.seed, args.bubble, args.stall);
+    let trace_cycles = if args.vcd.is_some() {
+        args.vcd_cycles
+    } else {
+        0
+    };
+    let result = simulate(
+        &dp,
+        args.arch,
+        random_inputs(&dp, args.seed),
+        &mut stim,
+        Stop::Cycles(args.cycles),
+        trace_cycles,
+    );
+    if let Some(path) = &args.vcd {
+        let mut buf = Vec::new();
+        write_vcd(
+            &mut buf,
+            &result.trace,
+            dp.config().c.format.width(),
+            dp.config().out.format.width(),
+        )?;
+        super::output::write_atomic(path, &buf)?;
+    }
+    let s = &result.stats;
+    if args.json {
+        print_json(s)?;
+    } else {
+        print_with(|w| write_stats(w, s, &dp.config().name))?;
+    }
+    Ok(if s.mismatches == 0 && s.order_errors == 0 {
+        Outcome::Ok
+    } else {
+        Outcome::CheckFailed
+    })
+}
+
+fn write_stats(w: &mut impl Write, s: &SimStats, name: &str) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "sim {name}, {}: {} cycles, {} inputs, {} outputs",
+        s.arch, s.n_cycles, s.n_inputs, s.n_outputs
+    )?;
+    writeln!(
+        w,
+        "  latency {}..{} cycles (nominal {}), initiation interval {}, throughput {:.4} results/cycle",
+        s.latency_min, s.latency_max, s.latency_nominal, s.initiation_interval, s.throughput
+    )?;
+    writeln!(
+        w,
+        "  bubbles {} cycles, output stalls {} cycles, backpressure {} cycles",
+        s.bubble_cycles, s.stall_cycles, s.backpressure_cycles
+    )?;
+    write!(w, "  occupancy:")?;
+    for (unit, o) in &s.occupancy {
+        write!(w, " {unit} {:.1}%", 100.0 * o)?;
+    }
+    writeln!(w)?;
+    writeln!(
+        w,
+        "  against the functional model: {} mismatches, {} out of order",
+        s.mismatches, s.order_errors
+    )
+}
