@@ -113,6 +113,8 @@ pub struct CheckReport {
     pub monotonicity_violations: Vec<MonotonicityViolation>,
     /// Evaluations where the cutoff forced the base to zero.
     pub n_cut: u64,
+    /// Remarks that help read the figures (for example, harmless saturation).
+    pub notes: Vec<String>,
 }
 
 /// How many violations are listed in full.
@@ -642,6 +644,25 @@ pub fn check(dp: &Datapath) -> Result<CheckReport, String> {
         })
         .collect();
     let out_max_ulp = stage_stats[dp.stage_out()].max_ulp;
+    let mut notes = Vec::new();
+    let t = &stage_stats[STAGE_T];
+    let t_format = dp.config().t.format;
+    let offset_max = dp
+        .constants()
+        .iter()
+        .map(|nc| nc.offset)
+        .fold(f64::NEG_INFINITY, f64::max);
+    if dp.config().cutoff == Cutoff::Clamp
+        && t.saturated > 0
+        && t.raw_max < t_format.max_raw()
+        && t_format.min_value() + offset_max <= 0.0
+    {
+        notes.push(format!(
+            "t saturated {} times, always at its minimum {}: harmless, since t_min + offset <= 0 gives a base <= 0 that the clamp cuts to 0 anyway; its error figures count those inputs",
+            t.saturated,
+            t_format.min_value()
+        ));
+    }
     let above = (*codes_all.end() - last).max(0) as u64;
     Ok(CheckReport {
         config: dp.config().name.clone(),
@@ -662,5 +683,6 @@ pub fn check(dp: &Datapath) -> Result<CheckReport, String> {
         n_monotonicity_violations: n_violations,
         monotonicity_violations: violations,
         n_cut,
+        notes,
     })
 }

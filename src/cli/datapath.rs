@@ -7,20 +7,32 @@ use anyhow::{Context, Result};
 use specfx::nset::NSet;
 use specfx::pipeline::{Config, Datapath};
 
-/// Reads a configuration: a built-in name (`baseline`), a TOML file, or a vector directory
-/// (or its `manifest.json`), whose manifest holds the full configuration; then applies `--n`.
+/// Reads a configuration: a built-in name (`baseline`; a file of that name is read as
+/// `./baseline`), a TOML file, or a vector directory (or its `manifest.json`), whose manifest
+/// holds the full configuration; then applies `--n`.
+///
+/// A TOML file that sets no `name` is named after the file.
 pub fn load(arg: &str, n: Option<&NSet>) -> Result<Datapath> {
     let path = Path::new(arg);
     let mut config = match Config::builtin(arg) {
-        Some(c) if !path.exists() => c,
-        _ if path.is_dir() || path.extension().is_some_and(|e| e == "json") => {
+        Some(c) => c,
+        None if path.is_dir() || path.extension().is_some_and(|e| e == "json") => {
             config_from_manifest(path)?
         }
-        _ => {
+        None => {
             let text = std::fs::read_to_string(path).with_context(|| {
                 format!("config {arg}: cannot read it (and it is not a built-in name: baseline)")
             })?;
-            Config::from_toml(&text).with_context(|| format!("config {arg}"))?
+            let mut config = Config::from_toml(&text).with_context(|| format!("config {arg}"))?;
+            let names_itself = text
+                .parse::<toml::Table>()
+                .is_ok_and(|t| t.contains_key("name"));
+            if !names_itself {
+                if let Some(stem) = path.file_stem() {
+                    config.name = stem.to_string_lossy().into_owned();
+                }
+            }
+            config
         }
     };
     if let Some(n) = n {

@@ -263,11 +263,35 @@ struct LatencyPatch {
 }
 
 /// `[square]` (one spec for every stage) or `[[square]]` (one table per stage).
-#[derive(Debug, Clone, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone)]
 enum SquarePatch {
     All(StagePatch),
     Each(Vec<StagePatch>),
+}
+
+impl<'de> Deserialize<'de> for SquarePatch {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error as _;
+        // Read the raw value first, then each table, so that a mistake inside one names it.
+        let value = toml::Value::deserialize(d)?;
+        let table = |v: toml::Value, key: &str| {
+            StagePatch::deserialize(v)
+                .map_err(|e| D::Error::custom(format!("{key}: {}", e.message())))
+        };
+        match value {
+            toml::Value::Table(_) => Ok(SquarePatch::All(table(value, "[square]")?)),
+            toml::Value::Array(items) => items
+                .into_iter()
+                .enumerate()
+                .map(|(i, v)| table(v, &format!("[[square]] number {}", i + 1)))
+                .collect::<Result<_, _>>()
+                .map(SquarePatch::Each),
+            other => Err(D::Error::custom(format!(
+                "square: expected a [square] table or [[square]] tables, got {}",
+                other.type_str()
+            ))),
+        }
+    }
 }
 
 /// What a configuration file may say.

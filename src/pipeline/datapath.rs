@@ -291,28 +291,30 @@ impl Datapath {
             Variant::Plain => Format::unsigned(2, 0).expect("valid"),
             Variant::Minimax => config.minimax.offset_format,
         };
+        // Each check names the stage whose exact input it is: t (d * slope), b (t + offset),
+        // square[i] (the square of the stage before it), out (sq_k * coef).
         let mut checks = vec![
-            ("t.format", product_bits(df.width(), slope_bits)),
-            ("b.format", sum_bits(config.t.format, offset_format)),
+            ("t".to_string(), product_bits(df.width(), slope_bits)),
+            ("b".to_string(), sum_bits(config.t.format, offset_format)),
         ];
         let mut prev = config.b.format;
         for (i, sq) in config.square.iter().enumerate() {
             checks.push((
-                if i == 0 { "b.format" } else { "square" },
+                format!("square[{}]", i + 1),
                 product_bits(prev.width(), prev.width()),
             ));
             prev = sq.format;
         }
         checks.push((
-            "coef.format",
+            "out".to_string(),
             product_bits(prev.width(), config.coef.format.width()),
         ));
         let fits_i64 = checks.iter().all(|&(_, bits)| bits <= 62);
-        for (key, bits) in checks {
+        for (stage, bits) in checks {
             if bits > MAX_EXACT_BITS {
                 return Err(config_error(
-                    key,
-                    format!("an exact intermediate would need {bits} bits; the model computes at most {MAX_EXACT_BITS}: narrow the formats"),
+                    &stage,
+                    format!("the stage's exact input would need {bits} bits; the model computes at most {MAX_EXACT_BITS}: narrow the formats feeding it"),
                 ));
             }
         }

@@ -2,7 +2,7 @@
 //! advance, and one loop per stage specialised at compile time for its rounding and overflow
 //! modes (8 x 4 variants), so the hot loops carry no branch on the modes.
 //!
-//! These kernels are an optimisation of [`crate::pipeline::Datapath::eval_wide`], which is the
+//! These kernels are an optimisation of [`crate::pipeline::Datapath::eval`], which is the
 //! plain transcription of the arithmetic; the tests compare the two on random configurations.
 
 use crate::fixed::{Format, Overflow, Rounding};

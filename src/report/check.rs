@@ -102,5 +102,9 @@ pub fn write_check_table(w: &mut impl Write, r: &CheckReport) -> io::Result<()> 
         w,
         "cutoff: {} evaluations had their base cut to zero",
         r.n_cut
-    )
+    )?;
+    for note in &r.notes {
+        writeln!(w, "note: {note}")?;
+    }
+    Ok(())
 }
