@@ -4,6 +4,7 @@
 //! I/O error (one line on stderr). A closed stdout (broken pipe) is not an error.
 
 mod check;
+pub mod cost;
 mod datapath;
 mod hdl;
 mod output;
@@ -39,6 +40,8 @@ enum Command {
     Sim(sim::SimArgs),
     /// Reference Verilog helpers: parameter headers and co-simulation stimulus.
     Hdl(hdl::HdlArgs),
+    /// Synthesis cost of a configuration: yosys on the reference Verilog, and the analytic model.
+    Cost(cost::CostArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -64,6 +67,7 @@ pub fn main() -> ExitCode {
         Command::Minimax(args) => reference::run_minimax(&args),
         Command::Vectors(args) => vectors::run(&args),
         Command::Sim(args) => sim::run(&args),
+        Command::Cost(args) => cost::run(&args),
         Command::Hdl(args) => hdl::run(&args),
     };
     match result {

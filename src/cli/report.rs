@@ -83,6 +83,66 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     let n_vectors = super::vectors::write_dir(&dp, &vectors_dir, &selection, 1, true)?;
     written.push(vectors_dir.clone());
 
+    step("simulating baseline's cycle-level model (both architectures, 20000 cycles)");
+    let mut sims = Vec::new();
+    for arch in specfx::cycle::Arch::ALL {
+        let mut stim = specfx::cycle::sim::Stimulus::new(1, 0.1, 0.1);
+        let r = specfx::cycle::sim::simulate(
+            &dp,
+            arch,
+            specfx::cycle::sim::random_inputs(&dp, 1),
+            &mut stim,
+            specfx::cycle::sim::Stop::Cycles(20_000),
+            if arch == specfx::cycle::Arch::Pipelined {
+                300
+            } else {
+                0
+            },
+        );
+        if arch == specfx::cycle::Arch::Pipelined {
+            written.push(emit(dir, "sim_baseline_pipelined.vcd", |b| {
+                specfx::cycle::vcd::write_vcd(
+                    b,
+                    &r.trace,
+                    dp.config().c.format.width(),
+                    dp.config().out.format.width(),
+                )
+            })?);
+        }
+        sims.push(r.stats);
+    }
+    written.push(emit(dir, "sim_baseline.json", |b| {
+        serde_json::to_writer_pretty(&mut *b, &sims).map_err(std::io::Error::other)?;
+        b.push(b'\n');
+        Ok(())
+    })?);
+    let yosys_present = std::process::Command::new("yosys")
+        .arg("-V")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    let mut costs = Vec::new();
+    if yosys_present {
+        step("synthesising baseline with yosys (ice40, both architectures)");
+        let hdl = super::cost::hdl_ref_dir(None);
+        for arch in specfx::cycle::Arch::ALL {
+            costs.push(super::cost::cost_report(
+                &dp,
+                arch,
+                specfx::hdl::cost::Target::Ice40,
+                &hdl,
+                false,
+            )?);
+        }
+        written.push(emit(dir, "cost_baseline.txt", |b| {
+            for c in &costs {
+                super::cost::write_cost(b, c)?;
+            }
+            Ok(())
+        })?);
+    } else {
+        step("yosys not found: skipping the synthesis cost (apt-get install yosys)");
+    }
+
     let n_claims = paper.forms.len() + 2;
     let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
         + usize::from(paper.delta.reproduced_max)
@@ -133,6 +193,24 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         "  golden vectors: {n_vectors} in {}",
         vectors_dir.display()
     )?;
+    for s in &sims {
+        writeln!(
+            out,
+            "  cycle model {}: latency {}..{} cycles (nominal {}), {:.3} results/cycle under 10% bubbles and stalls, {} mismatches",
+            s.arch, s.latency_min, s.latency_max, s.latency_nominal, s.throughput, s.mismatches
+        )?;
+    }
+    for c in &costs {
+        writeln!(
+            out,
+            "  yosys ice40 {}: {} LUT4, {} carry, {} DSP, {} FF",
+            c.arch,
+            c.luts.unwrap_or(0),
+            c.yosys.as_ref().map_or(0, |y| y.carries),
+            c.dsps.unwrap_or(0),
+            c.ffs.unwrap_or(0)
+        )?;
+    }
     writeln!(out, "  max |error| against cos^n over n = 16..=1024:")?;
     for e in &errs {
         writeln!(

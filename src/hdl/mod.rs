@@ -4,6 +4,8 @@
 //! header of `` `define `` macros that this module renders for a configuration and an
 //! architecture, so one RTL source serves every configuration.
 
+pub mod cost;
+
 use std::fmt::Write as _;
 
 use crate::cycle::Arch;

@@ -1,0 +1,240 @@
+//! `specfx cost`: synthesis cost from yosys on the reference Verilog, beside the analytic model.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+
+use super::output::{print_json, print_with};
+use super::Outcome;
+use specfx::cycle::Arch;
+use specfx::hdl::cost::{
+    analytic_cost, parse_stat_json, yosys_script, AnalyticCost, Target, YosysCost,
+};
+use specfx::hdl::params_header;
+use specfx::pipeline::Datapath;
+
+/// Arguments of `specfx cost`.
+#[derive(Debug, Args)]
+pub struct CostArgs {
+    /// A TOML configuration file, a vector directory, or a built-in name: baseline.
+    #[arg(long, default_value = "baseline")]
+    config: String,
+    /// Microarchitecture: pipelined or folded.
+    #[arg(long, default_value = "pipelined")]
+    arch: Arch,
+    /// Synthesis target: generic (gates and a CMOS transistor estimate), ice40 or xilinx.
+    #[arg(long, default_value = "ice40")]
+    target: Target,
+    /// The reference Verilog directory (default: $SPECFX_HDL_REF, else the hdl_ref/ of the
+    /// source tree this binary was built from).
+    #[arg(long)]
+    hdl_ref: Option<PathBuf>,
+    /// Only the analytic model: do not run yosys.
+    #[arg(long)]
+    analytic_only: bool,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Everything `specfx cost` reports.
+#[derive(Debug, Serialize)]
+pub struct CostReport {
+    /// Configuration name.
+    pub config: String,
+    /// Architecture.
+    pub arch: Arch,
+    /// Synthesis target.
+    pub target: Target,
+    /// The analytic model's figures.
+    pub analytic: AnalyticCost,
+    /// yosys's figures, when it ran.
+    pub yosys: Option<YosysCost>,
+    /// yosys LUTs (or gates, for generic).
+    pub luts: Option<u64>,
+    /// yosys DSP blocks.
+    pub dsps: Option<u64>,
+    /// yosys flip-flops.
+    pub ffs: Option<u64>,
+    /// `yosys -V`.
+    pub yosys_version: Option<String>,
+    /// The exact script yosys ran.
+    pub yosys_script: Option<String>,
+    /// yosys LUTs / analytic LUTs.
+    pub lut_ratio: Option<f64>,
+    /// yosys flip-flops / analytic register bits.
+    pub ff_ratio: Option<f64>,
+}
+
+/// The reference Verilog directory.
+pub fn hdl_ref_dir(arg: Option<&Path>) -> PathBuf {
+    arg.map(Path::to_path_buf)
+        .or_else(|| std::env::var_os("SPECFX_HDL_REF").map(PathBuf::from))
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("hdl_ref"))
+}
+
+/// The Verilog sources of the DUT: every `rtl/*.v`, sorted, then `specfx_dut.v`.
+pub fn rtl_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let rtl = dir.join("rtl");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&rtl)
+        .with_context(|| format!("cannot read the reference Verilog in {}", rtl.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "v"))
+        .collect();
+    files.sort();
+    files.push(dir.join("specfx_dut.v"));
+    Ok(files)
+}
+
+/// Runs yosys on the configuration and returns (cost, version, script).
+pub fn run_yosys(
+    dp: &Datapath,
+    arch: Arch,
+    target: Target,
+    hdl_ref: &Path,
+) -> Result<(YosysCost, String, String)> {
+    let version = Command::new("yosys")
+        .arg("-V")
+        .output()
+        .context("yosys not found: install it (Debian: apt-get install yosys)")?;
+    let version = String::from_utf8_lossy(&version.stdout).trim().to_string();
+    let work = tempfile::tempdir().context("cannot create a temporary directory")?;
+    std::fs::write(
+        work.path().join("specfx_params.vh"),
+        params_header(dp, arch),
+    )?;
+    let files: Vec<String> = rtl_files(hdl_ref)?
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let script = yosys_script(target, &files, &work.path().display().to_string());
+    std::fs::write(work.path().join("cost.ys"), &script)?;
+    let out = Command::new("yosys")
+        .args(["-q", "-s", "cost.ys"])
+        .current_dir(work.path())
+        .output()
+        .context("cannot run yosys")?;
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        let first = err
+            .lines()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("no message");
+        bail!("yosys failed on the reference Verilog: {first}");
+    }
+    let stat = std::fs::read_to_string(work.path().join("stat.json"))
+        .context("yosys wrote no statistics")?;
+    let cmos = std::fs::read_to_string(work.path().join("stat_cmos.txt")).ok();
+    let cost = parse_stat_json(&stat, cmos.as_deref()).map_err(anyhow::Error::msg)?;
+    Ok((cost, version, script))
+}
+
+/// Builds the report (running yosys unless `analytic_only`).
+pub fn cost_report(
+    dp: &Datapath,
+    arch: Arch,
+    target: Target,
+    hdl_ref: &Path,
+    analytic_only: bool,
+) -> Result<CostReport> {
+    let analytic = analytic_cost(dp, arch, target);
+    let (yosys, version, script) = if analytic_only {
+        (None, None, None)
+    } else {
+        let (c, v, s) = run_yosys(dp, arch, target, hdl_ref)?;
+        (Some(c), Some(v), Some(s))
+    };
+    let ratio = |a: u64, b: u64| (b > 0).then(|| a as f64 / b as f64);
+    Ok(CostReport {
+        config: dp.config().name.clone(),
+        arch,
+        target,
+        luts: yosys.as_ref().map(|y| y.luts),
+        dsps: yosys.as_ref().map(|y| y.dsps),
+        ffs: yosys.as_ref().map(|y| y.ffs),
+        lut_ratio: yosys.as_ref().and_then(|y| ratio(y.luts, analytic.luts)),
+        ff_ratio: yosys
+            .as_ref()
+            .and_then(|y| ratio(y.ffs, analytic.register_bits)),
+        analytic,
+        yosys,
+        yosys_version: version,
+        yosys_script: script,
+    })
+}
+
+/// Renders the report as text.
+pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Result<()> {
+    let a = &r.analytic;
+    writeln!(
+        w,
+        "cost {}, {}, target {}: latency {} cycles, initiation interval {}",
+        r.config, r.arch, r.target, a.latency, a.initiation_interval
+    )?;
+    writeln!(
+        w,
+        "  {:<18} {:>10} {:>10} {:>8}",
+        "", "analytic", "yosys", "ratio"
+    )?;
+    let opt = |x: Option<u64>| x.map_or("-".to_string(), |v| v.to_string());
+    let rat = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2}"));
+    writeln!(
+        w,
+        "  {:<18} {:>10} {:>10} {:>8}",
+        "LUTs / gates",
+        a.luts,
+        opt(r.luts),
+        rat(r.lut_ratio)
+    )?;
+    writeln!(
+        w,
+        "  {:<18} {:>10} {:>10} {:>8}",
+        "flip-flops",
+        a.register_bits,
+        opt(r.ffs),
+        rat(r.ff_ratio)
+    )?;
+    writeln!(
+        w,
+        "  {:<18} {:>10} {:>10}",
+        "DSP blocks",
+        a.dsps,
+        opt(r.dsps)
+    )?;
+    if let Some(y) = &r.yosys {
+        writeln!(w, "  {:<18} {:>10} {:>10}", "carry cells", "-", y.carries)?;
+        writeln!(w, "  {:<18} {:>10} {:>10}", "cells", "-", y.cells)?;
+        if let Some(t) = y.transistors {
+            writeln!(w, "  {:<18} {:>10} {:>10}", "transistors (CMOS)", "-", t)?;
+        }
+    }
+    write!(
+        w,
+        "  multipliers ({} partial-product bits):",
+        a.multiplier_bits
+    )?;
+    for m in &a.multipliers {
+        write!(w, " {} {}x{}", m.name, m.a_bits, m.b_bits)?;
+    }
+    writeln!(w)?;
+    if let Some(v) = &r.yosys_version {
+        writeln!(w, "  {v}")?;
+    }
+    Ok(())
+}
+
+/// Runs `specfx cost`.
+pub fn run(args: &CostArgs) -> Result<Outcome> {
+    let dp = super::datapath::load(&args.config, None)?;
+    let dir = hdl_ref_dir(args.hdl_ref.as_deref());
+    let r = cost_report(&dp, args.arch, args.target, &dir, args.analytic_only)?;
+    if args.json {
+        print_json(&r)?;
+    } else {
+        print_with(|w| write_cost(w, &r))?;
+    }
+    Ok(Outcome::Ok)
+}
