@@ -1,0 +1,150 @@
+//! Co-simulation of the reference Verilog against the golden vectors and the Rust cycle model,
+//! in Icarus Verilog and Verilator (both must be installed: `./scripts/test` installs them).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn specfx(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args(args)
+        .output()
+        .expect("the specfx binary runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let p = std::env::temp_dir().join(format!("specfx-cosim-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&p);
+    p
+}
+
+fn cosim(vectors: &Path, sim: &str, arch: &str, seed: &str) -> Output {
+    Command::new(Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/cosim"))
+        .args([
+            "--vectors",
+            vectors.to_str().unwrap(),
+            "--sim",
+            sim,
+            "--arch",
+            arch,
+        ])
+        .args(["--seed", seed, "--bubble", "0.25", "--stall", "0.25"])
+        .env("SPECFX", env!("CARGO_BIN_EXE_specfx"))
+        .output()
+        .expect("scripts/cosim runs")
+}
+
+/// The `N passed, N failed` line of a run.
+fn summary(o: &Output) -> (u64, u64) {
+    let text = String::from_utf8_lossy(&o.stdout);
+    let line = text
+        .lines()
+        .rev()
+        .find(|l| l.contains(" passed, ") && l.trim_end().ends_with(" failed"))
+        .unwrap_or_else(|| {
+            panic!(
+                "no summary line in:\n{text}\n{}",
+                String::from_utf8_lossy(&o.stderr)
+            )
+        });
+    let nums: Vec<u64> = line
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().unwrap())
+        .collect();
+    (nums[0], nums[1])
+}
+
+fn vectors(config: &str, name: &str, cases: &str) -> (PathBuf, u64) {
+    let dir = temp_dir(name);
+    let o = specfx(&[
+        "vectors",
+        "--config",
+        config,
+        "--cases",
+        cases,
+        "--seed",
+        "3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    (dir, manifest["n_vectors"].as_u64().unwrap())
+}
+
+fn config_path(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/configs")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn check_all(config: &str, name: &str, arch: &str, cases: &str) {
+    let (dir, n) = vectors(config, name, cases);
+    for sim in ["icarus", "verilator"] {
+        let o = cosim(&dir, sim, arch, "11");
+        let (passed, failed) = summary(&o);
+        assert_eq!(
+            (passed, failed),
+            (n, 0),
+            "{name} on {sim} ({arch}):\n{}\n{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(o.status.success());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn baseline_pipelined_matches_bit_and_cycle() {
+    check_all("baseline", "baseline", "pipelined", "corner,random:400");
+}
+
+#[test]
+fn narrow_trn_wrap_matches_bit_and_cycle() {
+    check_all(
+        &config_path("narrow_trn_wrap.toml"),
+        "narrow",
+        "pipelined",
+        "corner,random:300",
+    );
+}
+
+#[test]
+fn conv_sym_k5_matches_bit_and_cycle() {
+    check_all(
+        &config_path("conv_sym_k5.toml"),
+        "k5",
+        "pipelined",
+        "corner,random:300",
+    );
+}
+
+#[test]
+fn folded_matches_bit_and_cycle() {
+    check_all("baseline", "baseline_folded", "folded", "random:300");
+    check_all(
+        &config_path("minimax_folded.toml"),
+        "minimax_folded",
+        "folded",
+        "corner,random:200",
+    );
+}
+
+#[test]
+fn a_corrupted_expected_value_fails() {
+    let (dir, n) = vectors("baseline", "corrupt", "random:50");
+    let path = dir.join("expected_out.hex");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let v = u64::from_str_radix(&lines[17], 16).unwrap() ^ 1;
+    lines[17] = format!("{v:06x}");
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    let o = cosim(&dir, "icarus", "pipelined", "5");
+    assert!(!o.status.success(), "a corrupted vector must fail");
+    assert_eq!(summary(&o), (n - 1, 1));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
