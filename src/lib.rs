@@ -22,6 +22,7 @@ pub mod error;
 pub mod fixed;
 pub mod golden;
 pub mod hdl;
+mod names;
 pub mod nset;
 pub mod pipeline;
 pub mod reference;

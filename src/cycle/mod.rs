@@ -24,12 +24,9 @@
 pub mod sim;
 pub mod vcd;
 
-use std::fmt;
-use std::str::FromStr;
 
 use serde::Serialize;
 
-use crate::error::Error;
 use crate::pipeline::Datapath;
 
 /// The two microarchitectures.
@@ -82,25 +79,7 @@ impl Arch {
     }
 }
 
-impl fmt::Display for Arch {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Arch {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self, Error> {
-        Arch::ALL
-            .into_iter()
-            .find(|a| a.name() == s)
-            .ok_or_else(|| Error::UnknownName {
-                what: "architecture",
-                expected: "pipelined or folded",
-                got: s.to_string(),
-            })
-    }
-}
+crate::names::named_enum!(Arch, "architecture", "pipelined or folded");
 
 /// One input of a stream: its sequence number, the index of its n in the datapath's n set,
 /// and its raw input code.

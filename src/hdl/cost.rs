@@ -2,13 +2,10 @@
 //! parser behind `specfx cost` (which runs yosys; nothing here starts a process).
 
 use std::collections::BTreeMap;
-use std::fmt;
-use std::str::FromStr;
 
 use serde::Serialize;
 
 use crate::cycle::Arch;
-use crate::error::Error;
 use crate::golden::constant_formats;
 use crate::pipeline::Datapath;
 use crate::reference::lobe::Cutoff;
@@ -48,25 +45,7 @@ impl Target {
     }
 }
 
-impl fmt::Display for Target {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Target {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self, Error> {
-        Target::ALL
-            .into_iter()
-            .find(|t| t.name() == s)
-            .ok_or_else(|| Error::UnknownName {
-                what: "synthesis target",
-                expected: "generic, ice40 or xilinx",
-                got: s.to_string(),
-            })
-    }
-}
+crate::names::named_enum!(Target, "synthesis target", "generic, ice40 or xilinx");
 
 /// One multiplier of a datapath: its name and operand widths.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]

@@ -4,12 +4,7 @@
 //! exponent `n`, and evaluates in plain f64. These are the oracles the fixed-point datapath is
 //! compared with; they never use fixed-point types.
 
-use std::fmt;
-use std::str::FromStr;
-
 use serde::{Deserialize, Serialize};
-
-use crate::error::Error;
 
 /// The number of squarings k supported by cs_m (m = 2^k).
 pub const K_RANGE: std::ops::RangeInclusive<u32> = 1..=7;
@@ -45,25 +40,7 @@ impl Cutoff {
     }
 }
 
-impl fmt::Display for Cutoff {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Cutoff {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self, Error> {
-        Cutoff::ALL
-            .into_iter()
-            .find(|c| c.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| Error::UnknownName {
-                what: "cutoff",
-                expected: "clamp, paper or none",
-                got: s.to_string(),
-            })
-    }
-}
+crate::names::named_enum!(Cutoff, "cutoff", "clamp, paper or none");
 
 /// `m = 2^k`, the exponent reached by `k` squarings.
 ///

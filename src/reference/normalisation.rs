@@ -7,12 +7,9 @@
 //! original theta integral and is the independent check of the closed forms.
 
 use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, PI};
-use std::fmt;
-use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::Error;
 use crate::reference::lobe::{m_of_k, PAPER_CUTOFF_CONSTANT};
 use crate::reference::quadrature::integrate;
 
@@ -81,25 +78,7 @@ impl Form {
     }
 }
 
-impl fmt::Display for Form {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Form {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self, Error> {
-        Form::ALL
-            .into_iter()
-            .find(|x| x.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| Error::UnknownName {
-                what: "form",
-                expected: "phong, phong_modified, blinn_phong, blinn_phong_modified, blinn_phong_ndf or blinn_phong_heightfield",
-                got: s.to_string(),
-            })
-    }
-}
+crate::names::named_enum!(Form, "form", "phong, phong_modified, blinn_phong, blinn_phong_modified, blinn_phong_ndf or blinn_phong_heightfield");
 
 /// Where a coefficient comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -127,25 +106,7 @@ impl CoefSource {
     }
 }
 
-impl fmt::Display for CoefSource {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for CoefSource {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self, Error> {
-        CoefSource::ALL
-            .into_iter()
-            .find(|x| x.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| Error::UnknownName {
-                what: "coefficient source",
-                expected: "classic, paper or exact",
-                got: s.to_string(),
-            })
-    }
-}
+crate::names::named_enum!(CoefSource, "coefficient source", "classic, paper or exact");
 
 /// coef(n) for a form and source; `k` (m = 2^k) matters only for [`CoefSource::Exact`].
 ///
