@@ -3,3 +3,4 @@
 pub mod check;
 pub mod methods;
 pub mod paper;
+pub mod sweep;

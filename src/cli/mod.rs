@@ -12,6 +12,7 @@ mod paper;
 mod reference;
 mod report;
 mod sim;
+mod sweep;
 pub mod vectors;
 
 use std::process::ExitCode;
@@ -42,6 +43,8 @@ enum Command {
     Hdl(hdl::HdlArgs),
     /// Synthesis cost of a configuration: yosys on the reference Verilog, and the analytic model.
     Cost(cost::CostArgs),
+    /// Evaluates a design space: every point checked exhaustively and costed; Pareto front.
+    Sweep(sweep::SweepArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -68,6 +71,7 @@ pub fn main() -> ExitCode {
         Command::Vectors(args) => vectors::run(&args),
         Command::Sim(args) => sim::run(&args),
         Command::Cost(args) => cost::run(&args),
+        Command::Sweep(args) => sweep::run(&args),
         Command::Hdl(args) => hdl::run(&args),
     };
     match result {

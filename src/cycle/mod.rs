@@ -24,7 +24,6 @@
 pub mod sim;
 pub mod vcd;
 
-
 use serde::Serialize;
 
 use crate::pipeline::Datapath;

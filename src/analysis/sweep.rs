@@ -1,0 +1,432 @@
+//! Design-space sweeps: a space of configurations (axes of values over a base configuration),
+//! every point checked exhaustively and costed analytically, and the error/cost Pareto front.
+//!
+//! Points are numbered in a fixed order (the cartesian product of the axes, axes sorted by
+//! key, last axis fastest), so a sweep can be split into shards by index and merged back, or
+//! resumed, with identical results.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::analysis::check::check;
+use crate::cycle::Arch;
+use crate::error::Error;
+use crate::fixed::Format;
+use crate::hdl::cost::{analytic_cost, Target};
+use crate::nset::NSet;
+use crate::pipeline::{Config, Datapath};
+
+/// A design space: a base configuration and the values each axis takes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Space {
+    /// The base configuration every point starts from.
+    pub base: Config,
+    /// Axes by key (see [`AXIS_KEYS`]), each with its values as TOML values.
+    pub axes: BTreeMap<String, Vec<toml::Value>>,
+}
+
+/// The keys an axis may have. `<stage>.frac` and `<stage>.int` change the fraction or integer
+/// bits of a stage's format (for `square`, of every squaring stage), keeping the other.
+pub const AXIS_KEYS: &[&str] = &[
+    "k",
+    "cutoff",
+    "variant",
+    "arch",
+    "coef.form",
+    "coef.source",
+    "coef.frac",
+    "coef.rounding",
+    "t.frac",
+    "t.int",
+    "t.rounding",
+    "t.overflow",
+    "b.frac",
+    "b.int",
+    "b.rounding",
+    "b.overflow",
+    "square.frac",
+    "square.int",
+    "square.rounding",
+    "square.overflow",
+    "out.frac",
+    "out.int",
+    "out.rounding",
+    "out.overflow",
+    "latency.mul",
+];
+
+/// What a space file says (`base` and `n` optional, `[vary]` the axes).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpaceFile {
+    base: Option<toml::Table>,
+    n: Option<NSet>,
+    vary: toml::Table,
+}
+
+fn space_error(key: &str, problem: String) -> Error {
+    Error::Config {
+        key: key.to_string(),
+        problem,
+    }
+}
+
+/// Expands `"10..=16"` (or `"10..16"`, both ends included) into integers; other values stay.
+fn expand(key: &str, v: &toml::Value) -> Result<Vec<toml::Value>, Error> {
+    match v {
+        toml::Value::Array(items) => {
+            if items.is_empty() {
+                return Err(space_error(
+                    &format!("vary.{key}"),
+                    "expected at least one value".into(),
+                ));
+            }
+            Ok(items.clone())
+        }
+        toml::Value::String(s) if s.contains("..") => {
+            let (lo, hi) = s.split_once("..").expect("checked");
+            let hi = hi.strip_prefix('=').unwrap_or(hi);
+            let parse = |x: &str| {
+                x.trim().parse::<i64>().map_err(|_| {
+                    space_error(
+                        &format!("vary.{key}"),
+                        format!("expected a range like \"10..=16\", got \"{s}\""),
+                    )
+                })
+            };
+            let (lo, hi) = (parse(lo)?, parse(hi)?);
+            if lo > hi || hi - lo > 256 {
+                return Err(space_error(
+                    &format!("vary.{key}"),
+                    format!("expected an ascending range of at most 257 values, got \"{s}\""),
+                ));
+            }
+            Ok((lo..=hi).map(toml::Value::Integer).collect())
+        }
+        other => Ok(vec![other.clone()]),
+    }
+}
+
+impl Space {
+    /// Reads a space file. `base` is a table of configuration keys over `baseline` (as in a
+    /// configuration file), `n` replaces the exponents, and `[vary]` gives each axis its values
+    /// (an array, or a range string like `"10..=16"`).
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::analysis::sweep::Space;
+    /// let s = Space::from_toml("n = \"64\"\n[vary]\nk = [3, 4]\n\"square.frac\" = \"12..=14\"\n").unwrap();
+    /// assert_eq!(s.n_points(), 6);
+    /// ```
+    pub fn from_toml(text: &str) -> Result<Space, Error> {
+        let file: SpaceFile = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
+                .unwrap_or(1);
+            Error::Toml {
+                line,
+                message: e.message().replace('\n', " ").trim().to_string(),
+            }
+        })?;
+        let mut base = match file.base {
+            Some(t) => Config::from_toml(&toml::to_string(&t).expect("a table serialises"))?,
+            None => Config::baseline(),
+        };
+        if let Some(n) = file.n {
+            base.n = n;
+        }
+        let mut axes = BTreeMap::new();
+        for (key, v) in &file.vary {
+            if !AXIS_KEYS.contains(&key.as_str()) {
+                return Err(space_error(
+                    &format!("vary.{key}"),
+                    format!("unknown axis; expected one of {}", AXIS_KEYS.join(", ")),
+                ));
+            }
+            axes.insert(key.clone(), expand(key, v)?);
+        }
+        let space = Space { base, axes };
+        // Every value must at least be of the right kind for its axis.
+        for (key, values) in &space.axes {
+            for v in values {
+                let mut cfg = space.base.clone();
+                let mut arch = Arch::Pipelined;
+                apply(&mut cfg, &mut arch, key, v)
+                    .map_err(|p| space_error(&format!("vary.{key}"), p))?;
+            }
+        }
+        Ok(space)
+    }
+
+    /// The number of points (the product of the axes' lengths).
+    pub fn n_points(&self) -> u64 {
+        self.axes.values().map(|v| v.len() as u64).product()
+    }
+
+    /// The axis values of point `index`: the last axis varies fastest.
+    pub fn point_values(&self, index: u64) -> Vec<(String, toml::Value)> {
+        let mut rest = index;
+        let mut out: Vec<(String, toml::Value)> = Vec::new();
+        for (key, values) in self.axes.iter().rev() {
+            let len = values.len() as u64;
+            out.push((key.clone(), values[(rest % len) as usize].clone()));
+            rest /= len;
+        }
+        out.reverse();
+        out
+    }
+
+    /// The configuration and architecture of point `index`.
+    pub fn point(&self, index: u64) -> Result<(Config, Arch), String> {
+        let mut cfg = self.base.clone();
+        let mut arch = Arch::Pipelined;
+        for (key, v) in self.point_values(index) {
+            apply(&mut cfg, &mut arch, &key, &v).map_err(|p| format!("{key}: {p}"))?;
+        }
+        cfg.name = format!("point{index}");
+        Ok((cfg, arch))
+    }
+}
+
+fn with_frac(f: Format, frac: i64) -> Result<Format, String> {
+    let frac = i32::try_from(frac).map_err(|_| format!("fraction bits out of range: {frac}"))?;
+    Format::new(f.is_signed(), f.int_bits(), frac).map_err(|e| e.to_string())
+}
+
+fn with_int(f: Format, int: i64) -> Result<Format, String> {
+    let int = i32::try_from(int).map_err(|_| format!("integer bits out of range: {int}"))?;
+    Format::new(f.is_signed(), int, f.frac_bits()).map_err(|e| e.to_string())
+}
+
+fn as_str(v: &toml::Value) -> Result<&str, String> {
+    v.as_str()
+        .ok_or_else(|| format!("expected a string, got {v}"))
+}
+
+fn as_int(v: &toml::Value) -> Result<i64, String> {
+    v.as_integer()
+        .ok_or_else(|| format!("expected an integer, got {v}"))
+}
+
+fn parse<T: std::str::FromStr>(v: &toml::Value) -> Result<T, String>
+where
+    T::Err: std::fmt::Display,
+{
+    as_str(v)?.parse::<T>().map_err(|e| e.to_string())
+}
+
+/// Applies one axis value to a configuration.
+fn apply(cfg: &mut Config, arch: &mut Arch, key: &str, v: &toml::Value) -> Result<(), String> {
+    match key {
+        "k" => {
+            let k = u32::try_from(as_int(v)?).map_err(|_| format!("bad k: {v}"))?;
+            if !crate::reference::lobe::K_RANGE.contains(&k) {
+                return Err(format!("expected k in 1..=7, got {k}"));
+            }
+            let first = cfg.square[0];
+            cfg.square = vec![first; k as usize];
+            cfg.k = k;
+        }
+        "cutoff" => cfg.cutoff = parse(v)?,
+        "variant" => {
+            cfg.variant = match as_str(v)? {
+                "plain" => crate::pipeline::Variant::Plain,
+                "minimax" => crate::pipeline::Variant::Minimax,
+                s => return Err(format!("expected plain or minimax, got '{s}'")),
+            }
+        }
+        "arch" => *arch = parse(v)?,
+        "coef.form" => cfg.coef.form = parse(v)?,
+        "coef.source" => cfg.coef.source = parse(v)?,
+        "coef.frac" => cfg.coef.format = with_frac(cfg.coef.format, as_int(v)?)?,
+        "coef.rounding" => cfg.coef.rounding = parse(v)?,
+        "latency.mul" => {
+            cfg.latency.mul = u32::try_from(as_int(v)?).map_err(|_| format!("bad latency: {v}"))?
+        }
+        _ => {
+            let (stage, field) = key.split_once('.').ok_or("unknown axis")?;
+            let specs: Vec<&mut crate::pipeline::StageSpec> = match stage {
+                "t" => vec![&mut cfg.t],
+                "b" => vec![&mut cfg.b],
+                "out" => vec![&mut cfg.out],
+                "square" => cfg.square.iter_mut().collect(),
+                _ => return Err("unknown axis".into()),
+            };
+            for spec in specs {
+                match field {
+                    "frac" => spec.format = with_frac(spec.format, as_int(v)?)?,
+                    "int" => spec.format = with_int(spec.format, as_int(v)?)?,
+                    "rounding" => spec.rounding = parse(v)?,
+                    "overflow" => spec.overflow = parse(v)?,
+                    _ => return Err("unknown axis".into()),
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The figures of one evaluated point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PointResult {
+    /// The point's index in the space.
+    pub index: u64,
+    /// Its axis values, `key=value` joined by `;`.
+    pub values: String,
+    /// Why the configuration is invalid, if it is (then the figures are absent).
+    pub invalid: Option<String>,
+    /// max |fixed lobe - cos^n|.
+    pub shape_total_max_abs: Option<f64>,
+    /// max |fixed lobe - f64 lobe|.
+    pub shape_quant_max_abs: Option<f64>,
+    /// max output error in output LSBs.
+    pub out_max_ulp: Option<f64>,
+    /// Share of outputs correctly rounded.
+    pub out_correctly_rounded: Option<f64>,
+    /// Output non-decreasing in c for every n.
+    pub monotonic: Option<bool>,
+    /// Analytic LUT estimate (generic target: every product in logic).
+    pub luts: Option<u64>,
+    /// Analytic register bits.
+    pub register_bits: Option<u64>,
+    /// Partial-product bits of the multipliers.
+    pub multiplier_bits: Option<u64>,
+    /// Latency in cycles.
+    pub latency: Option<u64>,
+    /// Initiation interval in cycles.
+    pub initiation_interval: Option<u64>,
+    /// On the error/cost Pareto front (set when the sweep is assembled).
+    #[serde(default)]
+    pub pareto: bool,
+}
+
+/// Evaluates point `index` of a space: exhaustive check and analytic cost.
+pub fn evaluate(space: &Space, index: u64) -> PointResult {
+    let values = space
+        .point_values(index)
+        .iter()
+        .map(|(k, v)| format!("{k}={}", v.to_string().trim_matches('"')))
+        .collect::<Vec<_>>()
+        .join(";");
+    let empty = |invalid: String| PointResult {
+        index,
+        values: values.clone(),
+        invalid: Some(invalid),
+        shape_total_max_abs: None,
+        shape_quant_max_abs: None,
+        out_max_ulp: None,
+        out_correctly_rounded: None,
+        monotonic: None,
+        luts: None,
+        register_bits: None,
+        multiplier_bits: None,
+        latency: None,
+        initiation_interval: None,
+        pareto: false,
+    };
+    let (cfg, arch) = match space.point(index) {
+        Ok(p) => p,
+        Err(e) => return empty(e),
+    };
+    let dp = match Datapath::new(cfg) {
+        Ok(dp) => dp,
+        Err(e) => return empty(e.to_string()),
+    };
+    let r = match check(&dp) {
+        Ok(r) => r,
+        Err(e) => return empty(e),
+    };
+    let cost = analytic_cost(&dp, arch, Target::Generic);
+    PointResult {
+        index,
+        values,
+        invalid: None,
+        shape_total_max_abs: Some(r.shape_total_max_abs),
+        shape_quant_max_abs: Some(r.shape_quant_max_abs),
+        out_max_ulp: Some(r.out_max_ulp),
+        out_correctly_rounded: Some(r.stages[dp.stage_out()].correctly_rounded),
+        monotonic: Some(r.monotonic),
+        luts: Some(cost.luts),
+        register_bits: Some(cost.register_bits),
+        multiplier_bits: Some(cost.multiplier_bits),
+        latency: Some(cost.latency),
+        initiation_interval: Some(cost.initiation_interval),
+        pareto: false,
+    }
+}
+
+/// Marks the Pareto front: the valid points no other point beats in both cost (analytic
+/// LUTs) and error (`shape_total_max_abs`), ties broken by index. Sorts by index.
+pub fn mark_pareto(points: &mut [PointResult]) {
+    points.sort_by_key(|p| p.index);
+    let key = |p: &PointResult| p.luts.zip(p.shape_total_max_abs);
+    for i in 0..points.len() {
+        let Some((ci, ei)) = key(&points[i]) else {
+            points[i].pareto = false;
+            continue;
+        };
+        let dominated = points.iter().enumerate().any(|(j, q)| {
+            key(q).is_some_and(|(cj, ej)| {
+                j != i
+                    && cj <= ci
+                    && ej <= ei
+                    && (cj < ci || ej < ei || (cj == ci && ej == ei && j < i))
+            })
+        });
+        points[i].pareto = !dominated;
+    }
+}
+
+/// The CSV of a sweep: one row per point, in index order.
+pub fn write_csv(w: &mut impl std::io::Write, points: &[PointResult]) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "index,values,invalid,shape_total_max_abs,shape_quant_max_abs,out_max_ulp,out_correctly_rounded,monotonic,luts,register_bits,multiplier_bits,latency,initiation_interval,pareto"
+    )?;
+    let f = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
+    let u = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
+    for p in points {
+        writeln!(
+            w,
+            "{},\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{}",
+            p.index,
+            p.values,
+            p.invalid.as_deref().unwrap_or("").replace('"', "'"),
+            f(p.shape_total_max_abs),
+            f(p.shape_quant_max_abs),
+            f(p.out_max_ulp),
+            f(p.out_correctly_rounded),
+            p.monotonic.map_or(String::new(), |m| m.to_string()),
+            u(p.luts),
+            u(p.register_bits),
+            u(p.multiplier_bits),
+            u(p.latency),
+            u(p.initiation_interval),
+            p.pareto
+        )?;
+    }
+    Ok(())
+}
+
+/// Parses `I/N` (0 <= I < N).
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::sweep::parse_shard;
+/// assert_eq!(parse_shard("1/4").unwrap(), (1, 4));
+/// assert!(parse_shard("4/4").is_err());
+/// ```
+pub fn parse_shard(s: &str) -> Result<(u64, u64), String> {
+    let bad = || format!("expected a shard I/N with 0 <= I < N, got '{s}'");
+    let (i, n) = s.split_once('/').ok_or_else(bad)?;
+    let (i, n) = (
+        i.trim().parse::<u64>().map_err(|_| bad())?,
+        n.trim().parse::<u64>().map_err(|_| bad())?,
+    );
+    if n == 0 || i >= n {
+        return Err(bad());
+    }
+    Ok((i, n))
+}

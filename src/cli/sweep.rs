@@ -1,0 +1,242 @@
+//! `specfx sweep`: evaluate a design space (resumable, shardable) and `specfx sweep merge`.
+
+use std::collections::BTreeMap;
+use std::fs::{self, OpenOptions};
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::{Deserialize, Serialize};
+
+use super::output::write_atomic;
+use super::Outcome;
+use specfx::analysis::sweep::{evaluate, mark_pareto, parse_shard, write_csv, PointResult, Space};
+
+/// Arguments of `specfx sweep`.
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct SweepArgs {
+    #[command(subcommand)]
+    command: Option<SweepCommand>,
+    /// The design space (TOML: `base`, `n`, `[vary]`; see docs/sweep.md).
+    #[arg(long)]
+    space: Option<PathBuf>,
+    /// Output directory; an unfinished sweep there is resumed.
+    #[arg(long, default_value = "specfx-sweep")]
+    out: PathBuf,
+    /// Evaluate only the points whose index is I modulo N (written I/N).
+    #[arg(long, value_parser = parse_shard)]
+    shard: Option<(u64, u64)>,
+}
+
+#[derive(Debug, Subcommand)]
+enum SweepCommand {
+    /// Joins the shards of one sweep into a complete one.
+    Merge {
+        /// Output directory of the merged sweep.
+        #[arg(long)]
+        out: PathBuf,
+        /// The shard directories.
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+    },
+}
+
+/// `space.json`: what a sweep directory holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct SweepInfo {
+    specfx_version: String,
+    space: Space,
+    shard_index: u64,
+    shard_count: u64,
+    n_points: u64,
+}
+
+/// Runs `specfx sweep ...`.
+pub fn run(args: &SweepArgs) -> Result<Outcome> {
+    if let Some(SweepCommand::Merge { out, shards }) = &args.command {
+        return merge(out, shards);
+    }
+    let Some(space_path) = &args.space else {
+        bail!("--space: a design space file is required (or use `specfx sweep merge`)");
+    };
+    let text = fs::read_to_string(space_path)
+        .with_context(|| format!("cannot read {}", space_path.display()))?;
+    let space =
+        Space::from_toml(&text).with_context(|| format!("space {}", space_path.display()))?;
+    let (shard_index, shard_count) = args.shard.unwrap_or((0, 1));
+    let info = SweepInfo {
+        specfx_version: env!("CARGO_PKG_VERSION").to_string(),
+        n_points: space.n_points(),
+        space,
+        shard_index,
+        shard_count,
+    };
+    let dir = &args.out;
+    let info_path = dir.join("space.json");
+    if info_path.exists() {
+        let old: SweepInfo = serde_json::from_str(&fs::read_to_string(&info_path)?)
+            .with_context(|| format!("{}: not a sweep directory", dir.display()))?;
+        if old.space != info.space
+            || (old.shard_index, old.shard_count) != (shard_index, shard_count)
+        {
+            bail!(
+                "{} holds another sweep (a different space or shard): choose another --out",
+                dir.display()
+            );
+        }
+    } else {
+        fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let mut json = serde_json::to_vec_pretty(&info)?;
+        json.push(b'\n');
+        write_atomic(&info_path, &json)?;
+    }
+    let mut done = read_points(&dir.join("points.jsonl"))?;
+    let todo: Vec<u64> = (0..info.n_points)
+        .filter(|i| i % shard_count == shard_index && !done.contains_key(i))
+        .collect();
+    let total = (0..info.n_points)
+        .filter(|i| i % shard_count == shard_index)
+        .count();
+    eprintln!(
+        "sweep: {} points in the space, {total} in this shard, {} already done",
+        info.n_points,
+        total - todo.len()
+    );
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = ProgressBar::new(total as u64);
+        b.set_style(
+            ProgressStyle::with_template("sweep {bar:40} {pos}/{len} eta {eta} {msg}")
+                .expect("valid template"),
+        );
+        b.set_position((total - todo.len()) as u64);
+        b
+    });
+    let mut log = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(dir.join("points.jsonl"))
+        .with_context(|| format!("cannot open {}", dir.join("points.jsonl").display()))?;
+    for (k, &index) in todo.iter().enumerate() {
+        let p = evaluate(&info.space, index);
+        let mut line = serde_json::to_string(&p)?;
+        line.push('\n');
+        log.write_all(line.as_bytes())?;
+        log.flush()?;
+        match &bar {
+            Some(b) => b.inc(1),
+            None => eprintln!(
+                "sweep: point {index} done ({}/{}): {}",
+                total - todo.len() + k + 1,
+                total,
+                p.values
+            ),
+        }
+        done.insert(index, p);
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let mut points: Vec<PointResult> = done.into_values().collect();
+    write_results(dir, &mut points)?;
+    println!(
+        "sweep: {} points in {} ({} on the Pareto front)",
+        points.len(),
+        dir.display(),
+        points.iter().filter(|p| p.pareto).count()
+    );
+    Ok(Outcome::Ok)
+}
+
+/// The points recorded so far; a torn last line (an interrupted write) is dropped and will be
+/// computed again.
+fn read_points(path: &Path) -> Result<BTreeMap<u64, PointResult>> {
+    let mut map = BTreeMap::new();
+    let Ok(text) = fs::read_to_string(path) else {
+        return Ok(map);
+    };
+    let mut good = String::new();
+    for line in text.lines() {
+        if let Ok(p) = serde_json::from_str::<PointResult>(line) {
+            good.push_str(line);
+            good.push('\n');
+            map.insert(p.index, p);
+        }
+    }
+    if good.len() != text.len() {
+        write_atomic(path, good.as_bytes())?;
+    }
+    Ok(map)
+}
+
+fn write_results(dir: &Path, points: &mut [PointResult]) -> Result<()> {
+    mark_pareto(points);
+    let mut csv = Vec::new();
+    write_csv(&mut csv, points)?;
+    write_atomic(&dir.join("sweep.csv"), &csv)?;
+    let mut json = serde_json::to_vec_pretty(&points)?;
+    json.push(b'\n');
+    write_atomic(&dir.join("sweep.json"), &json)?;
+    Ok(())
+}
+
+fn merge(out: &Path, shards: &[PathBuf]) -> Result<Outcome> {
+    let mut info: Option<SweepInfo> = None;
+    let mut points = BTreeMap::new();
+    for dir in shards {
+        let path = dir.join("space.json");
+        let this: SweepInfo = serde_json::from_str(
+            &fs::read_to_string(&path)
+                .with_context(|| format!("cannot read {}", path.display()))?,
+        )
+        .with_context(|| format!("{}: not a sweep directory", dir.display()))?;
+        if let Some(first) = &info {
+            if first.space != this.space {
+                bail!(
+                    "{}: a shard of another sweep (its space differs)",
+                    dir.display()
+                );
+            }
+        } else {
+            info = Some(this.clone());
+        }
+        points.extend(read_points(&dir.join("points.jsonl"))?);
+    }
+    let info = info.expect("at least one shard");
+    let missing = (0..info.n_points)
+        .filter(|i| !points.contains_key(i))
+        .count();
+    if missing > 0 {
+        bail!(
+            "the shards hold {} of {} points: {missing} are missing (run or resume the other shards)",
+            points.len(),
+            info.n_points
+        );
+    }
+    fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let merged = SweepInfo {
+        shard_index: 0,
+        shard_count: 1,
+        ..info
+    };
+    let mut json = serde_json::to_vec_pretty(&merged)?;
+    json.push(b'\n');
+    write_atomic(&out.join("space.json"), &json)?;
+    let mut lines = String::new();
+    for p in points.values() {
+        lines.push_str(&serde_json::to_string(p)?);
+        lines.push('\n');
+    }
+    write_atomic(&out.join("points.jsonl"), lines.as_bytes())?;
+    let mut points: Vec<PointResult> = points.into_values().collect();
+    write_results(out, &mut points)?;
+    println!(
+        "sweep merge: {} points from {} shards into {}",
+        points.len(),
+        shards.len(),
+        out.display()
+    );
+    Ok(Outcome::Ok)
+}
