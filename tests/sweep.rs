@@ -65,10 +65,17 @@ fn shards_merged_equal_the_one_shot_sweep() {
             "{file}"
         );
     }
+    let svg = std::fs::read_to_string(one.join("sweep.svg")).unwrap();
+    assert!(svg.contains("Pareto front"));
+    let png = std::fs::read(one.join("sweep.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(png, std::fs::read(merged.join("sweep.png")).unwrap());
     let csv = std::fs::read_to_string(one.join("sweep.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 16);
     assert!(
-        csv.lines().skip(1).any(|l| l.ends_with(",true")),
+        csv.lines()
+            .skip(1)
+            .any(|l| l.split(',').nth(13) == Some("true")),
         "a Pareto front"
     );
     // Two shards are not the whole sweep.
@@ -164,6 +171,9 @@ fn point(index: u64, luts: u64, err: f64) -> PointResult {
         latency: Some(1),
         initiation_interval: Some(1),
         pareto: false,
+        yosys_luts: None,
+        yosys_ffs: None,
+        yosys_dsps: None,
     }
 }
 

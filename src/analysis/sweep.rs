@@ -300,6 +300,15 @@ pub struct PointResult {
     /// On the error/cost Pareto front (set when the sweep is assembled).
     #[serde(default)]
     pub pareto: bool,
+    /// yosys LUTs (Pareto points, with `--yosys`).
+    #[serde(default)]
+    pub yosys_luts: Option<u64>,
+    /// yosys flip-flops (Pareto points, with `--yosys`).
+    #[serde(default)]
+    pub yosys_ffs: Option<u64>,
+    /// yosys DSP blocks (Pareto points, with `--yosys`).
+    #[serde(default)]
+    pub yosys_dsps: Option<u64>,
 }
 
 /// Evaluates point `index` of a space: exhaustive check and analytic cost.
@@ -325,6 +334,9 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
         latency: None,
         initiation_interval: None,
         pareto: false,
+        yosys_luts: None,
+        yosys_ffs: None,
+        yosys_dsps: None,
     };
     let (cfg, arch) = match space.point(index) {
         Ok(p) => p,
@@ -354,6 +366,9 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
         latency: Some(cost.latency),
         initiation_interval: Some(cost.initiation_interval),
         pareto: false,
+        yosys_luts: None,
+        yosys_ffs: None,
+        yosys_dsps: None,
     }
 }
 
@@ -383,14 +398,14 @@ pub fn mark_pareto(points: &mut [PointResult]) {
 pub fn write_csv(w: &mut impl std::io::Write, points: &[PointResult]) -> std::io::Result<()> {
     writeln!(
         w,
-        "index,values,invalid,shape_total_max_abs,shape_quant_max_abs,out_max_ulp,out_correctly_rounded,monotonic,luts,register_bits,multiplier_bits,latency,initiation_interval,pareto"
+        "index,values,invalid,shape_total_max_abs,shape_quant_max_abs,out_max_ulp,out_correctly_rounded,monotonic,luts,register_bits,multiplier_bits,latency,initiation_interval,pareto,yosys_luts,yosys_ffs,yosys_dsps"
     )?;
     let f = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
     let u = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
     for p in points {
         writeln!(
             w,
-            "{},\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{}",
+            "{},\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             p.index,
             p.values,
             p.invalid.as_deref().unwrap_or("").replace('"', "'"),
@@ -404,10 +419,45 @@ pub fn write_csv(w: &mut impl std::io::Write, points: &[PointResult]) -> std::io
             u(p.multiplier_bits),
             u(p.latency),
             u(p.initiation_interval),
-            p.pareto
+            p.pareto,
+            u(p.yosys_luts),
+            u(p.yosys_ffs),
+            u(p.yosys_dsps)
         )?;
     }
     Ok(())
+}
+
+/// The error/cost chart of a sweep: every valid point, and the Pareto front as a line.
+pub fn chart(points: &[PointResult]) -> crate::report::chart::Chart {
+    use crate::report::chart::{Chart, Series};
+    let xy = |p: &PointResult| {
+        p.luts
+            .zip(p.shape_total_max_abs)
+            .map(|(c, e)| (c as f64, e))
+    };
+    let mut front: Vec<(f64, f64)> = points.iter().filter(|p| p.pareto).filter_map(xy).collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Chart {
+        title: "Sweep: lobe error against cos^n versus cost".into(),
+        x_label: "analytic cost (LUTs, every product in logic)".into(),
+        y_label: "max |fixed lobe - cos^n| (absolute, log scale)".into(),
+        log_y: true,
+        series: vec![
+            Series {
+                label: format!("{} points", points.iter().filter_map(xy).count()),
+                points: points.iter().filter_map(xy).collect(),
+                line: false,
+                color: (120, 120, 120),
+            },
+            Series {
+                label: format!("Pareto front ({} points)", front.len()),
+                points: front,
+                line: true,
+                color: (200, 30, 30),
+            },
+        ],
+    }
 }
 
 /// Parses `I/N` (0 <= I < N).

@@ -29,6 +29,9 @@ pub struct SweepArgs {
     /// Evaluate only the points whose index is I modulo N (written I/N).
     #[arg(long, value_parser = parse_shard)]
     shard: Option<(u64, u64)>,
+    /// Also synthesise the Pareto points with yosys for this target (generic, ice40, xilinx).
+    #[arg(long)]
+    yosys: Option<specfx::hdl::cost::Target>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -140,6 +143,10 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
         b.finish_and_clear();
     }
     let mut points: Vec<PointResult> = done.into_values().collect();
+    specfx::analysis::sweep::mark_pareto(&mut points);
+    if let Some(target) = args.yosys {
+        synthesise_front(&info.space, &mut points, target, dir)?;
+    }
     write_results(dir, &mut points)?;
     println!(
         "sweep: {} points in {} ({} on the Pareto front)",
@@ -148,6 +155,61 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
         points.iter().filter(|p| p.pareto).count()
     );
     Ok(Outcome::Ok)
+}
+
+/// Runs yosys on every Pareto point, keeping results in `yosys-<target>.jsonl` so that a
+/// resumed sweep does not synthesise a point twice.
+fn synthesise_front(
+    space: &Space,
+    points: &mut [PointResult],
+    target: specfx::hdl::cost::Target,
+    dir: &Path,
+) -> Result<()> {
+    #[derive(Serialize, Deserialize)]
+    struct Synth {
+        index: u64,
+        luts: u64,
+        ffs: u64,
+        dsps: u64,
+    }
+    let path = dir.join(format!("yosys-{target}.jsonl"));
+    let mut known: BTreeMap<u64, Synth> = fs::read_to_string(&path)
+        .unwrap_or_default()
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Synth>(l).ok())
+        .map(|s| (s.index, s))
+        .collect();
+    let hdl = super::cost::hdl_ref_dir(None);
+    for p in points.iter_mut().filter(|p| p.pareto) {
+        if let std::collections::btree_map::Entry::Vacant(slot) = known.entry(p.index) {
+            let (cfg, arch) = space.point(p.index).map_err(anyhow::Error::msg)?;
+            let dp = specfx::pipeline::Datapath::new(cfg)?;
+            eprintln!(
+                "sweep: synthesising Pareto point {} with yosys ({target})",
+                p.index
+            );
+            let (cost, _, _) = super::cost::run_yosys(&dp, arch, target, &hdl)?;
+            let s = Synth {
+                index: p.index,
+                luts: cost.luts,
+                ffs: cost.ffs,
+                dsps: cost.dsps,
+            };
+            let mut line = serde_json::to_string(&s)?;
+            line.push('\n');
+            OpenOptions::new()
+                .create(true)
+                .append(true)
+                .open(&path)?
+                .write_all(line.as_bytes())?;
+            slot.insert(s);
+        }
+        let s = &known[&p.index];
+        p.yosys_luts = Some(s.luts);
+        p.yosys_ffs = Some(s.ffs);
+        p.yosys_dsps = Some(s.dsps);
+    }
+    Ok(())
 }
 
 /// The points recorded so far; a torn last line (an interrupted write) is dropped and will be
@@ -179,6 +241,11 @@ fn write_results(dir: &Path, points: &mut [PointResult]) -> Result<()> {
     let mut json = serde_json::to_vec_pretty(&points)?;
     json.push(b'\n');
     write_atomic(&dir.join("sweep.json"), &json)?;
+    let chart = specfx::analysis::sweep::chart(points);
+    let svg = specfx::report::chart::render_svg(&chart).map_err(anyhow::Error::msg)?;
+    write_atomic(&dir.join("sweep.svg"), svg.as_bytes())?;
+    let png = specfx::report::chart::render_png(&chart).map_err(anyhow::Error::msg)?;
+    write_atomic(&dir.join("sweep.png"), &png)?;
     Ok(())
 }
 

@@ -1,4 +1,5 @@
-//! Renders results as text tables and CSV into any writer; never opens files.
+//! Renders results as text tables, CSV and charts into any writer or buffer; never opens files.
+pub mod chart;
 pub mod check;
 pub mod csv;
 pub mod paper;

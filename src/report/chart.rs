@@ -1,0 +1,202 @@
+//! Charts: scatter and line series on linear or logarithmic axes, rendered to SVG text or PNG
+//! bytes with an embedded font (DejaVu Sans), so output is identical on every machine.
+
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// One series of a chart.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend label.
+    pub label: String,
+    /// The (x, y) points, in drawing order.
+    pub points: Vec<(f64, f64)>,
+    /// Draw a line through the points (else only markers).
+    pub line: bool,
+    /// RGB colour.
+    pub color: (u8, u8, u8),
+}
+
+/// A chart: title, axis labels with their units, and series.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chart {
+    /// Title at the top.
+    pub title: String,
+    /// X axis label, with its unit.
+    pub x_label: String,
+    /// Y axis label, with its unit.
+    pub y_label: String,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The series.
+    pub series: Vec<Series>,
+}
+
+/// Chart size in pixels (the SVG uses the same user units).
+pub const SIZE: (u32, u32) = (960, 640);
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
+            .map_err(|_| ())
+            .expect("the embedded DejaVu Sans is a valid font");
+    });
+}
+
+fn ranges(chart: &Chart) -> ((f64, f64), (f64, f64)) {
+    let pts = chart.series.iter().flat_map(|s| s.points.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in pts {
+        if !x.is_finite() || !y.is_finite() || (chart.log_y && y <= 0.0) {
+            continue;
+        }
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        return ((0.0, 1.0), (if chart.log_y { 1e-3 } else { 0.0 }, 1.0));
+    }
+    let pad = |lo: f64, hi: f64| {
+        let d = if hi > lo {
+            0.05 * (hi - lo)
+        } else {
+            0.5 * lo.abs().max(1.0)
+        };
+        (lo - d, hi + d)
+    };
+    let xr = pad(x0, x1);
+    let yr = if chart.log_y {
+        (y0 / 1.5, y1 * 1.5)
+    } else {
+        pad(y0, y1)
+    };
+    (xr, yr)
+}
+
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, chart: &Chart) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(err)?;
+    let ((x0, x1), (y0, y1)) = ranges(chart);
+    let mut builder = ChartBuilder::on(&root);
+    builder
+        .caption(&chart.title, ("sans-serif", 22))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(84);
+    macro_rules! body {
+        ($ctx:expr) => {{
+            let mut ctx = $ctx;
+            ctx.configure_mesh()
+                .x_desc(&chart.x_label)
+                .y_desc(&chart.y_label)
+                .label_style(("sans-serif", 14))
+                .axis_desc_style(("sans-serif", 16))
+                .draw()
+                .map_err(err)?;
+            for s in &chart.series {
+                let color = RGBColor(s.color.0, s.color.1, s.color.2);
+                let pts: Vec<(f64, f64)> = s
+                    .points
+                    .iter()
+                    .copied()
+                    .filter(|&(x, y)| x.is_finite() && y.is_finite() && (!chart.log_y || y > 0.0))
+                    .collect();
+                if s.line {
+                    ctx.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                        .map_err(err)?;
+                }
+                ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                    .map_err(err)?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+            }
+            ctx.configure_series_labels()
+                .label_font(("sans-serif", 14))
+                .background_style(WHITE.mix(0.9))
+                .border_style(BLACK)
+                .draw()
+                .map_err(err)?;
+        }};
+    }
+    if chart.log_y {
+        body!(builder
+            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+            .map_err(err)?);
+    } else {
+        body!(builder.build_cartesian_2d(x0..x1, y0..y1).map_err(err)?);
+    }
+    root.present().map_err(err)
+}
+
+/// Renders a chart as SVG text.
+pub fn render_svg(chart: &Chart) -> Result<String, String> {
+    register_font();
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
+        draw(root, chart)?;
+    }
+    text.push('\n');
+    Ok(text)
+}
+
+/// Renders a chart as PNG bytes.
+pub fn render_png(chart: &Chart) -> Result<Vec<u8>, String> {
+    register_font();
+    let (w, h) = SIZE;
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+        draw(root, chart)?;
+    }
+    let mut png_bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut png_bytes, w, h);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_compression(png::Compression::Best);
+        let mut writer = enc.write_header().map_err(|e| e.to_string())?;
+        writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
+    }
+    Ok(png_bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chart() -> Chart {
+        Chart {
+            title: "test".into(),
+            x_label: "x (units)".into(),
+            y_label: "y (units)".into(),
+            log_y: true,
+            series: vec![Series {
+                label: "a".into(),
+                points: vec![(1.0, 1e-3), (2.0, 1e-2), (3.0, 0.0)],
+                line: true,
+                color: (200, 0, 0),
+            }],
+        }
+    }
+
+    #[test]
+    fn svg_and_png_render_deterministically() {
+        let svg = render_svg(&chart()).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("x (units)"));
+        let png1 = render_png(&chart()).unwrap();
+        let png2 = render_png(&chart()).unwrap();
+        assert_eq!(&png1[..8], b"\x89PNG\r\n\x1a\n");
+        assert_eq!(png1, png2);
+    }
+}
