@@ -2,5 +2,6 @@
 //! exhaustive accuracy checks.
 pub mod check;
 pub mod methods;
+pub mod optimize;
 pub mod paper;
 pub mod sweep;

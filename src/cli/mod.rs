@@ -7,6 +7,7 @@ mod check;
 pub mod cost;
 mod datapath;
 mod hdl;
+mod optimize;
 mod output;
 mod paper;
 mod reference;
@@ -45,6 +46,8 @@ enum Command {
     Cost(cost::CostArgs),
     /// Evaluates a design space: every point checked exhaustively and costed; Pareto front.
     Sweep(sweep::SweepArgs),
+    /// Finds the cheapest configuration that meets an error budget, proved by a check.
+    Optimize(optimize::OptimizeArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -72,6 +75,7 @@ pub fn main() -> ExitCode {
         Command::Sim(args) => sim::run(&args),
         Command::Cost(args) => cost::run(&args),
         Command::Sweep(args) => sweep::run(&args),
+        Command::Optimize(args) => optimize::run(&args),
         Command::Hdl(args) => hdl::run(&args),
     };
     match result {

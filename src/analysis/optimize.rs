@@ -1,0 +1,387 @@
+//! The optimiser: the cheapest configuration that meets an error budget, proved by an
+//! exhaustive check.
+//!
+//! Search: start from a wide feasible point (every searched stage, t, b and the squarings, at
+//! `start_frac` fraction bits; the output format is kept, it is the design's interface), then
+//! per-stage bisection of the fraction bits (each stage in turn, the others fixed,
+//! repeated until nothing shrinks), from each combination of the discrete choices (k, the
+//! variant, the rounding of every stage); keep the cheapest feasible result. Every candidate is
+//! checked exhaustively, and the answer is shown locally minimal: taking one fraction bit from
+//! any searched stage breaks the budget.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::str::FromStr;
+
+use serde::Serialize;
+
+use crate::analysis::check::{check, CheckReport};
+use crate::error::Error;
+use crate::fixed::{Format, Rounding};
+use crate::pipeline::{Config, Datapath, Variant};
+
+/// A quantity a budget can bound.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Metric {
+    /// max |fixed lobe - cos^n| (`shape_total`).
+    ShapeTotal,
+    /// max |fixed lobe - f64 lobe| (`shape_quant`).
+    ShapeQuant,
+    /// max output error in output LSBs (`out`, unit `ulp`).
+    Out,
+    /// Share of outputs correctly rounded (`correct`, a fraction or a percentage).
+    Correct,
+}
+
+/// One bound: `metric <= value` (or `>=` for `correct`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Bound {
+    /// The metric.
+    pub metric: Metric,
+    /// The limit, in the metric's own unit (absolute, LSBs or a fraction).
+    pub limit: f64,
+}
+
+/// An error budget: every bound must hold.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Budget {
+    /// The text it was parsed from.
+    pub text: String,
+    /// The bounds.
+    pub bounds: Vec<Bound>,
+}
+
+impl FromStr for Budget {
+    type Err = Error;
+    /// Parses `shape_total <= 1 lsb8`, `shape_quant <= 0.5 lsb8`, `out <= 1 ulp`,
+    /// `correct >= 99%` (or `0.99`), several joined by `,` or `and`. `lsbN` is 2^-N.
+    fn from_str(s: &str) -> Result<Self, Error> {
+        let bad = |part: &str, why: &str| {
+            Error::Config {
+            key: "budget".into(),
+            problem: format!("{why} in '{part}'; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%'"),
+        }
+        };
+        let mut bounds = Vec::new();
+        for part in s.split(',').flat_map(|p| p.split(" and ")) {
+            let part = part.trim();
+            let (lhs, op, rhs) = if let Some((l, r)) = part.split_once("<=") {
+                (l, "<=", r)
+            } else if let Some((l, r)) = part.split_once(">=") {
+                (l, ">=", r)
+            } else {
+                return Err(bad(part, "no <= or >="));
+            };
+            let metric = match lhs.trim() {
+                "shape_total" => Metric::ShapeTotal,
+                "shape_quant" => Metric::ShapeQuant,
+                "out" => Metric::Out,
+                "correct" => Metric::Correct,
+                other => return Err(bad(part, &format!("unknown metric '{other}'"))),
+            };
+            let want_op = if metric == Metric::Correct {
+                ">="
+            } else {
+                "<="
+            };
+            if op != want_op {
+                return Err(bad(part, &format!("{} takes {want_op}", lhs.trim())));
+            }
+            let rhs = rhs.trim();
+            let unit_at = rhs
+                .find("lsb")
+                .or_else(|| rhs.find("ulp"))
+                .or_else(|| rhs.find('%'));
+            let (number, unit) = match unit_at {
+                Some(i) => (rhs[..i].trim(), rhs[i..].trim()),
+                None => (rhs, ""),
+            };
+            let value: f64 = number.parse().map_err(|_| bad(part, "no number"))?;
+            let limit = match (metric, unit) {
+                (Metric::ShapeTotal | Metric::ShapeQuant, "") => value,
+                (Metric::ShapeTotal | Metric::ShapeQuant, u) if u.starts_with("lsb") => {
+                    let bits: i32 = u[3..]
+                        .parse()
+                        .map_err(|_| bad(part, "lsbN needs a number N"))?;
+                    value * (-f64::from(bits)).exp2()
+                }
+                (Metric::Out, "ulp" | "") => value,
+                (Metric::Correct, "%") => value / 100.0,
+                (Metric::Correct, "") => value,
+                _ => {
+                    return Err(bad(
+                        part,
+                        &format!("unit '{unit}' does not fit this metric"),
+                    ))
+                }
+            };
+            bounds.push(Bound { metric, limit });
+        }
+        Ok(Budget {
+            text: s.trim().to_string(),
+            bounds,
+        })
+    }
+}
+
+impl fmt::Display for Budget {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+/// The value of a metric in a check.
+pub fn metric_value(r: &CheckReport, metric: Metric) -> f64 {
+    match metric {
+        Metric::ShapeTotal => r.shape_total_max_abs,
+        Metric::ShapeQuant => r.shape_quant_max_abs,
+        Metric::Out => r.out_max_ulp,
+        Metric::Correct => r.stages.last().map_or(0.0, |s| s.correctly_rounded),
+    }
+}
+
+impl Budget {
+    /// Whether a check meets every bound.
+    pub fn met_by(&self, r: &CheckReport) -> bool {
+        self.bounds.iter().all(|b| {
+            let v = metric_value(r, b.metric);
+            match b.metric {
+                Metric::Correct => v >= b.limit,
+                _ => v <= b.limit,
+            }
+        })
+    }
+
+    /// How far a check is from the budget: the largest ratio value/limit (limit/value for
+    /// `correct`); at most 1 when met.
+    pub fn excess(&self, r: &CheckReport) -> f64 {
+        self.bounds
+            .iter()
+            .map(|b| {
+                let v = metric_value(r, b.metric);
+                match b.metric {
+                    Metric::Correct => b.limit / v.max(1e-300),
+                    _ => v / b.limit.max(1e-300),
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The searched stages: `t`, `b`, `sq1`..`sqk`. The output format is the interface the
+/// design must deliver (and the unit of `out <= N ulp`), so it is kept as the base has it.
+fn stage_names(k: u32) -> Vec<String> {
+    let mut v = vec!["t".to_string(), "b".to_string()];
+    v.extend((1..=k).map(|i| format!("sq{i}")));
+    v
+}
+
+fn set_frac(cfg: &mut Config, stage: &str, frac: i32) -> Result<(), String> {
+    let spec = match stage {
+        "t" => &mut cfg.t,
+        "b" => &mut cfg.b,
+        "out" => &mut cfg.out,
+        s => {
+            let i: usize = s[2..].parse().map_err(|_| format!("bad stage {s}"))?;
+            &mut cfg.square[i - 1]
+        }
+    };
+    spec.format = Format::new(spec.format.is_signed(), spec.format.int_bits(), frac)
+        .map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// The discrete choices the local search tries.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Choices {
+    /// Numbers of squarings.
+    pub k: Vec<u32>,
+    /// Variants.
+    pub variants: Vec<Variant>,
+    /// Rounding modes (applied to every searched stage at once).
+    pub roundings: Vec<Rounding>,
+}
+
+/// One evaluated candidate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Candidate {
+    /// Its configuration.
+    pub config: Config,
+    /// The cost (LUTs, analytic or yosys).
+    pub cost: f64,
+    /// Whether it meets the budget.
+    pub feasible: bool,
+    /// How far from the budget (<= 1 when met).
+    pub excess: f64,
+}
+
+/// What the optimiser found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OptimizeResult {
+    /// The budget.
+    pub budget: Budget,
+    /// The cheapest feasible configuration, if any.
+    pub best: Option<Candidate>,
+    /// The closest configuration (least excess) when none is feasible.
+    pub closest: Option<Candidate>,
+    /// Exhaustive checks run.
+    pub n_evaluations: u64,
+    /// Why the answer is minimal within the search.
+    pub minimality: Vec<String>,
+}
+
+/// Searches for the cheapest configuration meeting `budget`, starting from `base`.
+///
+/// `cost` prices a validated datapath (analytic LUTs, or yosys); `progress` receives a line
+/// per step.
+pub fn optimize(
+    base: &Config,
+    budget: &Budget,
+    choices: &Choices,
+    start_frac: i32,
+    cost: &mut dyn FnMut(&Datapath) -> Result<f64, String>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<OptimizeResult, String> {
+    let mut n_eval = 0u64;
+    let mut memo: BTreeMap<String, Option<Candidate>> = BTreeMap::new();
+    let mut evaluate = |cfg: &Config, n_eval: &mut u64| -> Result<Option<Candidate>, String> {
+        let key = cfg.to_toml();
+        if let Some(c) = memo.get(&key) {
+            return Ok(c.clone());
+        }
+        let c = match Datapath::new(cfg.clone()) {
+            Err(_) => None,
+            Ok(dp) => {
+                *n_eval += 1;
+                let r = check(&dp)?;
+                Some(Candidate {
+                    config: cfg.clone(),
+                    cost: cost(&dp)?,
+                    feasible: budget.met_by(&r),
+                    excess: budget.excess(&r),
+                })
+            }
+        };
+        memo.insert(key, c.clone());
+        Ok(c)
+    };
+    let mut best: Option<Candidate> = None;
+    let mut closest: Option<Candidate> = None;
+    for &k in &choices.k {
+        for &variant in &choices.variants {
+            for &rounding in &choices.roundings {
+                let mut cfg = base.clone();
+                cfg.k = k;
+                cfg.square = vec![base.square[0]; k as usize];
+                cfg.variant = variant;
+                let stages = stage_names(k);
+                for s in &stages {
+                    set_frac(&mut cfg, s, start_frac)?;
+                }
+                cfg.t.rounding = rounding;
+                cfg.b.rounding = rounding;
+                cfg.out.rounding = rounding;
+                for sq in &mut cfg.square {
+                    sq.rounding = rounding;
+                }
+                progress(&format!(
+                    "k = {k}, {}, {rounding}: start at {start_frac} fraction bits",
+                    variant.name()
+                ));
+                let Some(start) = evaluate(&cfg, &mut n_eval)? else {
+                    continue;
+                };
+                if !start.feasible {
+                    if closest.as_ref().is_none_or(|c| start.excess < c.excess) {
+                        closest = Some(start);
+                    }
+                    continue;
+                }
+                // Per-stage bisection until nothing shrinks.
+                let mut current = start;
+                loop {
+                    let mut changed = false;
+                    for s in &stages {
+                        let frac_of = |c: &Config| -> i32 {
+                            match s.as_str() {
+                                "t" => c.t.format.frac_bits(),
+                                "b" => c.b.format.frac_bits(),
+                                "out" => c.out.format.frac_bits(),
+                                x => c.square[x[2..].parse::<usize>().unwrap_or(1) - 1]
+                                    .format
+                                    .frac_bits(),
+                            }
+                        };
+                        let (mut lo, mut hi) = (-1, frac_of(&current.config));
+                        // Invariant: hi feasible; find the smallest feasible in (lo, hi], down
+                        // to 0 fraction bits.
+                        while hi - lo > 1 {
+                            let mid = (lo + hi) / 2;
+                            let mut trial = current.config.clone();
+                            if set_frac(&mut trial, s, mid).is_err() {
+                                lo = mid;
+                                continue;
+                            }
+                            match evaluate(&trial, &mut n_eval)? {
+                                Some(c) if c.feasible => {
+                                    hi = mid;
+                                    current = c;
+                                    changed = true;
+                                }
+                                _ => lo = mid,
+                            }
+                        }
+                    }
+                    if !changed {
+                        break;
+                    }
+                }
+                progress(&format!("  -> {:.0} LUTs", current.cost));
+                if best.as_ref().is_none_or(|b| current.cost < b.cost) {
+                    best = Some(current);
+                }
+            }
+        }
+    }
+    let mut minimality = Vec::new();
+    if let Some(b) = &best {
+        minimality.push(format!(
+            "cheapest of {} starting points (k in {:?}, variants {:?}, roundings {:?}), each shrunk by per-stage bisection until no stage could lose a fraction bit",
+            choices.k.len() * choices.variants.len() * choices.roundings.len(),
+            choices.k,
+            choices.variants.iter().map(|v| v.name()).collect::<Vec<_>>(),
+            choices.roundings.iter().map(|r| r.name()).collect::<Vec<_>>()
+        ));
+        for s in stage_names(b.config.k) {
+            let mut trial = b.config.clone();
+            let frac = match s.as_str() {
+                "t" => trial.t.format.frac_bits(),
+                "b" => trial.b.format.frac_bits(),
+                "out" => trial.out.format.frac_bits(),
+                x => trial.square[x[2..].parse::<usize>().unwrap_or(1) - 1]
+                    .format
+                    .frac_bits(),
+            };
+            let verdict = if set_frac(&mut trial, &s, frac - 1).is_err() {
+                "cannot lose a bit (format limit)".to_string()
+            } else {
+                match evaluate(&trial, &mut n_eval)? {
+                    Some(c) if c.feasible => {
+                        format!("ALSO FEASIBLE with {} bits (cost {:.0})", frac - 1, c.cost)
+                    }
+                    Some(_) => format!("{} fraction bits: one fewer breaks the budget", frac),
+                    None => "one fewer bit is not a valid configuration".to_string(),
+                }
+            };
+            minimality.push(format!("{s}: {verdict}"));
+        }
+    }
+    Ok(OptimizeResult {
+        budget: budget.clone(),
+        best,
+        closest,
+        n_evaluations: n_eval,
+        minimality,
+    })
+}

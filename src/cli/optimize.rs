@@ -1,0 +1,167 @@
+//! `specfx optimize`: the cheapest configuration meeting an error budget.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+
+use super::output::write_atomic;
+use super::Outcome;
+use specfx::analysis::check::check;
+use specfx::analysis::optimize::{optimize, Budget, Choices};
+use specfx::cycle::Arch;
+use specfx::fixed::Rounding;
+use specfx::hdl::cost::{analytic_cost, Target};
+use specfx::nset::NSet;
+use specfx::pipeline::{Datapath, Variant};
+
+/// Arguments of `specfx optimize`.
+#[derive(Debug, Args)]
+pub struct OptimizeArgs {
+    /// The budget, e.g. "shape_total <= 1 lsb8", "shape_quant <= 0.5 lsb8", "out <= 1 ulp",
+    /// "correct >= 99%", several joined by commas.
+    #[arg(long)]
+    budget: Budget,
+    /// The base configuration (formats' integer bits, coefficient, cutoff ... are kept).
+    #[arg(long, default_value = "baseline")]
+    config: String,
+    /// Exponents, replacing the configuration's set.
+    #[arg(long)]
+    n: Option<NSet>,
+    /// Cost to minimise: analytic (LUTs, instant) or yosys (iCE40 LUTs, seconds per candidate).
+    #[arg(long, default_value = "analytic")]
+    objective: String,
+    /// Numbers of squarings to try.
+    #[arg(long, default_value = "3,4,5")]
+    k: NSet,
+    /// Also try the minimax variant.
+    #[arg(long)]
+    minimax: bool,
+    /// Fraction bits every searched stage starts from (must meet the budget).
+    #[arg(long, default_value_t = 20)]
+    start_frac: i32,
+    /// Microarchitecture costed.
+    #[arg(long, default_value = "pipelined")]
+    arch: Arch,
+    /// Where to write the configuration found (TOML).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Runs `specfx optimize`. Exit code 1 when no configuration meets the budget.
+pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
+    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let base = dp.config().clone();
+    if let Some(&k) = args.k.values().iter().find(|&&k| !(1..=7).contains(&k)) {
+        bail!("--k: expected numbers of squarings in 1..=7, got {k}");
+    }
+    let yosys = match args.objective.as_str() {
+        "analytic" => false,
+        "yosys" => true,
+        other => bail!("--objective: expected analytic or yosys, got '{other}'"),
+    };
+    let hdl = super::cost::hdl_ref_dir(None);
+    let arch = args.arch;
+    let mut cost = |dp: &Datapath| -> Result<f64, String> {
+        if yosys {
+            super::cost::run_yosys(dp, arch, Target::Ice40, &hdl)
+                .map(|(c, _, _)| c.luts as f64)
+                .map_err(|e| format!("{e:#}"))
+        } else {
+            Ok(analytic_cost(dp, arch, Target::Generic).luts as f64)
+        }
+    };
+    let choices = Choices {
+        k: args.k.values().to_vec(),
+        variants: if args.minimax {
+            vec![Variant::Plain, Variant::Minimax]
+        } else {
+            vec![Variant::Plain]
+        },
+        roundings: vec![Rounding::Trn, Rounding::Rnd],
+    };
+    let mut progress = |line: &str| eprintln!("optimize: {line}");
+    let r = optimize(
+        &base,
+        &args.budget,
+        &choices,
+        args.start_frac,
+        &mut cost,
+        &mut progress,
+    )
+    .map_err(anyhow::Error::msg)?;
+    println!(
+        "optimize: budget '{}', {} exhaustive checks",
+        r.budget, r.n_evaluations
+    );
+    let Some(best) = &r.best else {
+        println!("no configuration in the space meets the budget");
+        if let Some(c) = &r.closest {
+            let dp = Datapath::new(c.config.clone())?;
+            let chk = check(&dp).map_err(anyhow::Error::msg)?;
+            println!(
+                "closest: k = {}, {}: shape_total {:.3e}, shape_quant {:.3e}, out {:.2} ulp, {:.2}% correct ({:.2}x the budget)",
+                c.config.k,
+                c.config.variant.name(),
+                chk.shape_total_max_abs,
+                chk.shape_quant_max_abs,
+                chk.out_max_ulp,
+                100.0 * chk.stages[dp.stage_out()].correctly_rounded,
+                c.excess
+            );
+        }
+        return Ok(Outcome::CheckFailed);
+    };
+    // The proof: the exhaustive check of the answer, against the budget.
+    let mut config = best.config.clone();
+    config.name = "optimized".into();
+    let dp = Datapath::new(config.clone())?;
+    let proof = check(&dp).map_err(anyhow::Error::msg)?;
+    if !r.budget.met_by(&proof) {
+        bail!("the configuration found does not meet the budget on re-check: this is a bug");
+    }
+    let header = format!(
+        "# specfx optimize: cheapest configuration found for the budget '{}'\n# cost {:.0} LUTs ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
+        r.budget,
+        best.cost,
+        args.objective,
+        r.n_evaluations,
+        proof.shape_total_max_abs,
+        proof.shape_quant_max_abs,
+        proof.out_max_ulp,
+        100.0 * proof.stages[dp.stage_out()].correctly_rounded
+    );
+    write_atomic(
+        &args.out,
+        format!("{header}{}", config.to_toml()).as_bytes(),
+    )?;
+    println!(
+        "best: k = {}, {}, t {} b {} squares {} out {}: {:.0} LUTs ({})",
+        config.k,
+        config.variant.name(),
+        config.t.format,
+        config.b.format,
+        config
+            .square
+            .iter()
+            .map(|s| s.format.to_string())
+            .collect::<Vec<_>>()
+            .join("/"),
+        config.out.format,
+        best.cost,
+        args.objective
+    );
+    println!(
+        "proved by an exhaustive check: shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded",
+        proof.shape_total_max_abs,
+        proof.shape_quant_max_abs,
+        proof.out_max_ulp,
+        100.0 * proof.stages[dp.stage_out()].correctly_rounded
+    );
+    println!("why minimal:");
+    for m in &r.minimality {
+        println!("  {m}");
+    }
+    println!("written to {}", args.out.display());
+    Ok(Outcome::Ok)
+}

@@ -1,0 +1,103 @@
+//! `specfx optimize`: its answer meets the budget by an independent check, no stage can lose a
+//! fraction bit, and an impossible budget is reported with the closest configuration.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use specfx::analysis::check::check;
+use specfx::fixed::Format;
+use specfx::pipeline::{Config, Datapath};
+
+fn specfx(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args(args)
+        .output()
+        .expect("the specfx binary runs")
+}
+
+fn temp(name: &str) -> PathBuf {
+    let p = std::env::temp_dir().join(format!("specfx-opt-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_file(&p);
+    p
+}
+
+#[test]
+fn the_answer_passes_check_against_its_budget_and_is_locally_minimal() {
+    let out = temp("best.toml");
+    let o = specfx(&[
+        "optimize",
+        "--budget",
+        "shape_quant <= 0.5 lsb8, out <= 64 ulp",
+        "--n",
+        "64,256",
+        "--k",
+        "3,4",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("exhaustive checks"), "{stdout}");
+
+    // `specfx check` on the written file, and the budget verified here.
+    let c = specfx(&["check", "--config", out.to_str().unwrap(), "--json"]);
+    assert!(c.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+    let quant = v["shape_quant_max_abs"].as_f64().unwrap();
+    let ulp = v["out_max_ulp"].as_f64().unwrap();
+    assert!(quant <= 0.5 / 256.0, "{quant}");
+    assert!(ulp <= 64.0, "{ulp}");
+
+    // One fraction bit less in any squaring stage breaks the budget.
+    let cfg = Config::from_toml(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    for i in 0..cfg.square.len() {
+        let mut narrower = cfg.clone();
+        let f = narrower.square[i].format;
+        narrower.square[i].format =
+            Format::new(f.is_signed(), f.int_bits(), f.frac_bits() - 1).unwrap();
+        let r = check(&Datapath::new(narrower).unwrap()).unwrap();
+        assert!(
+            r.shape_quant_max_abs > 0.5 / 256.0 || r.out_max_ulp > 64.0,
+            "square {} could lose a bit",
+            i + 1
+        );
+    }
+}
+
+#[test]
+fn an_impossible_budget_shows_the_closest() {
+    let out = temp("never.toml");
+    let o = specfx(&[
+        "optimize",
+        "--budget",
+        "shape_total <= 1e-6",
+        "--n",
+        "64",
+        "--k",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("no configuration in the space meets the budget"));
+    assert!(stdout.contains("closest"));
+    assert!(!out.exists());
+}
+
+#[test]
+fn bad_budgets_are_refused() {
+    for budget in [
+        "shape_total < 1",
+        "noise <= 1",
+        "correct <= 0.9",
+        "out <= 1 lsb8",
+    ] {
+        let o = specfx(&["optimize", "--budget", budget, "--out", "/tmp/x.toml"]);
+        assert_eq!(o.status.code(), Some(2), "{budget}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains("budget"),
+            "{budget}"
+        );
+    }
+}
