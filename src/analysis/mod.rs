@@ -5,3 +5,4 @@ pub mod methods;
 pub mod optimize;
 pub mod paper;
 pub mod sweep;
+pub mod tradeoff;

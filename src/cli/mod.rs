@@ -14,6 +14,7 @@ mod reference;
 mod report;
 mod sim;
 mod sweep;
+mod tradeoff;
 pub mod vectors;
 
 use std::process::ExitCode;
@@ -48,6 +49,8 @@ enum Command {
     Sweep(sweep::SweepArgs),
     /// Finds the cheapest configuration that meets an error budget, proved by a check.
     Optimize(optimize::OptimizeArgs),
+    /// Charts speed against accuracy for every method (f64 models and fixed-point datapaths).
+    Tradeoff(tradeoff::TradeoffArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -76,6 +79,7 @@ pub fn main() -> ExitCode {
         Command::Cost(args) => cost::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Optimize(args) => optimize::run(&args),
+        Command::Tradeoff(args) => tradeoff::run(&args),
         Command::Hdl(args) => hdl::run(&args),
     };
     match result {

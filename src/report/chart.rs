@@ -34,6 +34,32 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
+/// A colour for series `i` of `count`, evenly spaced in hue (HSL with s = 0.7, l = 0.45).
+pub fn hue(i: usize, count: usize) -> (u8, u8, u8) {
+    let h = i as f64 / count.max(1) as f64;
+    let (s, l) = (0.7, 0.45);
+    let q = if l < 0.5 {
+        l * (1.0 + s)
+    } else {
+        l + s - l * s
+    };
+    let p = 2.0 * l - q;
+    let channel = |t: f64| {
+        let t = t.rem_euclid(1.0);
+        let v = if t < 1.0 / 6.0 {
+            p + (q - p) * 6.0 * t
+        } else if t < 0.5 {
+            q
+        } else if t < 2.0 / 3.0 {
+            p + (q - p) * (2.0 / 3.0 - t) * 6.0
+        } else {
+            p
+        };
+        (v * 255.0).round() as u8
+    };
+    (channel(h + 1.0 / 3.0), channel(h), channel(h - 1.0 / 3.0))
+}
+
 /// Chart size in pixels (the SVG uses the same user units).
 pub const SIZE: (u32, u32) = (960, 640);
 
@@ -96,7 +122,15 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, chart: &Chart) -> Resu
     macro_rules! body {
         ($ctx:expr) => {{
             let mut ctx = $ctx;
+            let y_fmt = |y: &f64| {
+                if chart.log_y {
+                    format!("{y:.0e}")
+                } else {
+                    format!("{y}")
+                }
+            };
             ctx.configure_mesh()
+                .y_label_formatter(&y_fmt)
                 .x_desc(&chart.x_label)
                 .y_desc(&chart.y_label)
                 .label_style(("sans-serif", 14))
@@ -113,12 +147,23 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, chart: &Chart) -> Resu
                     .collect();
                 if s.line {
                     ctx.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
-                        .map_err(err)?;
+                        .map_err(err)?
+                        .label(s.label.clone())
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+                        });
                 }
-                ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
-                    .map_err(err)?
-                    .label(s.label.clone())
-                    .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+                // Markers, unless a long line would be buried under them.
+                if !s.line || pts.len() <= 60 {
+                    let markers = ctx
+                        .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                        .map_err(err)?;
+                    if !s.line {
+                        markers
+                            .label(s.label.clone())
+                            .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+                    }
+                }
             }
             ctx.configure_series_labels()
                 .label_font(("sans-serif", 14))

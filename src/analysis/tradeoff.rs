@@ -1,0 +1,259 @@
+//! Speed against accuracy: every method of computing the specular lobe, its error against
+//! cos^n, its software speed measured in the same run, and its hardware cost.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::cycle::Arch;
+use crate::hdl::cost::{analytic_cost, Target};
+use crate::pipeline::{Config, Datapath, ProbeColumns};
+use crate::reference::lobe::Cutoff;
+use crate::reference::method::Method;
+use crate::reference::minimax::sup_abs_error;
+use crate::report::chart::{Chart, Series};
+
+/// One method's figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MethodFigures {
+    /// The method's name.
+    pub method: String,
+    /// `f64` (software reference models) or `fixed` (a bit-accurate datapath).
+    pub kind: &'static str,
+    /// max over n and c of |method - cos^n|.
+    pub max_abs_err: f64,
+    /// Mean over n and over the c grid of |method - cos^n|.
+    pub mean_abs_err: f64,
+    /// Software evaluations per second, single thread, measured in this run.
+    pub evals_per_s: f64,
+    /// Multipliers of a hardware implementation (None: needs a divider, exp or log unit).
+    pub multipliers: Option<u32>,
+    /// Analytic LUTs of the pipelined datapath (fixed-point methods only).
+    pub luts: Option<u64>,
+    /// Latency in cycles at initiation interval 1 (pipelined, one register per operation).
+    pub latency: Option<u64>,
+    /// max over c of the error, for each n of the set.
+    pub per_n_max_abs_err: Vec<f64>,
+}
+
+/// The f64 methods compared: powf, repeated-squaring powi, Schlick, exp(-n(1-c)), cs_m with
+/// every cutoff for k = 2..7, and minimax for k = 2..7.
+pub fn f64_methods() -> Vec<(String, Method)> {
+    let mut v = vec![
+        ("powf".to_string(), Method::CosPow),
+        ("schlick".to_string(), Method::Schlick),
+        ("exp_limit".to_string(), Method::ExpLimit),
+    ];
+    for k in 2..=7 {
+        for cutoff in Cutoff::ALL {
+            let m = Method::CsM { k, cutoff };
+            v.push((m.name(), m));
+        }
+        let m = Method::Minimax { k };
+        v.push((m.name(), m));
+    }
+    v
+}
+
+/// The c grid of the mean error and of the speed measurement: 4097 points on [0, 1].
+fn grid() -> Vec<f64> {
+    (0..=4096).map(|i| f64::from(i) / 4096.0).collect()
+}
+
+fn cos_n(c: f64, n: u32) -> f64 {
+    if c <= 0.0 {
+        0.0
+    } else {
+        c.powf(f64::from(n))
+    }
+}
+
+/// Figures of an f64 method over the exponents `ns`.
+pub fn f64_figures(name: &str, method: Method, ns: &[u32]) -> MethodFigures {
+    let cs = grid();
+    let mut sum = 0.0;
+    let mut per_n = Vec::with_capacity(ns.len());
+    for &n in ns {
+        for &c in &cs {
+            sum += (method.eval(c, n) - cos_n(c, n)).abs();
+        }
+        per_n.push(sup_abs_error(n, 0.0, |c| method.eval(c, n)).0);
+    }
+    // Speed: one pass over the grid for every n, timed; "powi" is measured as repeated
+    // squaring on integer n.
+    let start = Instant::now();
+    let mut sink = 0.0;
+    for &n in ns {
+        for &c in &cs {
+            sink += method.eval(std::hint::black_box(c), n);
+        }
+    }
+    std::hint::black_box(sink);
+    let secs = start.elapsed().as_secs_f64().max(1e-9);
+    let (multipliers, latency) = match method {
+        Method::CsM { k, .. } | Method::Minimax { k } => (Some(k + 2), Some(u64::from(k) + 4)),
+        _ => (None, None),
+    };
+    MethodFigures {
+        method: name.to_string(),
+        kind: "f64",
+        max_abs_err: per_n.iter().copied().fold(0.0, f64::max),
+        mean_abs_err: sum / (ns.len() * cs.len()) as f64,
+        evals_per_s: (ns.len() * cs.len()) as f64 / secs,
+        multipliers,
+        luts: None,
+        latency,
+        per_n_max_abs_err: per_n,
+    }
+}
+
+/// Figures of `c.powi(n)` (repeated squaring in f64), which [`Method`] does not name.
+pub fn powi_figures(ns: &[u32]) -> MethodFigures {
+    let cs = grid();
+    let eval = |c: f64, n: u32| c.powi(n as i32);
+    let mut sum = 0.0;
+    let mut per_n = Vec::new();
+    for &n in ns {
+        for &c in &cs {
+            sum += (eval(c, n) - cos_n(c, n)).abs();
+        }
+        per_n.push(sup_abs_error(n, 0.0, |c| eval(c, n)).0);
+    }
+    let start = Instant::now();
+    let mut sink = 0.0;
+    for &n in ns {
+        for &c in &cs {
+            sink += eval(std::hint::black_box(c), n);
+        }
+    }
+    std::hint::black_box(sink);
+    let secs = start.elapsed().as_secs_f64().max(1e-9);
+    MethodFigures {
+        method: "powi".into(),
+        kind: "f64",
+        max_abs_err: per_n.iter().copied().fold(0.0, f64::max),
+        mean_abs_err: sum / (ns.len() * cs.len()) as f64,
+        evals_per_s: (ns.len() * cs.len()) as f64 / secs,
+        multipliers: None,
+        luts: None,
+        latency: None,
+        per_n_max_abs_err: per_n,
+    }
+}
+
+/// Baseline with every squaring (and b) at `frac` fraction bits: the fixed-point points.
+pub fn fixed_config(frac: i32) -> Config {
+    let mut cfg = Config::baseline();
+    cfg.name = format!("fixed_sq{frac}");
+    let fmt = crate::fixed::Format::unsigned(1, frac).expect("u1.F");
+    cfg.b.format = fmt;
+    for s in &mut cfg.square {
+        s.format = fmt;
+    }
+    cfg
+}
+
+/// Figures of a fixed-point datapath: its lobe (before the coefficient) against cos^n on the
+/// input codes of the grid, the batch evaluation speed, and its analytic cost.
+pub fn fixed_figures(dp: &Datapath) -> MethodFigures {
+    let one = dp.one_code();
+    let step = (one / 4096).max(1);
+    let codes: Vec<i64> = (0..=one).step_by(step as usize).collect();
+    let lsb_c = dp.config().c.format.lsb();
+    let last = dp.stage_last_square();
+    let lsb_s = dp.stages()[last].format.lsb();
+    let mut cols = ProbeColumns::default();
+    let mut sum = 0.0;
+    let mut per_n = Vec::new();
+    let all_codes: Vec<i64> = (0..=one).collect();
+    for nc in dp.constants() {
+        dp.eval_batch(nc, &codes, &mut cols);
+        for (i, &k) in codes.iter().enumerate() {
+            sum += (cols.values[last][i] as f64 * lsb_s - cos_n(k as f64 * lsb_c, nc.n)).abs();
+        }
+        // The maximum over every input code of this n.
+        dp.eval_batch(nc, &all_codes, &mut cols);
+        let max = all_codes
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| {
+                (cols.values[last][i] as f64 * lsb_s - cos_n(k as f64 * lsb_c, nc.n)).abs()
+            })
+            .fold(0.0, f64::max);
+        per_n.push(max);
+    }
+    let start = Instant::now();
+    for nc in dp.constants() {
+        dp.eval_batch(nc, std::hint::black_box(&codes), &mut cols);
+    }
+    let secs = start.elapsed().as_secs_f64().max(1e-9);
+    let cost = analytic_cost(dp, Arch::Pipelined, Target::Generic);
+    MethodFigures {
+        method: dp.config().name.clone(),
+        kind: "fixed",
+        max_abs_err: per_n.iter().copied().fold(0.0, f64::max),
+        mean_abs_err: sum / (dp.constants().len() * codes.len()) as f64,
+        evals_per_s: (dp.constants().len() * codes.len()) as f64 / secs,
+        multipliers: Some(dp.config().k + 2),
+        luts: Some(cost.luts),
+        latency: Some(cost.latency),
+        per_n_max_abs_err: per_n,
+    }
+}
+
+/// Chart of accuracy against speed: one point per method.
+pub fn speed_chart(figures: &[MethodFigures]) -> Chart {
+    let shown: Vec<&MethodFigures> = figures
+        .iter()
+        .filter(|f| !f.method.ends_with("_none") && !f.method.ends_with("_paper"))
+        .collect();
+    Chart {
+        title: "Speed against accuracy, n = 16..1024".into(),
+        x_label: "software speed (million evaluations per second, one core)".into(),
+        y_label: "max |method - cos^n| (absolute, log scale)".into(),
+        log_y: true,
+        series: shown
+            .iter()
+            .enumerate()
+            .map(|(i, f)| Series {
+                label: f.method.clone(),
+                points: vec![(f.evals_per_s / 1e6, f.max_abs_err.max(1e-17))],
+                line: false,
+                color: crate::report::chart::hue(i, shown.len()),
+            })
+            .collect(),
+    }
+}
+
+/// Chart of the error against n for a few methods.
+pub fn per_n_chart(figures: &[MethodFigures], ns: &[u32], names: &[&str]) -> Chart {
+    let colors = [
+        (31, 119, 180),
+        (214, 39, 40),
+        (44, 160, 44),
+        (255, 127, 14),
+        (148, 103, 189),
+        (0, 0, 0),
+    ];
+    Chart {
+        title: "Error against n".into(),
+        x_label: "specular exponent n".into(),
+        y_label: "max over c of |method - cos^n| (absolute, log scale)".into(),
+        log_y: true,
+        series: names
+            .iter()
+            .filter_map(|name| figures.iter().find(|f| f.method == *name))
+            .enumerate()
+            .map(|(i, f)| Series {
+                label: f.method.clone(),
+                points: ns
+                    .iter()
+                    .zip(&f.per_n_max_abs_err)
+                    .map(|(&n, &e)| (f64::from(n), e.max(1e-17)))
+                    .collect(),
+                line: true,
+                color: colors[i % colors.len()],
+            })
+            .collect(),
+    }
+}

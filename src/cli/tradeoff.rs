@@ -1,0 +1,132 @@
+//! `specfx tradeoff`: speed against accuracy for every method, with charts.
+
+use std::fs;
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use super::output::{print_json, write_atomic};
+use super::Outcome;
+use specfx::analysis::tradeoff::{
+    f64_figures, f64_methods, fixed_config, fixed_figures, per_n_chart, powi_figures, speed_chart,
+    MethodFigures,
+};
+use specfx::nset::NSet;
+use specfx::pipeline::Datapath;
+use specfx::report::chart::{render_png, render_svg, Chart};
+
+/// Arguments of `specfx tradeoff`.
+#[derive(Debug, Args)]
+pub struct TradeoffArgs {
+    /// Output directory.
+    #[arg(long, default_value = "specfx-tradeoff")]
+    out: PathBuf,
+    /// Exponents.
+    #[arg(long, default_value = "16..=1024")]
+    n: NSet,
+    /// Print the figures as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+fn write_chart(dir: &std::path::Path, stem: &str, chart: &Chart) -> Result<()> {
+    let svg = render_svg(chart).map_err(anyhow::Error::msg)?;
+    write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    let png = render_png(chart).map_err(anyhow::Error::msg)?;
+    write_atomic(&dir.join(format!("{stem}.png")), &png)
+}
+
+/// Computes every method's figures and writes CSV, JSON and charts into `dir`.
+pub fn tradeoff(dir: &std::path::Path, ns: &NSet) -> Result<Vec<MethodFigures>> {
+    fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let ns_v = ns.values();
+    let mut figures = Vec::new();
+    for (name, method) in f64_methods() {
+        eprintln!("tradeoff: {name}");
+        figures.push(f64_figures(&name, method, ns_v));
+    }
+    eprintln!("tradeoff: powi");
+    figures.insert(1, powi_figures(ns_v));
+    for frac in [8, 12, 16] {
+        let mut cfg = fixed_config(frac);
+        cfg.n = ns.clone();
+        let dp = Datapath::new(cfg)?;
+        eprintln!("tradeoff: {}", dp.config().name);
+        figures.push(fixed_figures(&dp));
+    }
+    let mut csv = Vec::new();
+    writeln!(
+        csv,
+        "method,kind,max_abs_err,mean_abs_err,evals_per_s,multipliers,luts,latency"
+    )?;
+    let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
+    for f in &figures {
+        writeln!(
+            csv,
+            "{},{},{:e},{:e},{:e},{},{},{}",
+            f.method,
+            f.kind,
+            f.max_abs_err,
+            f.mean_abs_err,
+            f.evals_per_s,
+            opt(f.multipliers.map(u64::from)),
+            opt(f.luts),
+            opt(f.latency)
+        )?;
+    }
+    write_atomic(&dir.join("tradeoff.csv"), &csv)?;
+    let mut json = serde_json::to_vec_pretty(&figures)?;
+    json.push(b'\n');
+    write_atomic(&dir.join("tradeoff.json"), &json)?;
+    write_chart(dir, "speed_accuracy", &speed_chart(&figures))?;
+    write_chart(
+        dir,
+        "error_vs_n",
+        &per_n_chart(
+            &figures,
+            ns_v,
+            &[
+                "cs16_clamp",
+                "minimax16",
+                "schlick",
+                "exp_limit",
+                "fixed_sq12",
+                "cs128_clamp",
+            ],
+        ),
+    )?;
+    Ok(figures)
+}
+
+/// Runs `specfx tradeoff`.
+pub fn run(args: &TradeoffArgs) -> Result<Outcome> {
+    let figures = tradeoff(&args.out, &args.n)?;
+    if args.json {
+        print_json(&figures)?;
+    } else {
+        let mut out = std::io::stdout().lock();
+        writeln!(
+            out,
+            "{:<16} {:>6} {:>11} {:>11} {:>12} {:>5} {:>6} {:>7}",
+            "method", "kind", "max |err|", "mean |err|", "Meval/s", "mult", "LUTs", "latency"
+        )?;
+        for f in &figures {
+            writeln!(
+                out,
+                "{:<16} {:>6} {:>11.3e} {:>11.3e} {:>12.1} {:>5} {:>6} {:>7}",
+                f.method,
+                f.kind,
+                f.max_abs_err,
+                f.mean_abs_err,
+                f.evals_per_s / 1e6,
+                f.multipliers.map_or("-".into(), |m| m.to_string()),
+                f.luts.map_or("-".into(), |m| m.to_string()),
+                f.latency.map_or("-".into(), |m| m.to_string())
+            )?;
+        }
+        writeln!(out, "written to {}", args.out.display())?;
+    }
+    Ok(Outcome::Ok)
+}

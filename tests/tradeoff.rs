@@ -1,0 +1,71 @@
+//! `specfx tradeoff`: every method listed with its figures, charts written, and errors that
+//! agree with a brute-force oracle.
+
+use std::process::Command;
+
+#[test]
+fn tradeoff_lists_every_method_with_figures_that_hold() {
+    let dir = std::env::temp_dir().join(format!("specfx-tradeoff-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args([
+            "tradeoff",
+            "--n",
+            "64,256",
+            "--json",
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let list = v.as_array().unwrap();
+    let names: Vec<&str> = list.iter().map(|m| m["method"].as_str().unwrap()).collect();
+    for want in [
+        "powf",
+        "powi",
+        "schlick",
+        "exp_limit",
+        "cs4_clamp",
+        "cs16_paper",
+        "cs128_none",
+        "minimax4",
+        "minimax128",
+        "fixed_sq8",
+        "fixed_sq16",
+    ] {
+        assert!(names.contains(&want), "{want} missing from {names:?}");
+    }
+    for m in list {
+        for key in ["max_abs_err", "mean_abs_err", "evals_per_s"] {
+            assert!(m[key].is_number(), "{}: {key}", m["method"]);
+        }
+        assert!(m["evals_per_s"].as_f64().unwrap() > 0.0);
+    }
+    // Brute force: exp(-n(1-c)) against c^n on a fine uniform grid, n = 64 and 256.
+    let mut brute: f64 = 0.0;
+    for n in [64.0f64, 256.0] {
+        for i in 0..=200_000 {
+            let c = f64::from(i) / 200_000.0;
+            brute = brute.max(((-n * (1.0 - c)).exp() - c.powf(n)).abs());
+        }
+    }
+    let exp = list.iter().find(|m| m["method"] == "exp_limit").unwrap();
+    let got = exp["max_abs_err"].as_f64().unwrap();
+    assert!(
+        got >= brute - 1e-12 && got - brute < 1e-6,
+        "{got} vs {brute}"
+    );
+    for file in [
+        "tradeoff.csv",
+        "tradeoff.json",
+        "speed_accuracy.svg",
+        "speed_accuracy.png",
+        "error_vs_n.svg",
+        "error_vs_n.png",
+    ] {
+        assert!(dir.join(file).is_file(), "{file}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
