@@ -14,7 +14,7 @@ mod reference;
 mod report;
 mod sim;
 mod sweep;
-mod tradeoff;
+pub mod tradeoff;
 pub mod vectors;
 
 use std::process::ExitCode;

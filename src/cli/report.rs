@@ -35,6 +35,53 @@ fn emit(
     Ok(path)
 }
 
+/// A self-contained index page linking (and showing) everything the report wrote.
+fn write_index(
+    w: &mut Vec<u8>,
+    files: &[PathBuf],
+    paper: &specfx::analysis::paper::PaperReproduction,
+    checked: &specfx::analysis::check::CheckReport,
+    figures: &[specfx::analysis::tradeoff::MethodFigures],
+) -> std::io::Result<()> {
+    let rel = |p: &PathBuf| {
+        p.components()
+            .skip(1)
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .join("/")
+    };
+    writeln!(w, "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>specfx report</title>")?;
+    writeln!(w, "<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto}}td,th{{padding:2px 8px;text-align:right}}img{{max-width:100%}}</style></head><body>")?;
+    writeln!(w, "<h1>specfx report</h1>")?;
+    let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
+        + usize::from(paper.delta.reproduced_max)
+        + usize::from(paper.delta.reproduced_min);
+    writeln!(w, "<h2>The paper</h2><p>{n_ok} of {} printed claims reproduce to 2 significant digits: <a href=\"paper.txt\">paper.txt</a>, <a href=\"paper.json\">paper.json</a>.</p>", paper.forms.len() + 2)?;
+    writeln!(w, "<h2>The baseline datapath</h2><p>{} evaluations, every input code and n = 16..1024: lobe error against cos^n {:.3e} (quantization {:.3e}, approximation {:.3e}), output max {:.2} ulp, monotonic: {}. <a href=\"check_baseline.txt\">check_baseline.txt</a>, <a href=\"check_baseline.json\">check_baseline.json</a>.</p>",
+        checked.n_evaluations, checked.shape_total_max_abs, checked.shape_quant_max_abs, checked.shape_approx_max_abs, checked.out_max_ulp, if checked.monotonic { "yes" } else { "no" })?;
+    writeln!(w, "<h2>Speed against accuracy</h2><img src=\"tradeoff/speed_accuracy.png\" alt=\"speed against accuracy\"><img src=\"tradeoff/error_vs_n.png\" alt=\"error against n\">")?;
+    writeln!(
+        w,
+        "<table><tr><th>method</th><th>max |err|</th><th>mean |err|</th><th>Meval/s</th></tr>"
+    )?;
+    for f in figures {
+        writeln!(
+            w,
+            "<tr><td>{}</td><td>{:.3e}</td><td>{:.3e}</td><td>{:.1}</td></tr>",
+            f.method,
+            f.max_abs_err,
+            f.mean_abs_err,
+            f.evals_per_s / 1e6
+        )?;
+    }
+    writeln!(w, "</table><h2>Every file</h2><ul>")?;
+    for f in files {
+        let r = rel(f);
+        writeln!(w, "<li><a href=\"{r}\">{r}</a></li>")?;
+    }
+    writeln!(w, "</ul></body></html>")
+}
+
 fn step(msg: &str) {
     eprintln!("specfx report: {msg}");
 }
@@ -142,6 +189,17 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     } else {
         step("yosys not found: skipping the synthesis cost (apt-get install yosys)");
     }
+
+    step("speed against accuracy of every method (the trade-off charts)");
+    let tradeoff_dir = dir.join("tradeoff");
+    let figures = super::tradeoff::tradeoff(&tradeoff_dir, &specfx::nset::NSet::range(16, 1024)?)?;
+    written.push(tradeoff_dir.join("tradeoff.csv"));
+    written.push(tradeoff_dir.join("speed_accuracy.png"));
+    written.push(tradeoff_dir.join("error_vs_n.png"));
+
+    written.push(emit(dir, "index.html", |b| {
+        write_index(b, &written, &paper, &checked, &figures)
+    })?);
 
     let n_claims = paper.forms.len() + 2;
     let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
