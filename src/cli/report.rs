@@ -38,14 +38,16 @@ fn emit(
 /// A self-contained index page linking (and showing) everything the report wrote.
 fn write_index(
     w: &mut Vec<u8>,
+    dir: &Path,
     files: &[PathBuf],
     paper: &specfx::analysis::paper::PaperReproduction,
     checked: &specfx::analysis::check::CheckReport,
     figures: &[specfx::analysis::tradeoff::MethodFigures],
 ) -> std::io::Result<()> {
     let rel = |p: &PathBuf| {
-        p.components()
-            .skip(1)
+        p.strip_prefix(dir)
+            .unwrap_or(p)
+            .components()
             .map(|c| c.as_os_str().to_string_lossy().into_owned())
             .collect::<Vec<_>>()
             .join("/")
@@ -198,7 +200,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     written.push(tradeoff_dir.join("error_vs_n.png"));
 
     written.push(emit(dir, "index.html", |b| {
-        write_index(b, &written, &paper, &checked, &figures)
+        write_index(b, dir, &written, &paper, &checked, &figures)
     })?);
 
     let n_claims = paper.forms.len() + 2;
