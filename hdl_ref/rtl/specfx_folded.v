@@ -96,12 +96,28 @@ module specfx_folded #(
         end
     endfunction
 
+    // Width of the widest exact square sq_{i-1}^2, i = 1..last.
+    function integer square_w(input integer last);
+        integer i;
+        begin
+            square_w = 0;
+            for (i = 1; i <= last; i = i + 1)
+                if (2 * chain_w(i - 1) + ((chain_s(i - 1) != 0) ? 0 : 1) > square_w)
+                    square_w = 2 * chain_w(i - 1) + ((chain_s(i - 1) != 0) ? 0 : 1);
+        end
+    endfunction
+
     localparam integer X_W = operand_w(K);                       // x, signed
     localparam integer SLOPE_XW = SLOPE_W + 1;
     localparam integer COEF_XW = COEF_W + 1;
     localparam integer Y_W0 = (SLOPE_XW > COEF_XW) ? SLOPE_XW : COEF_XW;
     localparam integer Y_W = (X_W > Y_W0) ? X_W : Y_W0;          // second operand, signed
-    localparam integer P_W = X_W + Y_W;                          // exact product, signed
+    // The product bits any step uses: each step's exact product fits in its own low bits.
+    localparam integer PT_W = D_W + SLOPE_W;                               // d * slope
+    localparam integer PO_W = chain_w(K) + COEF_W
+                            + ((chain_s(K) != 0 || COEF_S != 0) ? 0 : 1);  // sq_K * coef
+    localparam integer P_W0 = (PT_W > PO_W) ? PT_W : PO_W;
+    localparam integer P_W = (square_w(K) > P_W0) ? square_w(K) : P_W0;
     localparam integer STEP_W = $clog2(K + 2);
     localparam integer CNT_W = (LAT_MUL > 1) ? $clog2(LAT_MUL) : 1;
     localparam integer STEP_LAST_I = K + 1;
@@ -163,6 +179,8 @@ module specfx_folded #(
     );
 
     // ---- The quantizations of each step, all fed by the shared product. ----
+    // Each takes the low bits that hold its own exact product (the width the matching
+    // pipelined stage module computes).
     // results[s*X_W +: X_W] is step s's result as a signed X_W-bit value (s = 0..K).
     wire [(K+1)*X_W-1:0] results;
 
@@ -170,10 +188,10 @@ module specfx_folded #(
     wire [T_W-1:0] t;
     wire [B_W-1:0] b;
     specfx_quant #(
-        .IN_W(P_W), .IN_F(D_F + SLOPE_F), .IN_S(1),
+        .IN_W(PT_W), .IN_F(D_F + SLOPE_F), .IN_S(1),
         .OUT_W(T_W), .OUT_F(T_F), .OUT_S(T_S), .RND(T_RND), .OVF(T_OVF)
     ) u_q_t (
-        .x(product), .y(t)
+        .x(product[PT_W-1:0]), .y(t)
     );
     specfx_add_b #(
         .T_W(T_W), .T_F(T_F), .T_S(T_S),
@@ -189,12 +207,13 @@ module specfx_folded #(
     generate
         for (s = 1; s <= K; s = s + 1) begin : g_square
             wire [chain_w(s)-1:0] sq;
+            localparam integer PS_W = 2 * chain_w(s - 1) + ((chain_s(s - 1) != 0) ? 0 : 1);
             specfx_quant #(
-                .IN_W(P_W), .IN_F(2 * chain_f(s - 1)), .IN_S(1),
+                .IN_W(PS_W), .IN_F(2 * chain_f(s - 1)), .IN_S(1),
                 .OUT_W(chain_w(s)), .OUT_F(chain_f(s)), .OUT_S(chain_s(s)),
                 .RND(sq_field(SQ_RND, s, 0)), .OVF(sq_field(SQ_OVF, s, 0))
             ) u_q_sq (
-                .x(product), .y(sq)
+                .x(product[PS_W-1:0]), .y(sq)
             );
             specfx_extend #(.IN_W(chain_w(s)), .IN_S(chain_s(s)), .OUT_W(X_W)) u_sq_x (
                 .x(sq), .y(results[s*X_W +: X_W])
@@ -205,10 +224,10 @@ module specfx_folded #(
     // Step K + 1: out = Q_out(sq_K * coef).
     wire [OUT_W-1:0] out_q;
     specfx_quant #(
-        .IN_W(P_W), .IN_F(chain_f(K) + COEF_F), .IN_S(1),
+        .IN_W(PO_W), .IN_F(chain_f(K) + COEF_F), .IN_S(1),
         .OUT_W(OUT_W), .OUT_F(OUT_F), .OUT_S(OUT_S), .RND(OUT_RND), .OVF(OUT_OVF)
     ) u_q_out (
-        .x(product), .y(out_q)
+        .x(product[PO_W-1:0]), .y(out_q)
     );
 
     // The result of the running step (0..K), an AND-OR multiplexer.

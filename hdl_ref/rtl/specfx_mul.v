@@ -1,8 +1,9 @@
-// specfx_mul: the exact product of two raw codes, a * b, as a signed P_W-bit code (no
-// rounding, no overflow). P_W must hold the exact product: A_W + B_W when either operand is
-// signed, A_W + B_W + 1 when both are unsigned. The fraction bits of the product are the sum
-// of the operands' (the caller knows them). Rust: the `i128` products of
-// src/pipeline/datapath.rs `eval`.
+// specfx_mul: the product of two raw codes, a * b, as a signed P_W-bit code (no rounding, no
+// overflow). It is exact when P_W holds the exact product: A_W + B_W bits when either operand
+// is signed, A_W + B_W + 1 when both are unsigned (the stage modules); with a smaller P_W it is
+// the low P_W bits of the product (specfx_folded, where each step reads only the bits of its
+// own exact product). The fraction bits of the product are the sum of the operands' (the
+// caller knows them). Rust: the `i128` products of src/pipeline/datapath.rs `eval`.
 `default_nettype none
 
 module specfx_mul #(
