@@ -2,6 +2,20 @@
 
 use thiserror::Error;
 
+/// Parses TOML text into `T`, turning a parse error into [`Error::Toml`] with its line.
+pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Error> {
+    toml::from_str(text).map_err(|e: toml::de::Error| {
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
+            .unwrap_or(1);
+        Error::Toml {
+            line,
+            message: e.message().replace('\n', " ").trim().to_string(),
+        }
+    })
+}
+
 /// Errors from parsing and validating user input. Arithmetic never fails.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum Error {

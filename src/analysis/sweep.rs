@@ -120,16 +120,7 @@ impl Space {
     /// assert_eq!(s.n_points(), 6);
     /// ```
     pub fn from_toml(text: &str) -> Result<Space, Error> {
-        let file: SpaceFile = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
-                .unwrap_or(1);
-            Error::Toml {
-                line,
-                message: e.message().replace('\n', " ").trim().to_string(),
-            }
-        })?;
+        let file: SpaceFile = crate::error::parse_toml(text)?;
         let mut base = match file.base {
             Some(t) => Config::from_toml(&toml::to_string(&t).expect("a table serialises"))?,
             None => Config::baseline(),

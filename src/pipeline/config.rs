@@ -193,16 +193,7 @@ impl Config {
     /// assert!(err.to_string().starts_with("line 2: unknown field `formt`"));
     /// ```
     pub fn from_toml(text: &str) -> Result<Config, Error> {
-        let file: ConfigFile = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
-                .unwrap_or(1);
-            Error::Toml {
-                line,
-                message: e.message().replace('\n', " ").trim().to_string(),
-            }
-        })?;
+        let file: ConfigFile = crate::error::parse_toml(text)?;
         file.onto(Config::baseline())
     }
 
