@@ -1,15 +1,11 @@
 //! End-to-end tests of the `specfx` binary: outputs, JSON shapes and error handling.
 
+mod common;
+use common::specfx;
+
 use std::f64::consts::PI;
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn specfx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args(args)
-        .output()
-        .expect("the specfx binary runs")
-}
+use std::process::Output;
 
 fn stdout(o: &Output) -> String {
     String::from_utf8(o.stdout.clone()).expect("utf-8 stdout")

@@ -1,16 +1,12 @@
 //! End-to-end tests of `specfx check` and `specfx vectors` through the built binary.
 
+mod common;
+use common::specfx;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use sha2::{Digest, Sha256};
-
-fn specfx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args(args)
-        .output()
-        .expect("the specfx binary runs")
-}
 
 fn stdout(o: &Output) -> String {
     String::from_utf8(o.stdout.clone()).unwrap()

@@ -1,13 +1,9 @@
 //! End-to-end tests of `specfx sim`, `specfx hdl` and `specfx cost` through the built binary.
 
-use std::process::{Command, Output};
+mod common;
+use common::specfx;
 
-fn specfx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args(args)
-        .output()
-        .expect("the specfx binary runs")
-}
+use std::process::Output;
 
 fn json(o: &Output) -> serde_json::Value {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -1,15 +1,11 @@
 //! Co-simulation of the reference Verilog against the golden vectors and the Rust cycle model,
 //! in Icarus Verilog and Verilator (both must be installed: `./scripts/test` installs them).
 
+mod common;
+use common::specfx;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn specfx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args(args)
-        .output()
-        .expect("the specfx binary runs")
-}
 
 fn temp_dir(name: &str) -> PathBuf {
     let p = std::env::temp_dir().join(format!("specfx-cosim-{}-{name}", std::process::id()));

@@ -1,19 +1,14 @@
 //! `specfx optimize`: its answer meets the budget by an independent check, no stage can lose a
 //! fraction bit, and an impossible budget is reported with the closest configuration.
 
+mod common;
+use common::specfx;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
 use specfx::analysis::check::check;
 use specfx::fixed::Format;
 use specfx::pipeline::{Config, Datapath};
-
-fn specfx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args(args)
-        .output()
-        .expect("the specfx binary runs")
-}
 
 fn temp(name: &str) -> PathBuf {
     let p = std::env::temp_dir().join(format!("specfx-opt-{}-{name}", std::process::id()));

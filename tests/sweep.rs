@@ -1,17 +1,13 @@
 //! `specfx sweep`: sharding and merging give the one-shot result, an interrupted sweep resumes
 //! without recomputing, and bad spaces are refused.
 
+mod common;
+use common::specfx;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use specfx::analysis::sweep::{mark_pareto, PointResult};
-
-fn specfx(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args(args)
-        .output()
-        .expect("the specfx binary runs")
-}
 
 fn temp(name: &str) -> PathBuf {
     let p = std::env::temp_dir().join(format!("specfx-sweep-{}-{name}", std::process::id()));
