@@ -1,6 +1,8 @@
 //! Analyses over the reference and the datapath: the paper reproduction, method errors, and
 //! exhaustive accuracy checks.
+pub mod budget;
 pub mod check;
+pub mod gappa;
 pub mod methods;
 pub mod optimize;
 pub mod paper;

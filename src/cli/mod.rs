@@ -3,6 +3,7 @@
 //! Exit codes: 0 success, 1 the command ran but a check it performs failed, 2 bad input or an
 //! I/O error (one line on stderr). A closed stdout (broken pipe) is not an error.
 
+pub mod budget;
 mod check;
 pub mod cost;
 mod datapath;
@@ -47,6 +48,8 @@ enum Command {
     Cost(cost::CostArgs),
     /// Evaluates a design space: every point checked exhaustively and costed; Pareto front.
     Sweep(sweep::SweepArgs),
+    /// Error-budget report: per-stage attribution, headroom, histograms, gappa bounds.
+    Budget(budget::BudgetArgs),
     /// Finds the cheapest configuration that meets an error budget, proved by a check.
     Optimize(optimize::OptimizeArgs),
     /// Charts speed against accuracy for every method (f64 models and fixed-point datapaths).
@@ -78,6 +81,7 @@ pub fn main() -> ExitCode {
         Command::Sim(args) => sim::run(&args),
         Command::Cost(args) => cost::run(&args),
         Command::Sweep(args) => sweep::run(&args),
+        Command::Budget(args) => budget::run(&args),
         Command::Optimize(args) => optimize::run(&args),
         Command::Tradeoff(args) => tradeoff::run(&args),
         Command::Hdl(args) => hdl::run(&args),

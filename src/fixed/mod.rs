@@ -53,5 +53,6 @@ pub use exact::Exact;
 pub use format::Format;
 pub use mode::{Overflow, Rounding};
 pub use quantize::{
-    overflow_i64, quantize, quantize_i64, round_shift_i128, round_shift_i64, Event, Quantized,
+    overflow_i64, quantize, quantize_f64, quantize_i64, round_shift_i128, round_shift_i64, Event,
+    Quantized,
 };

@@ -469,6 +469,40 @@ fn quantize_beyond_i64(
     )
 }
 
+/// Quantizes a finite `f64` into `fmt`, exactly as [`quantize`] would its exact value (every
+/// finite `f64` is a dyadic rational); `None` for NaN and infinities.
+///
+/// This is how a model that keeps some stages in `f64` quantizes one of them.
+///
+/// # Examples
+///
+/// ```
+/// use specfx::fixed::{quantize_f64, Event, Format, Overflow, Rounding};
+///
+/// let fmt: Format = "s2.2".parse().unwrap();
+/// let q = quantize_f64(-1.375, fmt, Rounding::RndConv, Overflow::Wrap).unwrap();
+/// assert_eq!((q.raw, q.event), (-6, Event::None));
+/// assert_eq!(quantize_f64(f64::NAN, fmt, Rounding::Trn, Overflow::Sat), None);
+/// ```
+#[must_use]
+#[inline]
+pub fn quantize_f64(
+    x: f64,
+    fmt: Format,
+    rounding: Rounding,
+    overflow: Overflow,
+) -> Option<Quantized> {
+    let e = Exact::from_f64(x)?;
+    // A finite f64's raw has at most 53 significant bits, so it always fits in i64.
+    Some(quantize_i64(
+        e.raw as i64,
+        e.frac_bits,
+        fmt,
+        rounding,
+        overflow,
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,5 +1,7 @@
 //! Renders results as text tables, CSV and charts into any writer or buffer; never opens files.
+pub mod budget;
 pub mod chart;
 pub mod check;
 pub mod csv;
+pub mod doc;
 pub mod paper;

@@ -1,0 +1,325 @@
+//! Formal bounds with gappa: the script that states a datapath's quantization error for one
+//! exponent, and the reading of gappa's answer. Running gappa is the caller's business.
+//!
+//! For one n, the error |fixed output - f64 model output| is bounded over two regions of the
+//! input code:
+//! - the **upper region** `K..=1.0`, where neither model cuts the base: gappa proves the bound
+//!   of the straight-line program (subtraction, product, sum, k squarings, output product),
+//!   each rounding as the datapath rounds, together with the range of every stage (which must
+//!   fit its format: gappa's rounding operators do not overflow);
+//! - the **lower region** `0..K`, where one of the models cuts the base to zero (the clamp or the
+//!   paper's threshold): both outputs there are non-negative and non-decreasing in c (every
+//!   rounding mode is monotone, squares of non-negative values are monotone, and no stage
+//!   wraps), so the error is at most the larger of the two outputs at code `K - 1`. With the
+//!   paper cutoff both models are exactly 0 below the threshold.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use crate::analysis::budget::mixed_eval;
+use crate::fixed::{Event, Exact, Rounding};
+use crate::pipeline::{Datapath, NConstants, StageSpec};
+use crate::reference::lobe::Cutoff;
+
+/// Gappa's name for a rounding mode's direction.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::gappa::direction;
+/// use specfx::fixed::Rounding;
+/// assert_eq!(direction(Rounding::RndConv), "ne");
+/// assert_eq!(direction(Rounding::Trn), "dn");
+/// ```
+pub fn direction(r: Rounding) -> &'static str {
+    match r {
+        Rounding::Trn => "dn",
+        Rounding::TrnZero => "zr",
+        Rounding::Rnd => "nu",
+        Rounding::RndZero => "nz",
+        Rounding::RndMinInf => "nd",
+        Rounding::RndInf => "na",
+        Rounding::RndConv => "ne",
+        Rounding::RndConvOdd => "no",
+    }
+}
+
+/// A finite f64 written exactly in gappa's dyadic notation (`mbe` = m * 2^e).
+fn dyadic(x: f64) -> String {
+    let e = Exact::from_f64(x).expect("finite constant");
+    if e.raw == 0 {
+        "0".into()
+    } else {
+        format!("{}b{}", e.raw, -e.frac_bits)
+    }
+}
+
+fn raw_value(raw: i64, frac: i32) -> String {
+    format!("{raw}b{}", -frac)
+}
+
+/// One gappa problem: the script for an exponent's upper region, and what is known of the
+/// lower region.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Job {
+    /// The exponent.
+    pub n: u32,
+    /// The first input code of the upper region (`None`: the region is empty).
+    pub upper_from: Option<i64>,
+    /// The gappa script of the upper region (empty when it is empty).
+    pub script: String,
+    /// The bound of the lower region (0 when it is empty).
+    pub lower_bound: f64,
+    /// Stage names and formats' ranges to check gappa's ranges against, in script order.
+    pub ranges: Vec<(String, f64, f64)>,
+}
+
+/// The smallest code from which a monotone predicate holds, over `0..=one`.
+fn first_code(one: i64, holds: impl Fn(i64) -> bool) -> i64 {
+    let (mut lo, mut hi) = (0, one + 1);
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if holds(mid) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    lo
+}
+
+/// Builds the gappa job of one exponent, or says why its bound cannot be proved this way.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::gappa::job;
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let j = job(&dp, dp.constants_for(16).unwrap()).unwrap();
+/// assert_eq!(j.upper_from, Some(0)); // n = m: the base is c, never cut
+/// assert!(j.script.contains("@r_t = fixed<-16,ne>;"));
+/// ```
+pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, String> {
+    let cfg = dp.config();
+    let one = dp.one_code();
+    let c_lo = *dp.input_codes().start();
+    if c_lo < 0 {
+        return Err("signed input formats are not covered".into());
+    }
+    let upper_from = match cfg.cutoff {
+        Cutoff::None => 0,
+        Cutoff::Paper => nc.threshold.unwrap_or(0).max(0),
+        Cutoff::Clamp => {
+            let fixed = first_code(one, |code| !dp.eval(code, nc).cut);
+            let exact = first_code(one, |code| {
+                let c = code as f64 * cfg.c.format.lsb();
+                nc.slope * (c - 1.0) + nc.offset >= 0.0
+            });
+            fixed.max(exact)
+        }
+    };
+    let lower_bound = if upper_from == 0 || cfg.cutoff == Cutoff::Paper {
+        0.0
+    } else {
+        if (0..upper_from).any(|code| dp.eval(code, nc).events.contains(&Event::Wrapped)) {
+            return Err(format!(
+                "n = {}: a stage wraps below code {upper_from}, so the lower region is not monotone",
+                nc.n
+            ));
+        }
+        let below = upper_from - 1;
+        let fixed = dp
+            .config()
+            .out
+            .format
+            .to_f64(dp.eval(below, nc).values[dp.stage_out()]);
+        let reference = mixed_eval(dp, nc, below, 0).1;
+        fixed.max(reference)
+    };
+    if upper_from > one {
+        return Ok(Job {
+            n: nc.n,
+            upper_from: None,
+            script: String::new(),
+            lower_bound,
+            ranges: Vec::new(),
+        });
+    }
+    let mut s = String::new();
+    let mut ranges = Vec::new();
+    let mut round = |name: &str, spec: &StageSpec, s: &mut String| {
+        let _ = writeln!(
+            s,
+            "@r_{name} = fixed<{},{}>;",
+            -spec.format.frac_bits(),
+            direction(spec.rounding)
+        );
+        ranges.push((
+            name.to_string(),
+            spec.format.min_value(),
+            spec.format.max_value(),
+        ));
+    };
+    round("t", &cfg.t, &mut s);
+    round("b", &cfg.b, &mut s);
+    for (i, sq) in cfg.square.iter().enumerate() {
+        round(&format!("s{}", i + 1), sq, &mut s);
+    }
+    round("out", &cfg.out, &mut s);
+    let k = cfg.square.len();
+    let _ = writeln!(s, "SQ = {};", raw_value(nc.slope_raw, nc.slope_frac));
+    let _ = writeln!(s, "SE = {};", dyadic(nc.slope));
+    let _ = writeln!(s, "OQ = {};", raw_value(nc.offset_raw, nc.offset_frac));
+    let _ = writeln!(s, "OE = {};", dyadic(nc.offset));
+    let _ = writeln!(
+        s,
+        "CQ = {};",
+        raw_value(nc.coef_raw, cfg.coef.format.frac_bits())
+    );
+    let _ = writeln!(s, "CE = {};", dyadic(nc.coef));
+    s.push_str("d = c - 1;\nt = r_t(SQ * d);\nb = r_b(t + OQ);\n");
+    let mut prev = "b".to_string();
+    for i in 1..=k {
+        let _ = writeln!(s, "s{i} = r_s{i}({prev} * {prev});");
+        prev = format!("s{i}");
+    }
+    let _ = writeln!(s, "out = r_out({prev} * CQ);");
+    s.push_str("Mt = SE * d;\nMb = Mt + OE;\n");
+    let mut mprev = "Mb".to_string();
+    for i in 1..=k {
+        let _ = writeln!(s, "Ms{i} = {mprev} * {mprev};");
+        mprev = format!("Ms{i}");
+    }
+    let _ = writeln!(s, "Mout = {mprev} * CE;");
+    let fc = cfg.c.format.frac_bits();
+    let mut goal = format!(
+        "{{ @FIX(c, {}) /\\ c in [{}, {}] -> out - Mout in ?",
+        -fc,
+        raw_value(upper_from, fc),
+        raw_value(one, fc)
+    );
+    for (name, _, _) in &ranges {
+        let _ = write!(goal, " /\\ {name} in ?");
+    }
+    goal.push_str(" }\n");
+    s.push_str(&goal);
+    // Hints: each error splits into the rounding of this stage plus the propagated error of
+    // the stage before, which keeps gappa from losing the correlation between the two models.
+    s.push_str("t - Mt -> (t - SQ * d) + (SQ - SE) * d;\n");
+    s.push_str("b - Mb -> (b - (t + OQ)) + (t - Mt) + (OQ - OE);\n");
+    let mut prev = ("b".to_string(), "Mb".to_string());
+    for i in 1..=k {
+        let (p, mp) = &prev;
+        let _ = writeln!(
+            s,
+            "s{i} - Ms{i} -> (s{i} - {p} * {p}) + ({p} - {mp}) * ({p} + {mp});"
+        );
+        prev = (format!("s{i}"), format!("Ms{i}"));
+    }
+    let (p, mp) = &prev;
+    let _ = writeln!(
+        s,
+        "out - Mout -> (out - {p} * CQ) + ({p} - {mp}) * CQ + {mp} * (CQ - CE);"
+    );
+    Ok(Job {
+        n: nc.n,
+        upper_from: Some(upper_from),
+        script: s,
+        lower_bound,
+        ranges,
+    })
+}
+
+/// Parses a number as gappa prints it: an integer, optionally followed by `b` and a binary
+/// exponent (`-483405125002887169b-65`). Returns the nearest f64 widened by one part in 2^50 away
+/// from zero, so a bound never shrinks in the conversion.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::gappa::parse_number;
+/// assert_eq!(parse_number("83b-4"), Some(5.1875));
+/// assert_eq!(parse_number("0"), Some(0.0));
+/// assert!(parse_number("-3b-1").unwrap() <= -1.5);
+/// ```
+pub fn parse_number(text: &str) -> Option<f64> {
+    let (m, e) = match text.split_once('b') {
+        Some((m, e)) => (m, e.parse::<i32>().ok()?),
+        None => (text, 0),
+    };
+    let m: f64 = m.parse().ok()?;
+    let x = m * f64::from(e).exp2();
+    Some(if m.abs() < 9.007_199_254_740_992e15 && e.abs() < 1000 {
+        x
+    } else {
+        x * (1.0 + 2f64.powi(-50))
+    })
+}
+
+/// Reads the intervals gappa proved (`name in [lo, hi]` lines of its `Results:`), by name.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::gappa::parse_results;
+/// let text = "Results:\n  t in [-1, 0]\n  out - Mout in [-3b-20 {-2.86e-06, -2^(-18.4)}, 1b-19 {1.9e-06, 2^(-19)}]\n";
+/// let r = parse_results(text).unwrap();
+/// assert_eq!(r["t"], (-1.0, 0.0));
+/// assert_eq!(r["out - Mout"], (-3.0 / 1048576.0, 1.0 / 524288.0));
+/// ```
+pub fn parse_results(text: &str) -> Result<BTreeMap<String, (f64, f64)>, String> {
+    let mut map = BTreeMap::new();
+    let body = text
+        .split_once("Results:")
+        .map(|(_, b)| b)
+        .ok_or_else(|| format!("gappa printed no results: {}", first_line(text)))?;
+    for line in body.lines() {
+        let Some((name, interval)) = line.trim().split_once(" in [") else {
+            continue;
+        };
+        let interval = interval.trim_end_matches(']');
+        let mut bounds = interval
+            .split(',')
+            .map(|part| part.split('{').next().unwrap_or("").trim())
+            .filter(|p| !p.is_empty() && !p.contains(')'));
+        let lo = bounds.next().and_then(parse_number);
+        let hi = bounds.next().and_then(parse_number);
+        match (lo, hi) {
+            (Some(lo), Some(hi)) => {
+                map.insert(name.trim().to_string(), (lo, hi));
+            }
+            _ => return Err(format!("cannot read gappa's interval '{}'", line.trim())),
+        }
+    }
+    Ok(map)
+}
+
+fn first_line(text: &str) -> &str {
+    text.lines()
+        .find(|l| !l.trim().is_empty())
+        .unwrap_or("")
+        .trim()
+}
+
+/// The bound of one job from gappa's output: max(|proved error| over the upper region, the
+/// lower region's bound), after checking that every stage's proved range fits its format.
+pub fn bound(job: &Job, gappa_output: &str) -> Result<f64, String> {
+    if job.upper_from.is_none() {
+        return Ok(job.lower_bound);
+    }
+    let results = parse_results(gappa_output)?;
+    let (lo, hi) = *results.get("out - Mout").ok_or_else(|| {
+        format!(
+            "gappa did not bound the error: {}",
+            first_line(gappa_output)
+        )
+    })?;
+    for (name, fmin, fmax) in &job.ranges {
+        let (rlo, rhi) = results
+            .get(name.as_str())
+            .ok_or_else(|| format!("gappa did not bound stage {name}"))?;
+        if *rlo < *fmin || *rhi > *fmax {
+            return Err(format!(
+                "stage {name} may leave its format: gappa proves only [{rlo}, {rhi}] against {fmin}..={fmax}"
+            ));
+        }
+    }
+    Ok(lo.abs().max(hi.abs()).max(job.lower_bound))
+}

@@ -1,0 +1,281 @@
+//! `specfx budget`: the error-budget report of a configuration (Markdown, HTML, JSON, charts),
+//! with gappa's formal bounds when gappa is installed.
+
+use std::fs;
+use std::io::{ErrorKind, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use anyhow::{anyhow, Context, Result};
+use clap::Args;
+use rayon::prelude::*;
+
+use super::output::{print_json, write_atomic};
+use super::Outcome;
+use specfx::analysis::budget::{analyse, BudgetReport, FormalBound};
+use specfx::analysis::gappa;
+use specfx::analysis::optimize::Budget;
+use specfx::nset::NSet;
+use specfx::pipeline::Datapath;
+use specfx::report::budget::{charts, document};
+use specfx::report::chart::{render_png, render_svg};
+use specfx::report::doc::{write_html, write_markdown};
+
+/// Arguments of `specfx budget`.
+#[derive(Debug, Args)]
+pub struct BudgetArgs {
+    /// A TOML configuration file, or a built-in name: baseline.
+    #[arg(long, default_value = "baseline")]
+    config: String,
+    /// Exponents, replacing the configuration's set.
+    #[arg(long)]
+    n: Option<NSet>,
+    /// The budget to judge against, e.g. "shape_total <= 1 lsb8, out <= 1 ulp".
+    #[arg(long)]
+    budget: Option<Budget>,
+    /// Output directory.
+    #[arg(long, default_value = "specfx-budget")]
+    out: PathBuf,
+    /// Exponents to prove a bound for with gappa (default: up to 8 spread over the set).
+    #[arg(long)]
+    gappa_n: Option<NSet>,
+    /// Skip gappa even when it is installed.
+    #[arg(long)]
+    no_gappa: bool,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Up to 8 exponents of a set, spread evenly on a log scale, always with its ends.
+fn spread(ns: &[u32]) -> Vec<u32> {
+    if ns.len() <= 8 {
+        return ns.to_vec();
+    }
+    let (lo, hi) = (f64::from(ns[0]), f64::from(ns[ns.len() - 1]));
+    let mut picked: Vec<u32> = (0..8)
+        .map(|j| {
+            let target = lo * (hi / lo).powf(f64::from(j) / 7.0);
+            *ns.iter()
+                .min_by(|a, b| {
+                    (f64::from(**a) - target)
+                        .abs()
+                        .total_cmp(&(f64::from(**b) - target).abs())
+                })
+                .expect("a non-empty set")
+        })
+        .collect();
+    picked.dedup();
+    picked
+}
+
+/// Runs gappa on one script; `Ok(None)` when gappa is not installed.
+fn run_gappa(script: &str) -> Result<Option<String>> {
+    let child = Command::new("gappa")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn();
+    let mut child = match child {
+        Ok(c) => c,
+        Err(e) if e.kind() == ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(anyhow!("cannot run gappa: {e}")),
+    };
+    child
+        .stdin
+        .take()
+        .expect("piped stdin")
+        .write_all(script.as_bytes())
+        .context("cannot write to gappa")?;
+    let out = child.wait_with_output().context("gappa did not finish")?;
+    // gappa prints its results on stderr.
+    let mut text = String::from_utf8_lossy(&out.stderr).into_owned();
+    text.push_str(&String::from_utf8_lossy(&out.stdout));
+    Ok(Some(text))
+}
+
+/// Proves bounds with gappa for the chosen exponents and adds them to the report.
+fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Result<()> {
+    let jobs: Vec<(u32, Result<gappa::Job, String>)> = ns
+        .iter()
+        .filter_map(|&n| dp.constants_for(n).map(|nc| (n, gappa::job(dp, nc))))
+        .collect();
+    let results: Vec<Result<Option<(u32, f64, String)>>> = jobs
+        .par_iter()
+        .map(|(n, job)| {
+            let job = match job {
+                Ok(j) => j,
+                Err(why) => return Ok(Some((*n, f64::NAN, why.clone()))),
+            };
+            let output = if job.upper_from.is_some() {
+                match run_gappa(&job.script)? {
+                    Some(text) => text,
+                    None => return Ok(None),
+                }
+            } else {
+                String::new()
+            };
+            Ok(Some(match gappa::bound(job, &output) {
+                Ok(b) => {
+                    let how = match job.upper_from {
+                        Some(0) => "gappa on every code".to_string(),
+                        Some(k) => format!(
+                            "gappa from code {k}; below it, where a model cuts the base, monotonicity bounds the error by {:.3e}",
+                            job.lower_bound
+                        ),
+                        None => "every code is cut: monotonicity alone".to_string(),
+                    };
+                    (*n, b, how)
+                }
+                Err(why) => (*n, f64::NAN, why),
+            }))
+        })
+        .collect();
+    let out_lsb = report.out_lsb;
+    let mut failures = Vec::new();
+    for r in results {
+        let Some((n, bound, how)) = r? else {
+            report.formal_note = Some(
+                "gappa is not installed (Debian package `gappa`): no formal bound, only the exhaustive figures."
+                    .into(),
+            );
+            report.formal.clear();
+            return Ok(());
+        };
+        if bound.is_nan() {
+            failures.push(format!("n = {n}: {how}"));
+            continue;
+        }
+        let exhaustive = report
+            .per_n
+            .iter()
+            .find(|p| p.n == n)
+            .map_or(f64::NAN, |p| p.out_quant_max_ulp);
+        report.formal.push(FormalBound {
+            n,
+            bound,
+            bound_ulp: bound / out_lsb,
+            exhaustive_ulp: exhaustive,
+            how,
+        });
+    }
+    if !failures.is_empty() {
+        report.formal_note = Some(format!("No bound proved for {}", failures.join("; ")));
+    }
+    Ok(())
+}
+
+/// Analyses a datapath and writes the budget report into `dir`: `budget.md`, `budget.html`,
+/// `budget.json` and the charts (SVG and PNG).
+pub fn budget(
+    dp: &Datapath,
+    budget: Option<&Budget>,
+    gappa_n: Option<&[u32]>,
+    dir: &Path,
+) -> Result<BudgetReport> {
+    fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    eprintln!(
+        "budget: {}: attributing the error of every input to each source",
+        dp.config().name
+    );
+    let mut report =
+        analyse(dp, budget).map_err(|e| anyhow!("config {}: {e}", dp.config().name))?;
+    match gappa_n {
+        Some(ns) => {
+            eprintln!("budget: proving bounds with gappa for n = {ns:?}");
+            add_formal_bounds(dp, &mut report, ns)?;
+        }
+        None => report.formal_note = Some("gappa was not run (--no-gappa).".into()),
+    }
+    let mut svgs = Vec::new();
+    for (stem, chart) in charts(&report) {
+        let svg = render_svg(&chart).map_err(anyhow::Error::msg)?;
+        let png = render_png(&chart).map_err(anyhow::Error::msg)?;
+        write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+        write_atomic(&dir.join(format!("{stem}.png")), &png)?;
+        svgs.push((stem, svg));
+    }
+    let doc = document(&report);
+    let mut md = Vec::new();
+    write_markdown(&mut md, &doc)?;
+    let mut html = Vec::new();
+    write_html(
+        &mut html,
+        &format!("Error budget: {}", report.config),
+        &doc,
+        |stem| {
+            svgs.iter()
+                .find(|(s, _)| s == stem)
+                .map(|(_, svg)| svg.clone())
+        },
+    )?;
+    let mut json = serde_json::to_vec_pretty(&report)?;
+    json.push(b'\n');
+    write_atomic(&dir.join("budget.md"), &md)?;
+    write_atomic(&dir.join("budget.html"), &html)?;
+    write_atomic(&dir.join("budget.json"), &json)?;
+    Ok(report)
+}
+
+/// Runs `specfx budget`. Exit code 1 when the budget is not met.
+pub fn run(args: &BudgetArgs) -> Result<Outcome> {
+    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let ns: Vec<u32> = dp.constants().iter().map(|c| c.n).collect();
+    let gappa_n = match &args.gappa_n {
+        _ if args.no_gappa => None,
+        Some(set) => {
+            let wanted = set.values().to_vec();
+            if let Some(n) = wanted.iter().find(|n| !ns.contains(n)) {
+                return Err(anyhow!(
+                    "--gappa-n: n = {n} is not in the configuration's set {}",
+                    dp.config().n
+                ));
+            }
+            Some(wanted)
+        }
+        None => Some(spread(&ns)),
+    };
+    let report = budget(&dp, args.budget.as_ref(), gappa_n.as_deref(), &args.out)?;
+    if args.json {
+        print_json(&report)?;
+    } else {
+        let mut out = std::io::stdout().lock();
+        let a = &report.attribution;
+        writeln!(
+            out,
+            "{:<10} {:>8} {:>12} {:>10} {:>12}",
+            "source", "format", "max |err|", "max LSB", "RMS"
+        )?;
+        for s in a.sources.iter().chain(std::iter::once(&a.total)) {
+            writeln!(
+                out,
+                "{:<10} {:>8} {:>12.3e} {:>10.3} {:>12.3e}",
+                s.source, s.format, s.max_abs, s.max_ulp, s.rms
+            )?;
+        }
+        writeln!(
+            out,
+            "sum of parts {:.3e}, residual {:.3e}",
+            a.sum_of_max_abs, a.residual_max_abs
+        )?;
+        for f in &report.formal {
+            writeln!(
+                out,
+                "gappa n = {}: |err| <= {:.3} LSB (exhaustive {:.3})",
+                f.n, f.bound_ulp, f.exhaustive_ulp
+            )?;
+        }
+        if let Some(note) = &report.formal_note {
+            writeln!(out, "{note}")?;
+        }
+        if let (Some(text), Some(pass)) = (&report.budget, report.pass) {
+            writeln!(out, "budget {text}: {}", if pass { "PASS" } else { "FAIL" })?;
+        }
+        writeln!(out, "written to {}", args.out.display())?;
+    }
+    Ok(if report.pass == Some(false) {
+        Outcome::CheckFailed
+    } else {
+        Outcome::Ok
+    })
+}

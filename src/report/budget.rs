@@ -1,0 +1,407 @@
+//! The error-budget report: its document (tables, prose) and its charts, from a
+//! [`BudgetReport`].
+
+use crate::analysis::budget::{BudgetReport, Histogram};
+use crate::analysis::check::Input;
+use crate::report::chart::{hue, Chart, Series};
+use crate::report::doc::Block;
+
+fn e(x: f64) -> String {
+    format!("{x:.3e}")
+}
+
+fn ulp(x: f64) -> String {
+    format!("{x:.3}")
+}
+
+fn at(i: &Input) -> String {
+    format!("n = {}, c = {:.6} (code {})", i.n, i.c, i.c_raw)
+}
+
+fn histogram_series(h: &Histogram, label: &str, color: (u8, u8, u8)) -> Series {
+    Series {
+        label: label.into(),
+        points: h
+            .counts
+            .iter()
+            .enumerate()
+            .filter(|&(_, &c)| c > 0)
+            .map(|(i, &c)| (h.lo + (i as f64 + 0.5) * h.bin_width, c as f64))
+            .collect(),
+        line: false,
+        color,
+    }
+}
+
+/// The report's charts, each with the file stem it is written under.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::budget::analyse;
+/// use specfx::pipeline::{Config, Datapath};
+/// use specfx::report::budget::charts;
+/// let mut cfg = Config::baseline();
+/// cfg.n = "32".parse().unwrap();
+/// let r = analyse(&Datapath::new(cfg).unwrap(), None).unwrap();
+/// let stems: Vec<String> = charts(&r).into_iter().map(|(s, _)| s).collect();
+/// assert_eq!(stems, ["histogram_out", "histogram_shape", "error_vs_c", "error_vs_n"]);
+/// ```
+pub fn charts(r: &BudgetReport) -> Vec<(String, Chart)> {
+    let h_out = Chart {
+        title: format!("{}: output error against the f64 model", r.config),
+        x_label: "fixed output - f64 output (output LSBs)".into(),
+        y_label: "evaluations (count)".into(),
+        log_y: true,
+        series: vec![histogram_series(
+            &r.histogram_out,
+            &format!("bins of {} LSB", r.histogram_out.bin_width),
+            hue(0, 3),
+        )],
+    };
+    let h_shape = Chart {
+        title: format!("{}: lobe error against cos^n", r.config),
+        x_label: "fixed lobe - cos^n (units of 2^-8)".into(),
+        y_label: "evaluations (count)".into(),
+        log_y: true,
+        series: vec![histogram_series(
+            &r.histogram_shape,
+            &format!("bins of {} x 2^-8", r.histogram_shape.bin_width),
+            hue(1, 3),
+        )],
+    };
+    let mid = |lo: f64, hi: f64| 0.5 * (lo + hi);
+    let vs_c = Chart {
+        title: format!(
+            "{}: largest error per interval of c, over every n",
+            r.config
+        ),
+        x_label: "c = cos(theta) (interval midpoint)".into(),
+        y_label: "max error (output LSBs; lobe in 2^-8)".into(),
+        log_y: false,
+        series: vec![
+            Series {
+                label: "output vs f64 model (output LSBs)".into(),
+                points: r
+                    .per_c
+                    .iter()
+                    .map(|p| (mid(p.c_lo, p.c_hi), p.out_quant_max_ulp))
+                    .collect(),
+                line: true,
+                color: hue(0, 3),
+            },
+            Series {
+                label: "lobe vs cos^n (2^-8)".into(),
+                points: r
+                    .per_c
+                    .iter()
+                    .map(|p| (mid(p.c_lo, p.c_hi), p.shape_total_max_abs * 256.0))
+                    .collect(),
+                line: true,
+                color: hue(1, 3),
+            },
+        ],
+    };
+    let per_n = |label: &str, i: usize, f: &dyn Fn(&crate::analysis::budget::PerN) -> f64| Series {
+        label: label.into(),
+        points: r.per_n.iter().map(|p| (f64::from(p.n), f(p))).collect(),
+        line: true,
+        color: hue(i, 4),
+    };
+    let vs_n = Chart {
+        title: format!("{}: largest error per exponent", r.config),
+        x_label: "exponent n".into(),
+        y_label: "max |error| (absolute)".into(),
+        log_y: true,
+        series: vec![
+            per_n("lobe vs cos^n (total)", 0, &|p| p.shape_total_max_abs),
+            per_n("lobe: approximation", 1, &|p| p.shape_approx_max_abs),
+            per_n("lobe: quantization", 2, &|p| p.shape_quant_max_abs),
+            per_n("output: quantization", 3, &|p| p.out_quant_max_abs),
+        ],
+    };
+    vec![
+        ("histogram_out".into(), h_out),
+        ("histogram_shape".into(), h_shape),
+        ("error_vs_c".into(), vs_c),
+        ("error_vs_n".into(), vs_n),
+    ]
+}
+
+fn s(x: &str) -> String {
+    x.to_string()
+}
+
+/// The report as a document; figures refer to the stems of [`charts`].
+pub fn document(r: &BudgetReport) -> Vec<Block> {
+    let c = &r.check;
+    let mut doc = vec![
+        Block::Heading(1, format!("Error budget: {}", r.config)),
+        Block::Paragraph(format!(
+            "{} evaluations: {} input codes up to 1.0 for each of {} exponents (n = {}). Output LSB = {}.",
+            c.n_evaluations, c.n_input_codes, c.n_exponents, c.n_set, e(r.out_lsb)
+        )),
+    ];
+    match (&r.budget, r.pass) {
+        (Some(text), Some(pass)) => {
+            doc.push(Block::Heading(2, "Verdict".into()));
+            doc.push(Block::Paragraph(format!(
+                "Budget `{text}`: **{}**.",
+                if pass { "PASS" } else { "FAIL" }
+            )));
+            doc.push(Block::Table {
+                header: vec![s("metric"), s("limit"), s("measured"), s("verdict")],
+                rows: r
+                    .bounds
+                    .iter()
+                    .map(|b| {
+                        vec![
+                            serde_json::to_value(b.metric)
+                                .ok()
+                                .and_then(|v| v.as_str().map(str::to_string))
+                                .unwrap_or_default(),
+                            format!("{:.6e}", b.limit),
+                            format!("{:.6e}", b.value),
+                            s(if b.pass { "pass" } else { "FAIL" }),
+                        ]
+                    })
+                    .collect(),
+            });
+        }
+        _ => doc.push(Block::Paragraph(
+            "No budget given (`--budget`, e.g. `shape_total <= 1 lsb8, out <= 1 ulp`): figures only."
+                .into(),
+        )),
+    }
+
+    let a = &r.attribution;
+    doc.push(Block::Heading(
+        2,
+        "Where the output error comes from".into(),
+    ));
+    doc.push(Block::Paragraph(
+        "Each row quantizes one source as the datapath does and keeps every other exact (f64); the error is that model's output minus the f64 model's output. The last row is the datapath itself, every source quantized."
+            .into(),
+    ));
+    let mut rows: Vec<Vec<String>> = a
+        .sources
+        .iter()
+        .chain(std::iter::once(&a.total))
+        .map(|st| {
+            let share = if a.sum_of_max_abs > 0.0 {
+                format!("{:.1}%", 100.0 * st.max_abs / a.sum_of_max_abs)
+            } else {
+                s("-")
+            };
+            vec![
+                if st.source == "all" {
+                    s("all (measured)")
+                } else {
+                    st.source.clone()
+                },
+                st.format.clone(),
+                st.rounding.clone(),
+                e(st.max_abs),
+                ulp(st.max_ulp),
+                share,
+                e(st.mean),
+                e(st.rms),
+                at(&st.worst),
+            ]
+        })
+        .collect();
+    if let Some(last) = rows.last_mut() {
+        last[5] = s("");
+    }
+    doc.push(Block::Table {
+        header: vec![
+            s("source"),
+            s("format"),
+            s("rounding"),
+            s("max |err|"),
+            s("max (LSB)"),
+            s("share of sum"),
+            s("mean (bias)"),
+            s("RMS"),
+            s("worst input"),
+        ],
+        rows,
+    });
+    doc.push(Block::Paragraph(format!(
+        "Sum of the sources' max |err|: {} against the measured max {} (first order, the measured max cannot exceed the sum by more than the residual). Root sum of squares of the sources' RMS: {} against the measured RMS {}. Residual, the largest |total - sum of the parts| at one input: {} at {}.",
+        e(a.sum_of_max_abs),
+        e(a.total.max_abs),
+        e(a.rss_of_rms),
+        e(a.total.rms),
+        e(a.residual_max_abs),
+        at(&a.residual_worst)
+    )));
+
+    doc.push(Block::Paragraph(
+        "One source at a time counts twice an error that a later stage would absorb (a stage that rounds a value already on its grid adds nothing in the datapath, but rounds the exact value in its own row). The incremental view quantizes the sources cumulatively in pipeline order: each row is what that source adds on top of the ones before it, and the rows add up to the measured error exactly, input by input."
+            .into(),
+    ));
+    doc.push(Block::Table {
+        header: vec![
+            s("source"),
+            s("adds max |err|"),
+            s("max (LSB)"),
+            s("mean (bias)"),
+            s("RMS"),
+            s("worst input"),
+        ],
+        rows: a
+            .incremental
+            .iter()
+            .map(|st| {
+                vec![
+                    st.source.clone(),
+                    e(st.max_abs),
+                    ulp(st.max_ulp),
+                    e(st.mean),
+                    e(st.rms),
+                    at(&st.worst),
+                ]
+            })
+            .collect(),
+    });
+
+    let sp = &r.split;
+    doc.push(Block::Heading(2, "Approximation and quantization".into()));
+    doc.push(Block::Table {
+        header: vec![s("error"), s("max |err|"), s("worst input")],
+        rows: vec![
+            vec![
+                s("output: approximation (f64 model - coef cos^n)"),
+                e(sp.approx_max_abs),
+                at(&sp.approx_worst),
+            ],
+            vec![
+                s("output: quantization (fixed - f64 model)"),
+                e(sp.quant_max_abs),
+                at(&sp.quant_worst),
+            ],
+            vec![
+                s("output: total (fixed - coef cos^n)"),
+                e(sp.total_max_abs),
+                at(&sp.total_worst),
+            ],
+            vec![
+                s("lobe: approximation (f64 lobe - cos^n)"),
+                e(c.shape_approx_max_abs),
+                at(&c.shape_approx_worst),
+            ],
+            vec![
+                s("lobe: quantization (fixed lobe - f64 lobe)"),
+                e(c.shape_quant_max_abs),
+                at(&c.shape_quant_worst),
+            ],
+            vec![
+                s("lobe: total (fixed lobe - cos^n)"),
+                e(c.shape_total_max_abs),
+                at(&c.shape_total_worst),
+            ],
+        ],
+    });
+
+    doc.push(Block::Heading(2, "Headroom and overflow".into()));
+    doc.push(Block::Paragraph(
+        "The range each stage's values took against its format's range. Spare integer bits could be removed without changing any result; a stage that saturates or wraps has none."
+            .into(),
+    ));
+    doc.push(Block::Table {
+        header: vec![
+            s("stage"),
+            s("format"),
+            s("seen min"),
+            s("seen max"),
+            s("format range"),
+            s("int bits"),
+            s("needed"),
+            s("spare"),
+            s("wrapped"),
+            s("saturated"),
+            s("zeroed"),
+        ],
+        rows: r
+            .headroom
+            .iter()
+            .map(|h| {
+                vec![
+                    h.stage.clone(),
+                    h.format.clone(),
+                    format!("{}", h.seen_min),
+                    format!("{}", h.seen_max),
+                    format!("{} ..= {}", h.format_min, h.format_max),
+                    h.int_bits.to_string(),
+                    h.int_bits_needed.to_string(),
+                    h.spare_int_bits.to_string(),
+                    h.wrapped.to_string(),
+                    h.saturated.to_string(),
+                    h.zeroed.to_string(),
+                ]
+            })
+            .collect(),
+    });
+
+    doc.push(Block::Heading(2, "Formal bound (gappa)".into()));
+    if r.formal.is_empty() {
+        doc.push(Block::Paragraph(
+            r.formal_note
+                .clone()
+                .unwrap_or_else(|| "Not computed.".into()),
+        ));
+    } else {
+        doc.push(Block::Paragraph(
+            "A bound on |fixed output - f64 model output| proved by gappa for every input of each exponent below, beside the exhaustive maximum (which it must not be below)."
+                .into(),
+        ));
+        doc.push(Block::Table {
+            header: vec![
+                s("n"),
+                s("proved bound"),
+                s("proved (LSB)"),
+                s("exhaustive (LSB)"),
+                s("how"),
+            ],
+            rows: r
+                .formal
+                .iter()
+                .map(|f| {
+                    vec![
+                        f.n.to_string(),
+                        e(f.bound),
+                        ulp(f.bound_ulp),
+                        ulp(f.exhaustive_ulp),
+                        f.how.clone(),
+                    ]
+                })
+                .collect(),
+        });
+        if let Some(note) = &r.formal_note {
+            doc.push(Block::Paragraph(note.clone()));
+        }
+    }
+
+    doc.push(Block::Heading(2, "Distributions".into()));
+    for (stem, chart) in charts(r) {
+        doc.push(Block::Figure {
+            stem,
+            caption: chart.title,
+        });
+    }
+    let h = &r.histogram_out;
+    if h.below + h.above > 0 {
+        doc.push(Block::Paragraph(format!(
+            "{} output errors fall outside the histogram's range of ±{} LSB.",
+            h.below + h.above,
+            -h.lo
+        )));
+    }
+    if !c.notes.is_empty() {
+        doc.push(Block::Heading(2, "Notes".into()));
+        for note in &c.notes {
+            doc.push(Block::Paragraph(note.clone()));
+        }
+    }
+    doc
+}

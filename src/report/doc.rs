@@ -1,0 +1,175 @@
+//! A small document model (headings, paragraphs, tables, figures) rendered to Markdown or to
+//! one self-contained HTML page, so a report is written once and read either way.
+
+use std::io::{self, Write};
+
+/// One block of a document.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Block {
+    /// A heading of level 1..=3.
+    Heading(u8, String),
+    /// A paragraph of plain text (`code` spans in backquotes are kept as code).
+    Paragraph(String),
+    /// A table: a header row and body rows of the same length.
+    Table {
+        /// Column titles.
+        header: Vec<String>,
+        /// Body rows.
+        rows: Vec<Vec<String>>,
+    },
+    /// A figure: a chart written beside the document as `<stem>.svg` and `<stem>.png`.
+    Figure {
+        /// The file stem.
+        stem: String,
+        /// The caption.
+        caption: String,
+    },
+}
+
+fn md_cell(s: &str) -> String {
+    s.replace('|', "\\|")
+}
+
+/// Renders a document as GitHub-flavoured Markdown; figures link their SVG file.
+///
+/// # Examples
+/// ```
+/// use specfx::report::doc::{write_markdown, Block};
+/// let doc = [
+///     Block::Heading(1, "Budget".into()),
+///     Block::Table { header: vec!["stage".into(), "|err|".into()], rows: vec![vec!["t".into(), "1e-5".into()]] },
+/// ];
+/// let mut out = Vec::new();
+/// write_markdown(&mut out, &doc).unwrap();
+/// let text = String::from_utf8(out).unwrap();
+/// assert!(text.starts_with("# Budget\n"));
+/// assert!(text.contains("| stage | \\|err\\| |\n| --- | --- |\n| t | 1e-5 |\n"));
+/// ```
+pub fn write_markdown(w: &mut impl Write, doc: &[Block]) -> io::Result<()> {
+    for (i, block) in doc.iter().enumerate() {
+        if i > 0 {
+            writeln!(w)?;
+        }
+        match block {
+            Block::Heading(level, text) => {
+                writeln!(w, "{} {text}", "#".repeat(usize::from(*level)))?;
+            }
+            Block::Paragraph(text) => writeln!(w, "{text}")?,
+            Block::Table { header, rows } => {
+                let line = |cells: &[String]| {
+                    let cells: Vec<String> = cells.iter().map(|c| md_cell(c)).collect();
+                    format!("| {} |", cells.join(" | "))
+                };
+                writeln!(w, "{}", line(header))?;
+                writeln!(w, "|{}", " --- |".repeat(header.len()))?;
+                for row in rows {
+                    writeln!(w, "{}", line(row))?;
+                }
+            }
+            Block::Figure { stem, caption } => {
+                writeln!(w, "![{caption}]({stem}.svg)")?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Escapes text for HTML.
+pub fn html_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for ch in s.chars() {
+        match ch {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            _ => out.push(ch),
+        }
+    }
+    out
+}
+
+/// Escapes text and turns `code` spans into `<code>` elements.
+fn html_text(s: &str) -> String {
+    let mut out = String::new();
+    for (i, part) in s.split('`').enumerate() {
+        if i % 2 == 1 {
+            out.push_str("<code>");
+            out.push_str(&html_escape(part));
+            out.push_str("</code>");
+        } else {
+            out.push_str(&html_escape(part));
+        }
+    }
+    out
+}
+
+const STYLE: &str = "body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}\
+table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}\
+th{background:#eee}td:first-child,th:first-child{text-align:left}figure{margin:1em 0}\
+figcaption{font-size:90%;color:#555}svg{max-width:100%;height:auto}code{background:#f3f3f3;padding:0 3px}";
+
+/// Renders a document as one self-contained HTML page: every figure's SVG is inlined, found
+/// by its stem through `svg_of`.
+///
+/// # Examples
+/// ```
+/// use specfx::report::doc::{write_html, Block};
+/// let doc = [Block::Paragraph("a <= b".into()), Block::Figure { stem: "h".into(), caption: "H".into() }];
+/// let mut out = Vec::new();
+/// write_html(&mut out, "T", &doc, |stem| (stem == "h").then(|| "<svg></svg>".to_string())).unwrap();
+/// let text = String::from_utf8(out).unwrap();
+/// assert!(text.contains("<p>a &lt;= b</p>"));
+/// assert!(text.contains("<svg></svg>"));
+/// ```
+pub fn write_html(
+    w: &mut impl Write,
+    title: &str,
+    doc: &[Block],
+    svg_of: impl Fn(&str) -> Option<String>,
+) -> io::Result<()> {
+    writeln!(w, "<!DOCTYPE html>")?;
+    writeln!(
+        w,
+        "<html><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head><body>",
+        html_escape(title)
+    )?;
+    for block in doc {
+        match block {
+            Block::Heading(level, text) => {
+                writeln!(w, "<h{level}>{}</h{level}>", html_text(text))?;
+            }
+            Block::Paragraph(text) => writeln!(w, "<p>{}</p>", html_text(text))?,
+            Block::Table { header, rows } => {
+                writeln!(w, "<table>")?;
+                let cells: String = header
+                    .iter()
+                    .map(|c| format!("<th>{}</th>", html_text(c)))
+                    .collect();
+                writeln!(w, "<tr>{cells}</tr>")?;
+                for row in rows {
+                    let cells: String = row
+                        .iter()
+                        .map(|c| format!("<td>{}</td>", html_text(c)))
+                        .collect();
+                    writeln!(w, "<tr>{cells}</tr>")?;
+                }
+                writeln!(w, "</table>")?;
+            }
+            Block::Figure { stem, caption } => {
+                writeln!(w, "<figure>")?;
+                match svg_of(stem) {
+                    // The SVG's own XML is inlined as is; it starts at its <svg> element.
+                    Some(svg) => w.write_all(svg.trim_end().as_bytes())?,
+                    None => write!(w, "<p>(figure {} missing)</p>", html_escape(stem))?,
+                }
+                writeln!(
+                    w,
+                    "\n<figcaption>{}</figcaption></figure>",
+                    html_text(caption)
+                )?;
+            }
+        }
+    }
+    writeln!(w, "</body></html>")
+}
