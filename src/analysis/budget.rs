@@ -37,8 +37,8 @@ pub enum Source {
 }
 
 impl Source {
-    /// The bit of this source in a quantization mask.
-    fn bit(self) -> u32 {
+    /// The bit of this source in a quantization mask of [`mixed_eval`].
+    pub fn mask(self) -> u32 {
         match self {
             Source::Constants => 1,
             Source::T => 1 << 1,
@@ -112,7 +112,7 @@ fn quantize_spec(x: f64, spec: &StageSpec) -> f64 {
 /// ```
 pub fn mixed_eval(dp: &Datapath, nc: &NConstants, c_raw: i64, mask: u32) -> (f64, f64) {
     let cfg = dp.config();
-    let on = |s: Source| mask & s.bit() != 0;
+    let on = |s: Source| mask & s.mask() != 0;
     let code = c_raw.min(dp.one_code());
     let c = code as f64 * cfg.c.format.lsb();
     let d = c - 1.0;
@@ -584,7 +584,7 @@ fn analyse_one_n(
     let cumulative: Vec<u32> = srcs
         .iter()
         .scan(0, |m, s| {
-            *m |= s.bit();
+            *m |= s.mask();
             Some(*m)
         })
         .collect();
@@ -621,7 +621,7 @@ fn analyse_one_n(
                 acc.total.add(e_total, at);
                 let mut sum = 0.0;
                 for (src, m) in srcs.iter().zip(&mut acc.sources) {
-                    let e = mixed_eval(dp, nc, code, src.bit()).1 - ref_out;
+                    let e = mixed_eval(dp, nc, code, src.mask()).1 - ref_out;
                     m.add(e, at);
                     sum += e;
                 }

@@ -70,7 +70,23 @@ pub enum Outcome {
 
 /// Parses the arguments, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help and version go to stdout with exit code 0, as clap prints them; no command at
+        // all shows the whole help.
+        Err(e)
+            if !e.use_stderr()
+                || e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+        {
+            e.exit()
+        }
+        Err(e) => {
+            // One line: clap's first, without its "For more information" footer.
+            let text = e.to_string();
+            eprintln!("specfx: {}", text.lines().next().unwrap_or("bad arguments"));
+            return ExitCode::from(2);
+        }
+    };
     let result = match cli.command {
         Command::Report(args) => report::run(&args),
         Command::Paper(args) => paper::run(&args),
