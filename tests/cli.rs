@@ -139,7 +139,15 @@ fn report_writes_its_files_and_a_summary() {
     let dir = temp_dir("report");
     let o = specfx(&["report", "--out", dir.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    for name in ["paper.txt", "paper.json", "methods.csv", "coefficients.csv"] {
+    for name in [
+        "paper.txt",
+        "paper.json",
+        "methods.csv",
+        "coefficients.csv",
+        "budget_baseline/budget.html",
+        "budget_baseline/budget.json",
+        "index.html",
+    ] {
         let p = dir.join(name);
         assert!(p.is_file(), "{name} missing");
         assert!(std::fs::metadata(&p).unwrap().len() > 0, "{name} empty");
@@ -147,6 +155,8 @@ fn report_writes_its_files_and_a_summary() {
     let out = stdout(&o);
     assert!(out.contains("printed claims reproduce"));
     assert!(out.contains("cs16_clamp"));
+    let index = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    assert!(index.contains("href=\"budget_baseline/budget.html\""));
     let methods = std::fs::read_to_string(dir.join("methods.csv")).unwrap();
     assert_eq!(methods.lines().count(), 1 + 1009);
     // No temporary file is left behind.

@@ -48,7 +48,7 @@ pub struct BudgetArgs {
 }
 
 /// Up to 8 exponents of a set, spread evenly on a log scale, always with its ends.
-fn spread(ns: &[u32]) -> Vec<u32> {
+pub fn spread(ns: &[u32]) -> Vec<u32> {
     if ns.len() <= 8 {
         return ns.to_vec();
     }

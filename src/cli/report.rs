@@ -42,6 +42,7 @@ fn write_index(
     files: &[PathBuf],
     paper: &specfx::analysis::paper::PaperReproduction,
     checked: &specfx::analysis::check::CheckReport,
+    budget: &specfx::analysis::budget::BudgetReport,
     figures: &[specfx::analysis::tradeoff::MethodFigures],
 ) -> std::io::Result<()> {
     let rel = |p: &PathBuf| {
@@ -61,6 +62,20 @@ fn write_index(
     writeln!(w, "<h2>The paper</h2><p>{n_ok} of {} printed claims reproduce to 2 significant digits: <a href=\"paper.txt\">paper.txt</a>, <a href=\"paper.json\">paper.json</a>.</p>", paper.forms.len() + 2)?;
     writeln!(w, "<h2>The baseline datapath</h2><p>{} evaluations, every input code and n = 16..1024: lobe error against cos^n {:.3e} (quantization {:.3e}, approximation {:.3e}), output max {:.2} ulp, monotonic: {}. <a href=\"check_baseline.txt\">check_baseline.txt</a>, <a href=\"check_baseline.json\">check_baseline.json</a>.</p>",
         checked.n_evaluations, checked.shape_total_max_abs, checked.shape_quant_max_abs, checked.shape_approx_max_abs, checked.out_max_ulp, if checked.monotonic { "yes" } else { "no" })?;
+    let a = &budget.attribution;
+    let top = a
+        .incremental
+        .iter()
+        .max_by(|x, y| x.max_abs.total_cmp(&y.max_abs))
+        .map_or(String::new(), |s| s.source.clone());
+    let formal = budget
+        .formal
+        .iter()
+        .map(|f| f.bound_ulp / f.exhaustive_ulp.max(1e-300))
+        .fold(0.0, f64::max);
+    writeln!(w, "<h2>Error budget of the baseline</h2><p>Output quantization error {:.3e} ({:.0} output LSBs); the largest part comes from stage <code>{top}</code>. {} <a href=\"budget_baseline/budget.html\">budget_baseline/budget.html</a> (also .md, .json).</p><img src=\"budget_baseline/error_vs_n.png\" alt=\"error per exponent\">",
+        a.total.max_abs, a.total.max_ulp,
+        if budget.formal.is_empty() { budget.formal_note.clone().unwrap_or_default() } else { format!("gappa proves bounds for {} exponents, at most {formal:.2} times the exhaustive maximum.", budget.formal.len()) })?;
     writeln!(w, "<h2>Speed against accuracy</h2><img src=\"tradeoff/speed_accuracy.png\" alt=\"speed against accuracy\"><img src=\"tradeoff/error_vs_n.png\" alt=\"error against n\">")?;
     writeln!(
         w,
@@ -192,6 +207,14 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         step("yosys not found: skipping the synthesis cost (apt-get install yosys)");
     }
 
+    step("error budget of baseline (attribution per stage, gappa bounds if installed)");
+    let budget_dir = dir.join("budget_baseline");
+    let ns: Vec<u32> = dp.constants().iter().map(|c| c.n).collect();
+    let budget = super::budget::budget(&dp, None, Some(&super::budget::spread(&ns)), &budget_dir)?;
+    written.push(budget_dir.join("budget.html"));
+    written.push(budget_dir.join("budget.md"));
+    written.push(budget_dir.join("budget.json"));
+
     step("speed against accuracy of every method (the trade-off charts)");
     let tradeoff_dir = dir.join("tradeoff");
     let figures = super::tradeoff::tradeoff(&tradeoff_dir, &specfx::nset::NSet::range(16, 1024)?)?;
@@ -200,7 +223,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     written.push(tradeoff_dir.join("error_vs_n.png"));
 
     written.push(emit(dir, "index.html", |b| {
-        write_index(b, dir, &written, &paper, &checked, &figures)
+        write_index(b, dir, &written, &paper, &checked, &budget, &figures)
     })?);
 
     let n_claims = paper.forms.len() + 2;
@@ -252,6 +275,13 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         out,
         "  golden vectors: {n_vectors} in {}",
         vectors_dir.display()
+    )?;
+    writeln!(
+        out,
+        "  error budget: output quantization error {:.3e} ({:.0} LSB), {} gappa bounds (details: budget_baseline/budget.html)",
+        budget.attribution.total.max_abs,
+        budget.attribution.total.max_ulp,
+        budget.formal.len()
     )?;
     for s in &sims {
         writeln!(
