@@ -7,13 +7,24 @@ use common::specfx;
 use std::path::PathBuf;
 
 use specfx::analysis::check::check;
-use specfx::fixed::Format;
-use specfx::pipeline::{Config, Datapath};
+use specfx::cycle::Arch;
+use specfx::fixed::{Format, Overflow, Rounding};
+use specfx::hdl::cost::{analytic_cost, Target};
+use specfx::pipeline::{Config, Datapath, StageSpec};
 
 fn temp(name: &str) -> PathBuf {
     let p = std::env::temp_dir().join(format!("specfx-opt-{}-{name}", std::process::id()));
     let _ = std::fs::remove_file(&p);
     p
+}
+
+fn spec_of(c: &mut Config, stage: usize) -> &mut StageSpec {
+    match stage {
+        0 => &mut c.t,
+        1 => &mut c.b,
+        2 => &mut c.out,
+        i => &mut c.square[i - 3],
+    }
 }
 
 #[test]
@@ -42,6 +53,42 @@ fn the_answer_passes_check_against_its_budget_and_is_locally_minimal() {
     let ulp = v["out_max_ulp"].as_f64().unwrap();
     assert!(quant <= 0.5 / 256.0, "{quant}");
     assert!(ulp <= 64.0, "{ulp}");
+
+    // No single change of one stage's rounding or overflow mode is both within the budget
+    // and cheaper (the local search's claim), checked here stage by stage.
+    let cfg = Config::from_toml(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let lut = |c: &Config| {
+        analytic_cost(
+            &Datapath::new(c.clone()).unwrap(),
+            Arch::Pipelined,
+            Target::Generic,
+        )
+        .luts
+    };
+    let meets = |c: &Config| {
+        let r = check(&Datapath::new(c.clone()).unwrap()).unwrap();
+        r.shape_quant_max_abs <= 0.5 / 256.0 && r.out_max_ulp <= 64.0
+    };
+    let base_luts = lut(&cfg);
+    let n_stages = 3 + cfg.square.len();
+    for stage in 0..n_stages {
+        for r in Rounding::ALL {
+            let mut trial = cfg.clone();
+            spec_of(&mut trial, stage).rounding = r;
+            assert!(
+                lut(&trial) >= base_luts || !meets(&trial),
+                "stage {stage}: {r} is better"
+            );
+        }
+        for o in Overflow::ALL {
+            let mut trial = cfg.clone();
+            spec_of(&mut trial, stage).overflow = o;
+            assert!(
+                lut(&trial) >= base_luts || !meets(&trial),
+                "stage {stage}: {o} is better"
+            );
+        }
+    }
 
     // One fraction bit less in any squaring stage breaks the budget.
     let cfg = Config::from_toml(&std::fs::read_to_string(&out).unwrap()).unwrap();
@@ -95,4 +142,38 @@ fn bad_budgets_are_refused() {
             "{budget}"
         );
     }
+}
+
+#[test]
+fn truncation_and_wrap_drop_their_logic_from_the_analytic_cost() {
+    // Baseline's quantizers: t s2.16 (18 bits), b u1.16 (17), four squares u1.16 (17 each),
+    // out u8.16 (24): 127 output bits, each with a rounding increment and a saturation.
+    let base = Config::baseline();
+    let luts = |c: &Config| {
+        analytic_cost(
+            &Datapath::new(c.clone()).unwrap(),
+            Arch::Pipelined,
+            Target::Generic,
+        )
+        .luts
+    };
+    let mut trn = base.clone();
+    let mut wrap = base.clone();
+    for c in [&mut trn, &mut wrap] {
+        let specs = [&mut c.t, &mut c.b, &mut c.out]
+            .into_iter()
+            .chain(c.square.iter_mut())
+            .collect::<Vec<_>>();
+        for s in specs {
+            s.rounding = Rounding::Trn;
+        }
+    }
+    for s in [&mut wrap.t, &mut wrap.b, &mut wrap.out]
+        .into_iter()
+        .chain(wrap.square.iter_mut())
+    {
+        s.overflow = Overflow::Wrap;
+    }
+    assert_eq!(luts(&base) - luts(&trn), 127);
+    assert_eq!(luts(&trn) - luts(&wrap), 127);
 }

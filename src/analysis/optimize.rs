@@ -5,9 +5,12 @@
 //! `start_frac` fraction bits; the output format is kept, it is the design's interface), then
 //! per-stage bisection of the fraction bits (each stage in turn, the others fixed,
 //! repeated until nothing shrinks), from each combination of the discrete choices (k, the
-//! variant, the rounding of every stage); keep the cheapest feasible result. Every candidate is
-//! checked exhaustively, and the answer is shown locally minimal: taking one fraction bit from
-//! any searched stage breaks the budget.
+//! variant, the rounding of every stage); keep the cheapest feasible result. Then a local
+//! search from it: each stage's rounding and overflow mode changed alone (the output's too),
+//! the rounding also with one fraction bit less, accepting any feasible cheaper move, until no
+//! move improves. Every candidate is checked exhaustively, and the answer is shown locally
+//! minimal: taking one fraction bit from any searched stage breaks the budget, and no single
+//! mode change is feasible and cheaper.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -17,7 +20,8 @@ use serde::Serialize;
 
 use crate::analysis::check::{check, CheckReport};
 use crate::error::Error;
-use crate::fixed::{Format, Rounding};
+use crate::fixed::{Format, Overflow, Rounding};
+use crate::pipeline::StageSpec;
 use crate::pipeline::{Config, Datapath, Variant};
 
 /// A quantity a budget can bound.
@@ -175,6 +179,24 @@ fn stage_names(k: u32) -> Vec<String> {
     let mut v = vec!["t".to_string(), "b".to_string()];
     v.extend((1..=k).map(|i| format!("sq{i}")));
     v
+}
+
+/// The spec of a searched stage (or `out`) by name.
+fn spec_mut<'a>(cfg: &'a mut Config, stage: &str) -> Result<&'a mut StageSpec, String> {
+    Ok(match stage {
+        "t" => &mut cfg.t,
+        "b" => &mut cfg.b,
+        "out" => &mut cfg.out,
+        s => {
+            let i: usize = s
+                .get(2..)
+                .and_then(|x| x.parse().ok())
+                .ok_or_else(|| format!("bad stage {s}"))?;
+            cfg.square
+                .get_mut(i.wrapping_sub(1))
+                .ok_or_else(|| format!("bad stage {s}"))?
+        }
+    })
 }
 
 fn set_frac(cfg: &mut Config, stage: &str, frac: i32) -> Result<(), String> {
@@ -344,6 +366,57 @@ pub fn optimize(
             }
         }
     }
+    // Local search over each stage's rounding and overflow modes (the output's too: its
+    // format is the interface, its modes are not), alone or with one fraction bit less, until
+    // no single move is both feasible and cheaper.
+    let mut n_moves = 0u64;
+    if let Some(mut current) = best.take() {
+        let mut stages = stage_names(current.config.k);
+        stages.push("out".into());
+        loop {
+            let mut improved = false;
+            for s in &stages {
+                let spec = *spec_mut(&mut current.config.clone(), s)?;
+                let mut trials = Vec::new();
+                for r in Rounding::ALL.into_iter().filter(|&r| r != spec.rounding) {
+                    let mut trial = current.config.clone();
+                    spec_mut(&mut trial, s)?.rounding = r;
+                    if s != "out" {
+                        let mut fewer = trial.clone();
+                        if set_frac(&mut fewer, s, spec.format.frac_bits() - 1).is_ok() {
+                            trials.push(fewer);
+                        }
+                    }
+                    trials.push(trial);
+                }
+                for o in Overflow::ALL.into_iter().filter(|&o| o != spec.overflow) {
+                    let mut trial = current.config.clone();
+                    spec_mut(&mut trial, s)?.overflow = o;
+                    trials.push(trial);
+                }
+                for trial in trials {
+                    n_moves += 1;
+                    if let Some(c) = evaluate(&trial, &mut n_eval)? {
+                        if c.feasible && c.cost < current.cost {
+                            let now = *spec_mut(&mut c.config.clone(), s)?;
+                            progress(&format!(
+                                "  local search: {s} {} {} {}: {:.0} LUTs",
+                                now.format, now.rounding, now.overflow, c.cost
+                            ));
+                            current = c;
+                            improved = true;
+                            // The other trials of this stage were built from the old point.
+                            break;
+                        }
+                    }
+                }
+            }
+            if !improved {
+                break;
+            }
+        }
+        best = Some(current);
+    }
     let mut minimality = Vec::new();
     if let Some(b) = &best {
         minimality.push(format!(
@@ -352,6 +425,9 @@ pub fn optimize(
             choices.k,
             choices.variants.iter().map(|v| v.name()).collect::<Vec<_>>(),
             choices.roundings.iter().map(|r| r.name()).collect::<Vec<_>>()
+        ));
+        minimality.push(format!(
+            "then a local search over every stage's rounding and overflow modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried, none of the final ones both feasible and cheaper"
         ));
         for s in stage_names(b.config.k) {
             let mut trial = b.config.clone();

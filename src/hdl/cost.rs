@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::cycle::Arch;
+use crate::fixed::{Overflow, Rounding};
 use crate::golden::constant_formats;
 use crate::pipeline::Datapath;
 use crate::reference::lobe::Cutoff;
@@ -83,8 +84,9 @@ pub struct AnalyticCost {
 
 /// The analytic cost of a datapath on a target.
 ///
-/// The LUT estimate is deliberately simple (one LUT per adder bit, two per quantizer output
-/// bit, one per partial-product bit when no DSP takes the product); `specfx cost` prints it
+/// The LUT estimate is deliberately simple (one LUT per adder bit, one per quantizer output
+/// bit for rounding unless it is TRN and one for overflow unless it is WRAP, one per
+/// partial-product bit when no DSP takes the product); `specfx cost` prints it
 /// beside yosys's count with their ratio, so sweeps can use it and calibrate it.
 ///
 /// # Examples
@@ -121,17 +123,29 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
         a_bits: w(prev),
         b_bits: w(cfg.coef.format),
     });
-    let quantizer_bits: u64 = [cfg.t.format, cfg.b.format, cfg.out.format]
+    // A quantizer's rounding is an increment across its output (none for TRN, which only
+    // drops bits); its overflow handling a compare-and-select per output bit (none for WRAP,
+    // which only drops bits).
+    let specs: Vec<&crate::pipeline::StageSpec> = [&cfg.t, &cfg.b, &cfg.out]
+        .into_iter()
+        .chain(cfg.square.iter())
+        .collect();
+    let rounding_bits: u64 = specs
         .iter()
-        .chain(cfg.square.iter().map(|s| &s.format))
-        .map(|f| u64::from(f.width()))
+        .filter(|s| s.rounding != Rounding::Trn)
+        .map(|s| u64::from(s.format.width()))
+        .sum();
+    let overflow_bits: u64 = specs
+        .iter()
+        .filter(|s| s.overflow != Overflow::Wrap)
+        .map(|s| u64::from(s.format.width()))
         .sum();
     let sum_bits = u64::from(
         cfg.t.format.int_bits().max(offset.int_bits()) as u32
             + cfg.t.format.frac_bits().max(offset.frac_bits()) as u32
             + 1,
     );
-    let adder_bits = u64::from(w(cfg.c.format)) + 1 + sum_bits + quantizer_bits;
+    let adder_bits = u64::from(w(cfg.c.format)) + 1 + sum_bits + rounding_bits;
     let carried = u64::from(w(offset) + w(cfg.coef.format))
         + if cfg.cutoff == Cutoff::Paper {
             2 * u64::from(w(cfg.c.format))
@@ -194,7 +208,7 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
             .sum(),
         None => 0,
     };
-    let luts = adder_bits + quantizer_bits + if dsps == 0 { multiplier_bits } else { 0 };
+    let luts = adder_bits + overflow_bits + if dsps == 0 { multiplier_bits } else { 0 };
     AnalyticCost {
         arch,
         multipliers,
