@@ -107,4 +107,11 @@ fn cost_runs_yosys_and_the_analytic_model() {
     ]));
     assert!(v["yosys"].is_null());
     assert_eq!(v["analytic"]["multipliers"].as_array().unwrap().len(), 1);
+    // The fast generic mapping: gates and a transistor estimate, through abc -fast.
+    let v = json(&specfx(&["cost", "--target", "generic-fast", "--json"]));
+    assert!(v["yosys_script"]
+        .as_str()
+        .unwrap()
+        .contains("abc -fast -g cmos2"));
+    assert!(v["yosys"]["transistors"].as_u64().unwrap() > 1000);
 }

@@ -17,6 +17,9 @@ use crate::reference::lobe::Cutoff;
 pub enum Target {
     /// Generic gates (`synth`, then `abc -g cmos2`), with a CMOS transistor estimate.
     Generic,
+    /// Generic gates mapped by `abc -fast -g cmos2`: minutes become seconds on wide or folded
+    /// datapaths, for about 15% more cells.
+    GenericFast,
     /// Lattice iCE40 (`synth_ice40 -dsp`): LUT4, carry cells, SB_MAC16 DSPs.
     Ice40,
     /// Xilinx 7-series (`synth_xilinx -family xc7`): LUT1..6, CARRY4, DSP48E1.
@@ -25,12 +28,18 @@ pub enum Target {
 
 impl Target {
     /// Every target.
-    pub const ALL: [Target; 3] = [Target::Generic, Target::Ice40, Target::Xilinx];
+    pub const ALL: [Target; 4] = [
+        Target::Generic,
+        Target::GenericFast,
+        Target::Ice40,
+        Target::Xilinx,
+    ];
 
     /// The name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Target::Generic => "generic",
+            Target::GenericFast => "generic-fast",
             Target::Ice40 => "ice40",
             Target::Xilinx => "xilinx",
         }
@@ -39,14 +48,18 @@ impl Target {
     /// Width of one DSP block's operands (a x b), if the target has DSP blocks.
     pub fn dsp_operands(self) -> Option<(u32, u32)> {
         match self {
-            Target::Generic => None,
+            Target::Generic | Target::GenericFast => None,
             Target::Ice40 => Some((16, 16)),
             Target::Xilinx => Some((18, 25)),
         }
     }
 }
 
-crate::names::named_enum!(Target, "synthesis target", "generic, ice40 or xilinx");
+crate::names::named_enum!(
+    Target,
+    "synthesis target",
+    "generic, generic-fast, ice40 or xilinx"
+);
 
 /// One multiplier of a datapath: its name and operand widths.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
@@ -230,6 +243,10 @@ pub fn yosys_script(target: Target, files: &[String], include_dir: &str) -> Stri
     match target {
         Target::Generic => {
             s.push_str("synth -top specfx_dut -flatten\nabc -g cmos2\n");
+            s.push_str("tee -q -o stat_cmos.txt stat -tech cmos\n");
+        }
+        Target::GenericFast => {
+            s.push_str("synth -top specfx_dut -flatten\nabc -fast -g cmos2\n");
             s.push_str("tee -q -o stat_cmos.txt stat -tech cmos\n");
         }
         Target::Ice40 => s.push_str("synth_ice40 -top specfx_dut -dsp\n"),
