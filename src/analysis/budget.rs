@@ -710,7 +710,8 @@ fn source_spec(dp: &Datapath, src: Source) -> (Format, String) {
 /// use specfx::pipeline::{Config, Datapath};
 /// let mut cfg = Config::baseline();
 /// cfg.n = "64".parse().unwrap();
-/// let r = analyse(&Datapath::new(cfg).unwrap(), Some(&"out <= 1 ulp".parse().unwrap())).unwrap();
+/// let budget = "shape_quant <= 0.5 lsb8".parse().unwrap();
+/// let r = analyse(&Datapath::new(cfg).unwrap(), Some(&budget)).unwrap();
 /// assert_eq!(r.pass, Some(true));
 /// assert_eq!(r.attribution.sources.len(), 8);
 /// assert!(r.attribution.total.max_abs <= r.attribution.sum_of_max_abs + r.attribution.residual_max_abs);

@@ -96,7 +96,7 @@ fn first_code(one: i64, holds: impl Fn(i64) -> bool) -> i64 {
 /// let dp = Datapath::new(Config::baseline()).unwrap();
 /// let j = job(&dp, dp.constants_for(16).unwrap()).unwrap();
 /// assert_eq!(j.upper_from, Some(0)); // n = m: the base is c, never cut
-/// assert!(j.script.contains("@r_t = fixed<-16,ne>;"));
+/// assert!(j.script.contains("@r_t = fixed<-16,nu>;")); // RND: to nearest, ties up
 /// ```
 pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, String> {
     let cfg = dp.config();
