@@ -122,8 +122,7 @@ pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, String> {
     } else {
         if (0..upper_from).any(|code| dp.eval(code, nc).events.contains(&Event::Wrapped)) {
             return Err(format!(
-                "n = {}: a stage wraps below code {upper_from}, so the lower region is not monotone",
-                nc.n
+                "a stage wraps below code {upper_from}, so the lower region is not monotone"
             ));
         }
         let below = upper_from - 1;
