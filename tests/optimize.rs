@@ -177,3 +177,23 @@ fn truncation_and_wrap_drop_their_logic_from_the_analytic_cost() {
     assert_eq!(luts(&base) - luts(&trn), 127);
     assert_eq!(luts(&trn) - luts(&wrap), 127);
 }
+
+#[test]
+fn defaults_budget_and_output_file() {
+    // No --budget, no --out: the default budget `shape_quant <= 0.5 lsb8` and
+    // ./specfx-optimized.toml in the working directory.
+    let dir = temp("defaults-dir");
+    std::fs::create_dir_all(&dir).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args(["optimize", "--n", "64", "--k", "4"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("shape_quant <= 0.5 lsb8"), "{stdout}");
+    let written = std::fs::read_to_string(dir.join("specfx-optimized.toml")).unwrap();
+    let cfg = Config::from_toml(&written).unwrap();
+    let r = check(&Datapath::new(cfg).unwrap()).unwrap();
+    assert!(r.shape_quant_max_abs <= 0.5 / 256.0);
+}

@@ -188,3 +188,17 @@ fn pareto_front_by_hand() {
     let front: Vec<u64> = pts.iter().filter(|p| p.pareto).map(|p| p.index).collect();
     assert_eq!(front, [0, 1, 4]);
 }
+
+#[test]
+fn without_a_space_the_built_in_space_is_swept() {
+    // Shard 0 of 27 of the built-in 54-point space: points 0 and 27, k = 3 and k = 4 at 10
+    // fraction bits with truncation (the space's last axis varies fastest).
+    let out = temp("builtin");
+    let o = specfx(&["sweep", "--out", out.to_str().unwrap(), "--shard", "0/27"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    let space = std::fs::read_to_string(out.join("space.json")).unwrap();
+    assert!(space.contains("\"n_points\": 54"), "{space}");
+}

@@ -108,7 +108,29 @@ fn expand(key: &str, v: &toml::Value) -> Result<Vec<toml::Value>, Error> {
     }
 }
 
+/// The built-in design space `specfx sweep` evaluates without `--space`: around `baseline`,
+/// the number of squarings and the squaring stages' fraction bits and rounding (54 points).
+pub const DEFAULT_SPACE: &str = r#"# specfx's built-in design space: baseline with k, and the squarings' width and rounding.
+n = "16..=1024"
+
+[vary]
+k = [3, 4, 5]
+"square.frac" = "10..=18"
+"square.rounding" = ["TRN", "RND"]
+"#;
+
 impl Space {
+    /// The built-in space ([`DEFAULT_SPACE`]).
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::analysis::sweep::Space;
+    /// assert_eq!(Space::builtin().n_points(), 3 * 9 * 2);
+    /// ```
+    pub fn builtin() -> Space {
+        Space::from_toml(DEFAULT_SPACE).expect("the built-in space is valid")
+    }
+
     /// Reads a space file. `base` is a table of configuration keys over `baseline` (as in a
     /// configuration file), `n` replaces the exponents, and `[vary]` gives each axis its values
     /// (an array, or a range string like `"10..=16"`).

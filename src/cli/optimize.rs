@@ -20,7 +20,7 @@ use specfx::pipeline::{Datapath, Variant};
 pub struct OptimizeArgs {
     /// The budget, e.g. "shape_total <= 1 lsb8", "shape_quant <= 0.5 lsb8", "out <= 1 ulp",
     /// "correct >= 99%", several joined by commas.
-    #[arg(long)]
+    #[arg(long, default_value = "shape_quant <= 0.5 lsb8")]
     budget: Budget,
     /// The base configuration (formats' integer bits, coefficient, cutoff ... are kept).
     #[arg(long, default_value = "baseline")]
@@ -44,7 +44,7 @@ pub struct OptimizeArgs {
     #[arg(long, default_value = "pipelined")]
     arch: Arch,
     /// Where to write the configuration found (TOML).
-    #[arg(long)]
+    #[arg(long, default_value = "specfx-optimized.toml")]
     out: PathBuf,
 }
 

@@ -20,7 +20,8 @@ use specfx::analysis::sweep::{evaluate, mark_pareto, parse_shard, write_csv, Poi
 pub struct SweepArgs {
     #[command(subcommand)]
     command: Option<SweepCommand>,
-    /// The design space (TOML: `base`, `n`, `[vary]`; see docs/sweep.md).
+    /// The design space (TOML: `base`, `n`, `[vary]`; see docs/sweep.md). Without it, the
+    /// built-in space: baseline with k = 3..5, squarings of 10..=18 fraction bits, TRN or RND.
     #[arg(long)]
     space: Option<PathBuf>,
     /// Output directory; an unfinished sweep there is resumed.
@@ -62,13 +63,14 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
     if let Some(SweepCommand::Merge { out, shards }) = &args.command {
         return merge(out, shards);
     }
-    let Some(space_path) = &args.space else {
-        bail!("--space: a design space file is required (or use `specfx sweep merge`)");
+    let space = match &args.space {
+        None => Space::builtin(),
+        Some(space_path) => {
+            let text = fs::read_to_string(space_path)
+                .with_context(|| format!("cannot read {}", space_path.display()))?;
+            Space::from_toml(&text).with_context(|| format!("space {}", space_path.display()))?
+        }
     };
-    let text = fs::read_to_string(space_path)
-        .with_context(|| format!("cannot read {}", space_path.display()))?;
-    let space =
-        Space::from_toml(&text).with_context(|| format!("space {}", space_path.display()))?;
     let (shard_index, shard_count) = args.shard.unwrap_or((0, 1));
     let info = SweepInfo {
         specfx_version: env!("CARGO_PKG_VERSION").to_string(),
