@@ -35,6 +35,36 @@ impl NSet {
         format!("{lo}..={hi}").parse()
     }
 
+    /// The set of the given exponents, written as compactly as ranges allow.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::nset::NSet;
+    /// let s = NSet::from_values(&[7, 1, 2, 3, 5]).unwrap();
+    /// assert_eq!(s.to_string(), "1..=3,5,7");
+    /// assert_eq!(s.values(), &[1, 2, 3, 5, 7]);
+    /// ```
+    pub fn from_values(values: &[u32]) -> Result<NSet, Error> {
+        let mut v = values.to_vec();
+        v.sort_unstable();
+        v.dedup();
+        let mut parts = Vec::new();
+        let mut i = 0;
+        while i < v.len() {
+            let mut j = i;
+            while j + 1 < v.len() && v[j + 1] == v[j] + 1 {
+                j += 1;
+            }
+            parts.push(if j == i {
+                v[i].to_string()
+            } else {
+                format!("{}..={}", v[i], v[j])
+            });
+            i = j + 1;
+        }
+        parts.join(",").parse()
+    }
+
     /// The exponents, ascending.
     pub fn values(&self) -> &[u32] {
         &self.values

@@ -6,5 +6,6 @@ pub mod gappa;
 pub mod methods;
 pub mod optimize;
 pub mod paper;
+pub mod stability;
 pub mod sweep;
 pub mod tradeoff;

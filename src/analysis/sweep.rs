@@ -455,6 +455,7 @@ pub fn chart(points: &[PointResult]) -> crate::report::chart::Chart {
         title: "Sweep: lobe error against cos^n versus cost".into(),
         x_label: "analytic cost (LUTs, every product in logic)".into(),
         y_label: "max |fixed lobe - cos^n| (absolute, log scale)".into(),
+        log_x: false,
         log_y: true,
         series: vec![
             Series {

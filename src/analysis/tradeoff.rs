@@ -211,6 +211,7 @@ pub fn speed_chart(figures: &[MethodFigures]) -> Chart {
         title: "Speed against accuracy, n = 16..1024".into(),
         x_label: "software speed (million evaluations per second, one core)".into(),
         y_label: "max |method - cos^n| (absolute, log scale)".into(),
+        log_x: false,
         log_y: true,
         series: shown
             .iter()
@@ -239,6 +240,7 @@ pub fn per_n_chart(figures: &[MethodFigures], ns: &[u32], names: &[&str]) -> Cha
         title: "Error against n".into(),
         x_label: "specular exponent n".into(),
         y_label: "max over c of |method - cos^n| (absolute, log scale)".into(),
+        log_x: false,
         log_y: true,
         series: names
             .iter()

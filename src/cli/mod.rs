@@ -14,6 +14,7 @@ mod paper;
 mod reference;
 mod report;
 mod sim;
+pub mod stability;
 mod sweep;
 pub mod tradeoff;
 pub mod vectors;
@@ -52,6 +53,8 @@ enum Command {
     Budget(budget::BudgetArgs),
     /// Finds the cheapest configuration that meets an error budget, proved by a check.
     Optimize(optimize::OptimizeArgs),
+    /// Maps where every method and datapath fails over n and theta: heat maps and regions.
+    Stability(stability::StabilityArgs),
     /// Charts speed against accuracy for every method (f64 models and fixed-point datapaths).
     Tradeoff(tradeoff::TradeoffArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
@@ -100,6 +103,7 @@ pub fn main() -> ExitCode {
         Command::Budget(args) => budget::run(&args),
         Command::Optimize(args) => optimize::run(&args),
         Command::Tradeoff(args) => tradeoff::run(&args),
+        Command::Stability(args) => stability::run(&args),
         Command::Hdl(args) => hdl::run(&args),
     };
     match result {

@@ -51,6 +51,7 @@ pub fn charts(r: &BudgetReport) -> Vec<(String, Chart)> {
         title: format!("{}: output error against the f64 model", r.config),
         x_label: "fixed output - f64 output (output LSBs)".into(),
         y_label: "evaluations (count)".into(),
+        log_x: false,
         log_y: true,
         series: vec![histogram_series(
             &r.histogram_out,
@@ -62,6 +63,7 @@ pub fn charts(r: &BudgetReport) -> Vec<(String, Chart)> {
         title: format!("{}: lobe error against cos^n", r.config),
         x_label: "fixed lobe - cos^n (units of 2^-8)".into(),
         y_label: "evaluations (count)".into(),
+        log_x: false,
         log_y: true,
         series: vec![histogram_series(
             &r.histogram_shape,
@@ -77,6 +79,7 @@ pub fn charts(r: &BudgetReport) -> Vec<(String, Chart)> {
         ),
         x_label: "c = cos(theta) (interval midpoint)".into(),
         y_label: "max error (output LSBs; lobe in 2^-8)".into(),
+        log_x: false,
         log_y: false,
         series: vec![
             Series {
@@ -111,6 +114,7 @@ pub fn charts(r: &BudgetReport) -> Vec<(String, Chart)> {
         title: format!("{}: largest error per exponent", r.config),
         x_label: "exponent n".into(),
         y_label: "max |error| (absolute)".into(),
+        log_x: false,
         log_y: true,
         series: vec![
             per_n("lobe vs cos^n (total)", 0, &|p| p.shape_total_max_abs),

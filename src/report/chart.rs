@@ -28,6 +28,8 @@ pub struct Chart {
     pub x_label: String,
     /// Y axis label, with its unit.
     pub y_label: String,
+    /// Logarithmic x axis.
+    pub log_x: bool,
     /// Logarithmic y axis.
     pub log_y: bool,
     /// The series.
@@ -63,7 +65,8 @@ pub fn hue(i: usize, count: usize) -> (u8, u8, u8) {
 /// Chart size in pixels (the SVG uses the same user units).
 pub const SIZE: (u32, u32) = (960, 640);
 
-fn register_font() {
+/// Registers the embedded font under `sans-serif` (once).
+pub fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
@@ -81,7 +84,11 @@ fn ranges(chart: &Chart) -> ((f64, f64), (f64, f64)) {
         f64::NEG_INFINITY,
     );
     for &(x, y) in pts {
-        if !x.is_finite() || !y.is_finite() || (chart.log_y && y <= 0.0) {
+        if !x.is_finite()
+            || !y.is_finite()
+            || (chart.log_y && y <= 0.0)
+            || (chart.log_x && x <= 0.0)
+        {
             continue;
         }
         x0 = x0.min(x);
@@ -100,7 +107,11 @@ fn ranges(chart: &Chart) -> ((f64, f64), (f64, f64)) {
         };
         (lo - d, hi + d)
     };
-    let xr = pad(x0, x1);
+    let xr = if chart.log_x {
+        (x0 / 1.2, x1 * 1.2)
+    } else {
+        pad(x0, x1)
+    };
     let yr = if chart.log_y {
         (y0 / 1.5, y1 * 1.5)
     } else {
@@ -143,7 +154,12 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, chart: &Chart) -> Resu
                     .points
                     .iter()
                     .copied()
-                    .filter(|&(x, y)| x.is_finite() && y.is_finite() && (!chart.log_y || y > 0.0))
+                    .filter(|&(x, y)| {
+                        x.is_finite()
+                            && y.is_finite()
+                            && (!chart.log_y || y > 0.0)
+                            && (!chart.log_x || x > 0.0)
+                    })
                     .collect();
                 if s.line {
                     ctx.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
@@ -173,12 +189,17 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, chart: &Chart) -> Resu
                 .map_err(err)?;
         }};
     }
-    if chart.log_y {
-        body!(builder
+    match (chart.log_x, chart.log_y) {
+        (false, false) => body!(builder.build_cartesian_2d(x0..x1, y0..y1).map_err(err)?),
+        (false, true) => body!(builder
             .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-            .map_err(err)?);
-    } else {
-        body!(builder.build_cartesian_2d(x0..x1, y0..y1).map_err(err)?);
+            .map_err(err)?),
+        (true, false) => body!(builder
+            .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+            .map_err(err)?),
+        (true, true) => body!(builder
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .map_err(err)?),
     }
     root.present().map_err(err)
 }
@@ -204,6 +225,12 @@ pub fn render_png(chart: &Chart) -> Result<Vec<u8>, String> {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
         draw(root, chart)?;
     }
+    encode_png(&rgb, SIZE)
+}
+
+/// Encodes an RGB buffer of `size` pixels as PNG bytes (best compression, deterministic).
+pub fn encode_png(rgb: &[u8], size: (u32, u32)) -> Result<Vec<u8>, String> {
+    let (w, h) = size;
     let mut png_bytes = Vec::new();
     {
         let mut enc = png::Encoder::new(&mut png_bytes, w, h);
@@ -211,7 +238,7 @@ pub fn render_png(chart: &Chart) -> Result<Vec<u8>, String> {
         enc.set_depth(png::BitDepth::Eight);
         enc.set_compression(png::Compression::Best);
         let mut writer = enc.write_header().map_err(|e| e.to_string())?;
-        writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
+        writer.write_image_data(rgb).map_err(|e| e.to_string())?;
     }
     Ok(png_bytes)
 }
@@ -225,6 +252,7 @@ mod tests {
             title: "test".into(),
             x_label: "x (units)".into(),
             y_label: "y (units)".into(),
+            log_x: false,
             log_y: true,
             series: vec![Series {
                 label: "a".into(),

@@ -24,6 +24,14 @@ pub enum Block {
         /// The caption.
         caption: String,
     },
+    /// An image file beside the document, linked rather than inlined (for documents with
+    /// many large images).
+    Image {
+        /// The file name, relative to the document.
+        src: String,
+        /// The caption.
+        caption: String,
+    },
 }
 
 fn md_cell(s: &str) -> String {
@@ -68,6 +76,9 @@ pub fn write_markdown(w: &mut impl Write, doc: &[Block]) -> io::Result<()> {
             }
             Block::Figure { stem, caption } => {
                 writeln!(w, "![{caption}]({stem}.svg)")?;
+            }
+            Block::Image { src, caption } => {
+                writeln!(w, "![{caption}]({src})")?;
             }
         }
     }
@@ -166,6 +177,15 @@ pub fn write_html(
                 writeln!(
                     w,
                     "\n<figcaption>{}</figcaption></figure>",
+                    html_text(caption)
+                )?;
+            }
+            Block::Image { src, caption } => {
+                writeln!(
+                    w,
+                    "<figure><img src=\"{}\" alt=\"{}\" style=\"max-width:100%\"><figcaption>{}</figcaption></figure>",
+                    html_escape(src),
+                    html_escape(caption),
                     html_text(caption)
                 )?;
             }

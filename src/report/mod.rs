@@ -5,3 +5,4 @@ pub mod check;
 pub mod csv;
 pub mod doc;
 pub mod paper;
+pub mod stability;

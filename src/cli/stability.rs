@@ -1,0 +1,241 @@
+//! `specfx stability`: maps where every method and datapath fails, with heat maps and tables.
+
+use std::fs;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::output::{print_json, write_atomic};
+use super::Outcome;
+use specfx::analysis::stability::{
+    analyse, default_paths, FloatPath, Grid, Path as MapPath, StabilityReport, Tolerance,
+};
+use specfx::nset::NSet;
+use specfx::report::chart::{render_png, render_svg};
+use specfx::report::doc::{write_html, write_markdown};
+use specfx::report::stability::{
+    document, heatmap_png, heatmap_stem, heatmap_svg, overshoot_chart, overview_png, overview_svg,
+    write_overshoot_csv, write_regions_csv, write_special_csv,
+};
+
+/// Arguments of `specfx stability`.
+#[derive(Debug, Args)]
+pub struct StabilityArgs {
+    /// Output directory.
+    #[arg(long, default_value = "specfx-stability")]
+    out: PathBuf,
+    /// Exponents of the map.
+    #[arg(long, default_value = "1..=4096")]
+    n: NSet,
+    /// Float paths are sampled at every c = j / 2^C_BITS in [0, 1].
+    #[arg(long, default_value_t = 15)]
+    c_bits: u32,
+    /// Tolerance on |lobe - cos^n|: "1 lsb8" (2^-8), "0.5 lsb10", or a number.
+    #[arg(long, default_value = "1 lsb8")]
+    tol: Tolerance,
+    /// Datapaths to map (TOML files or built-in names), repeatable; replaces the built-in
+    /// baseline, narrow_sat and narrow_wrap.
+    #[arg(long)]
+    config: Vec<String>,
+    /// Float paths: "all", "none", or a comma list of names (powf, powf_f32, powi, schlick,
+    /// exp_limit, cs16_clamp, minimax16, ...).
+    #[arg(long, default_value = "all")]
+    float: String,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
+    let defaults = default_paths();
+    let floats: Vec<FloatPath> = FloatPath::default_set();
+    let mut paths: Vec<MapPath> = match args.float.trim() {
+        "all" => floats.into_iter().map(MapPath::Float).collect(),
+        "none" => Vec::new(),
+        list => {
+            let mut v = Vec::new();
+            for name in list.split(',').map(str::trim) {
+                let Some(p) = floats.iter().find(|p| p.name() == name) else {
+                    bail!(
+                        "--float: unknown path '{name}'; expected all, none or names among {}",
+                        floats
+                            .iter()
+                            .map(|p| p.name())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    );
+                };
+                v.push(MapPath::Float(*p));
+            }
+            v
+        }
+    };
+    if args.config.is_empty() {
+        paths.extend(
+            defaults
+                .into_iter()
+                .filter(|p| matches!(p, MapPath::Fixed(_))),
+        );
+    } else {
+        for arg in &args.config {
+            let dp = super::datapath::load(arg, None)?;
+            paths.push(MapPath::Fixed(Box::new(dp.config().clone())));
+        }
+    }
+    if paths.is_empty() {
+        bail!("--float none and no datapath: nothing to map");
+    }
+    Ok(paths)
+}
+
+fn write_chart_files(dir: &Path, stem: &str, svg: String, png: Vec<u8>) -> Result<()> {
+    write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    write_atomic(&dir.join(format!("{stem}.png")), &png)
+}
+
+/// Maps every path of `paths` over `grid` and writes the report into `dir`; returns the report.
+pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<StabilityReport> {
+    fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = ProgressBar::new(0);
+        b.set_style(
+            ProgressStyle::with_template("stability {bar:40} {pos}/{len} exponents, eta {eta}")
+                .expect("valid template"),
+        );
+        b
+    });
+    let last_tenth = Mutex::new(0usize);
+    let progress = |done: usize, total: usize| match &bar {
+        Some(b) => {
+            b.set_length(total as u64);
+            b.set_position(done as u64);
+        }
+        None => {
+            let tenth = done * 10 / total.max(1);
+            let mut last = last_tenth.lock().expect("progress lock");
+            if tenth > *last {
+                *last = tenth;
+                eprintln!(
+                    "stability: {}% ({done}/{total} path-exponent columns)",
+                    tenth * 10
+                );
+            }
+        }
+    };
+    eprintln!(
+        "stability: {} paths, n = {}, c in steps of 2^-{}, tolerance {}",
+        paths.len(),
+        grid.n,
+        grid.c_bits,
+        grid.tol
+    );
+    let report = analyse(paths, grid, &progress)?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    eprintln!("stability: writing heat maps and tables");
+    let tol = grid.tol.value;
+    for m in &report.maps {
+        write_chart_files(
+            dir,
+            &heatmap_stem(&m.path),
+            heatmap_svg(m, tol).map_err(anyhow::Error::msg)?,
+            heatmap_png(m, tol).map_err(anyhow::Error::msg)?,
+        )?;
+    }
+    let overview = overview_svg(&report.maps, tol).map_err(anyhow::Error::msg)?;
+    write_chart_files(
+        dir,
+        "overview",
+        overview.clone(),
+        overview_png(&report.maps, tol).map_err(anyhow::Error::msg)?,
+    )?;
+    let chart = overshoot_chart(&report);
+    let overshoot = render_svg(&chart).map_err(anyhow::Error::msg)?;
+    write_chart_files(
+        dir,
+        "overshoot",
+        overshoot.clone(),
+        render_png(&chart).map_err(anyhow::Error::msg)?,
+    )?;
+    let mut buf = Vec::new();
+    write_regions_csv(&mut buf, &report)?;
+    write_atomic(&dir.join("regions.csv"), &buf)?;
+    buf.clear();
+    write_special_csv(&mut buf, &report)?;
+    write_atomic(&dir.join("special_inputs.csv"), &buf)?;
+    buf.clear();
+    write_overshoot_csv(&mut buf, &report)?;
+    write_atomic(&dir.join("overshoot.csv"), &buf)?;
+    let doc = document(&report);
+    buf.clear();
+    write_markdown(&mut buf, &doc)?;
+    write_atomic(&dir.join("stability.md"), &buf)?;
+    buf.clear();
+    write_html(&mut buf, "specfx stability", &doc, |stem| match stem {
+        "overview" => Some(overview.clone()),
+        "overshoot" => Some(overshoot.clone()),
+        _ => None,
+    })?;
+    write_atomic(&dir.join("stability.html"), &buf)?;
+    let mut json = serde_json::to_vec_pretty(&report)?;
+    json.push(b'\n');
+    write_atomic(&dir.join("stability.json"), &json)?;
+    Ok(report)
+}
+
+/// Runs `specfx stability`.
+pub fn run(args: &StabilityArgs) -> Result<Outcome> {
+    let paths = select_paths(args)?;
+    let grid = Grid {
+        n: args.n.clone(),
+        c_bits: args.c_bits,
+        tol: args.tol.clone(),
+    };
+    if !(1..=24).contains(&grid.c_bits) {
+        bail!("--c-bits: expected 1..=24, got {}", grid.c_bits);
+    }
+    let report = stability(&args.out, &paths, &grid)?;
+    if args.json {
+        print_json(&report)?;
+        return Ok(Outcome::Ok);
+    }
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "{:<16} {:>9} {:>11} {:>6} {:>8}  failing regions",
+        "path", "precision", "max |err|", "at n", "theta"
+    )?;
+    for m in &report.maps {
+        let failing: Vec<String> = m
+            .regions
+            .iter()
+            .filter(|g| g.fails)
+            .map(|g| format!("{} (n {}..={})", g.kind, g.n_min, g.n_max))
+            .collect();
+        writeln!(
+            out,
+            "{:<16} {:>9} {:>11.3e} {:>6} {:>8.3}  {}",
+            m.path,
+            m.precision,
+            m.max_abs_err,
+            m.worst_n,
+            m.worst_c.clamp(-1.0, 1.0).acos().to_degrees(),
+            if failing.is_empty() {
+                "none".to_string()
+            } else {
+                failing.join(", ")
+            }
+        )?;
+    }
+    writeln!(
+        out,
+        "written to {} (stability.html, stability.md, stability.json, regions.csv, heat maps)",
+        args.out.display()
+    )?;
+    Ok(Outcome::Ok)
+}

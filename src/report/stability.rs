@@ -1,0 +1,712 @@
+//! The stability report: heat maps of where each path fails (SVG and PNG), the overview of
+//! every path, the overshoot chart, the region and special-input tables, and the document.
+
+use std::io::{self, Write};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::analysis::stability::{
+    Kind, PathMap, StabilityReport, HEAT_ROWS, OVERSHOOT_J_MAX, SPECIAL_N,
+};
+use crate::report::chart::{hue, register_font, Chart, Series};
+use crate::report::doc::Block;
+
+/// Heat-map size in pixels (the SVG uses the same user units).
+pub const HEAT_SIZE: (u32, u32) = (960, 600);
+
+/// One colour class of a heat-map cell, with its legend label.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shade {
+    /// No sample in the cell.
+    Empty,
+    /// The datapath cannot hold the exponents of the column.
+    Unrepresentable,
+    /// NaN or infinity.
+    NonFinite,
+    /// |err| = 0.
+    Exact,
+    /// |err| <= tol / 1000, tol / 100, tol / 10, tol (levels 0..=3).
+    Within(u8),
+    /// |err| <= 4 tol, 16 tol, 64 tol, above (levels 0..=3).
+    Beyond(u8),
+}
+
+impl Shade {
+    /// Every shade, in legend order.
+    pub const ALL: [Shade; 11] = [
+        Shade::Exact,
+        Shade::Within(0),
+        Shade::Within(1),
+        Shade::Within(2),
+        Shade::Within(3),
+        Shade::Beyond(0),
+        Shade::Beyond(1),
+        Shade::Beyond(2),
+        Shade::Beyond(3),
+        Shade::NonFinite,
+        Shade::Unrepresentable,
+    ];
+
+    /// The shade of a cell.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::analysis::stability::Cell;
+    /// use specfx::report::stability::Shade;
+    /// let cell = |e: f64| Cell { samples: 1, max_abs_err: e, flags: 0 };
+    /// assert_eq!(Shade::of(&cell(0.0), 0.01), Shade::Exact);
+    /// assert_eq!(Shade::of(&cell(0.01), 0.01), Shade::Within(3));
+    /// assert_eq!(Shade::of(&cell(0.02), 0.01), Shade::Beyond(0));
+    /// assert_eq!(Shade::of(&cell(1.0), 0.01), Shade::Beyond(3));
+    /// ```
+    pub fn of(cell: &crate::analysis::stability::Cell, tol: f64) -> Shade {
+        if cell.flags & Kind::NonFinite.bit() != 0 {
+            return Shade::NonFinite;
+        }
+        if cell.samples == 0 {
+            return if cell.flags & Kind::Unrepresentable.bit() != 0 {
+                Shade::Unrepresentable
+            } else {
+                Shade::Empty
+            };
+        }
+        let e = cell.max_abs_err;
+        if e == 0.0 {
+            Shade::Exact
+        } else if e <= tol {
+            let level = [tol / 1000.0, tol / 100.0, tol / 10.0]
+                .iter()
+                .filter(|&&t| e > t)
+                .count();
+            Shade::Within(level as u8)
+        } else {
+            let level = [4.0 * tol, 16.0 * tol, 64.0 * tol]
+                .iter()
+                .filter(|&&t| e > t)
+                .count();
+            Shade::Beyond(level as u8)
+        }
+    }
+
+    /// The RGB colour.
+    pub fn rgb(self) -> (u8, u8, u8) {
+        match self {
+            Shade::Empty => (250, 250, 250),
+            Shade::Unrepresentable => (170, 170, 170),
+            Shade::NonFinite => (0, 0, 0),
+            Shade::Exact => (255, 255, 255),
+            Shade::Within(0) => (224, 243, 219),
+            Shade::Within(1) => (168, 221, 181),
+            Shade::Within(2) => (102, 194, 164),
+            Shade::Within(_) => (35, 139, 69),
+            Shade::Beyond(0) => (254, 196, 79),
+            Shade::Beyond(1) => (254, 153, 41),
+            Shade::Beyond(2) => (236, 92, 32),
+            Shade::Beyond(_) => (153, 0, 13),
+        }
+    }
+
+    /// The legend label for a tolerance.
+    pub fn label(self, tol: f64) -> String {
+        match self {
+            Shade::Empty => "no sample".into(),
+            Shade::Unrepresentable => "n's constants do not fit".into(),
+            Shade::NonFinite => "NaN or infinite".into(),
+            Shade::Exact => "exact".into(),
+            Shade::Within(l) => format!(
+                "<= {:.1e}",
+                tol / [1000.0, 100.0, 10.0, 1.0][usize::from(l.min(3))]
+            ),
+            Shade::Beyond(l) if l < 3 => {
+                format!("<= {:.1e}", tol * [4.0, 16.0, 64.0][usize::from(l)])
+            }
+            Shade::Beyond(_) => format!("> {:.1e}", 64.0 * tol),
+        }
+    }
+}
+
+/// Flags drawn as a cross on a heat-map cell.
+const CROSS_FLAGS: [Kind; 3] = [Kind::NegativeBase, Kind::NonMonotonic, Kind::Wrap];
+
+fn draw_heatmap<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    m: &PathMap,
+    tol: f64,
+) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(err)?;
+    let (w, _) = root.dim_in_pixel();
+    let (plot, legend) = root.split_horizontally(w - 200);
+    let cols = &m.heat.columns;
+    let x_lo = f64::from(cols[0].0);
+    let x_hi = f64::from(cols[cols.len() - 1].1) + 1.0;
+    let worst = format!(
+        "max |err| {:.2e} at n = {}, theta = {:.2} deg",
+        m.max_abs_err,
+        m.worst_n,
+        m.worst_c.clamp(-1.0, 1.0).acos().to_degrees()
+    );
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(
+            format!("{} ({}): |lobe - cos^n|, {worst}", m.path, m.precision),
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(60)
+        .build_cartesian_2d((x_lo..x_hi).log_scale(), 0f64..90f64)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .x_desc("specular exponent n (log scale)")
+        .y_desc("theta = arccos(c) (degrees)")
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    // Runs of equal shade along each row become one rectangle.
+    let x_edge = |col: usize| {
+        if col + 1 < cols.len() {
+            f64::from(cols[col + 1].0)
+        } else {
+            x_hi
+        }
+    };
+    let mut rects = Vec::new();
+    for row in 0..HEAT_ROWS {
+        let mut start = 0;
+        while start < cols.len() {
+            let shade = Shade::of(m.heat.cell(start, row), tol);
+            let mut end = start + 1;
+            while end < cols.len() && Shade::of(m.heat.cell(end, row), tol) == shade {
+                end += 1;
+            }
+            let (r, g, b) = shade.rgb();
+            rects.push(Rectangle::new(
+                [
+                    (f64::from(cols[start].0), row as f64),
+                    (x_edge(end - 1), row as f64 + 1.0),
+                ],
+                RGBColor(r, g, b).filled(),
+            ));
+            start = end;
+        }
+    }
+    chart.draw_series(rects).map_err(err)?;
+    let mark = |bits: u16| {
+        let mut v = Vec::new();
+        for (col, &(first, _)) in cols.iter().enumerate() {
+            for row in 0..HEAT_ROWS {
+                if m.heat.cell(col, row).flags & bits != 0 {
+                    let x = (f64::from(first) * x_edge(col)).sqrt();
+                    v.push((x, row as f64 + 0.5));
+                }
+            }
+        }
+        v
+    };
+    let cross_bits = CROSS_FLAGS.iter().fold(0, |a, k| a | k.bit());
+    chart
+        .draw_series(
+            mark(cross_bits)
+                .into_iter()
+                .map(|p| Cross::new(p, 3, BLACK.stroke_width(1))),
+        )
+        .map_err(err)?;
+    chart
+        .draw_series(
+            mark(Kind::Underflow.bit())
+                .into_iter()
+                .map(|p| Circle::new(p, 1, RGBColor(40, 70, 200).filled())),
+        )
+        .map_err(err)?;
+    // The legend, drawn by hand beside the plot.
+    let font = ("sans-serif", 13).into_font();
+    let mut y = 40;
+    legend
+        .draw(&Text::new(
+            format!("|err|, tol = {tol:.2e}"),
+            (6, y),
+            font.clone(),
+        ))
+        .map_err(err)?;
+    y += 22;
+    for shade in Shade::ALL {
+        let (r, g, b) = shade.rgb();
+        legend
+            .draw(&Rectangle::new(
+                [(6, y), (24, y + 14)],
+                RGBColor(r, g, b).filled(),
+            ))
+            .map_err(err)?;
+        legend
+            .draw(&Rectangle::new(
+                [(6, y), (24, y + 14)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(err)?;
+        legend
+            .draw(&Text::new(shade.label(tol), (30, y), font.clone()))
+            .map_err(err)?;
+        y += 20;
+    }
+    y += 10;
+    legend
+        .draw(&Cross::new((15, y + 7), 4, BLACK.stroke_width(1)))
+        .map_err(err)?;
+    legend
+        .draw(&Text::new("negative base, non-", (30, y), font.clone()))
+        .map_err(err)?;
+    legend
+        .draw(&Text::new("monotonic or wrap", (30, y + 16), font.clone()))
+        .map_err(err)?;
+    y += 40;
+    legend
+        .draw(&Circle::new((15, y + 7), 2, RGBColor(40, 70, 200).filled()))
+        .map_err(err)?;
+    legend
+        .draw(&Text::new("underflow", (30, y), font))
+        .map_err(err)?;
+    root.present().map_err(err)
+}
+
+fn draw_overview<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    maps: &[PathMap],
+    tol: f64,
+) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            &format!("Where each path stays within {tol:.2e} of cos^n (green) and where it fails (red); x: n = {}..{} (log), y: theta 0..90 deg", maps.first().map_or(1, |m| m.heat.columns[0].0), maps.first().map_or(1, |m| m.heat.columns[m.heat.columns.len() - 1].1)),
+            ("sans-serif", 18),
+        )
+        .map_err(err)?;
+    let n_cols = 6;
+    let n_rows = maps.len().div_ceil(n_cols).max(1);
+    let tiles = root.split_evenly((n_rows, n_cols));
+    for (tile, m) in tiles.iter().zip(maps) {
+        let cols = &m.heat.columns;
+        let x_lo = f64::from(cols[0].0);
+        let x_hi = f64::from(cols[cols.len() - 1].1) + 1.0;
+        let verdict = if m.passes() { "passes" } else { "fails" };
+        let mut chart = ChartBuilder::on(tile)
+            .caption(format!("{} ({verdict})", m.path), ("sans-serif", 13))
+            .margin(4)
+            .build_cartesian_2d((x_lo..x_hi).log_scale(), 0f64..90f64)
+            .map_err(err)?;
+        let x_edge = |col: usize| {
+            if col + 1 < cols.len() {
+                f64::from(cols[col + 1].0)
+            } else {
+                x_hi
+            }
+        };
+        let class = |col: usize, row: usize| {
+            let c = m.heat.cell(col, row);
+            let structural =
+                c.flags & (Kind::NonFinite.bit() | Kind::Over.bit() | Kind::Under.bit()) != 0;
+            if c.flags & Kind::Unrepresentable.bit() != 0 {
+                (170, 170, 170)
+            } else if c.samples == 0 {
+                (250, 250, 250)
+            } else if structural {
+                (215, 48, 39)
+            } else {
+                (120, 198, 121)
+            }
+        };
+        let mut rects = Vec::new();
+        for row in 0..HEAT_ROWS {
+            let mut start = 0;
+            while start < cols.len() {
+                let k = class(start, row);
+                let mut end = start + 1;
+                while end < cols.len() && class(end, row) == k {
+                    end += 1;
+                }
+                rects.push(Rectangle::new(
+                    [
+                        (f64::from(cols[start].0), row as f64),
+                        (x_edge(end - 1), row as f64 + 1.0),
+                    ],
+                    RGBColor(k.0, k.1, k.2).filled(),
+                ));
+                start = end;
+            }
+        }
+        chart.draw_series(rects).map_err(err)?;
+    }
+    root.present().map_err(err)
+}
+
+/// Renders into an SVG string with a drawing function.
+fn svg_with(
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<String, String> {
+    register_font();
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        draw(root)?;
+    }
+    text.push('\n');
+    Ok(text)
+}
+
+/// Renders into PNG bytes with a drawing function.
+fn png_with(
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<Vec<u8>, String> {
+    register_font();
+    let (w, h) = size;
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        draw(root)?;
+    }
+    crate::report::chart::encode_png(&rgb, size)
+}
+
+/// The heat map of one path as SVG text.
+pub fn heatmap_svg(m: &PathMap, tol: f64) -> Result<String, String> {
+    svg_with(HEAT_SIZE, |root| draw_heatmap(root, m, tol))
+}
+
+/// The heat map of one path as PNG bytes.
+pub fn heatmap_png(m: &PathMap, tol: f64) -> Result<Vec<u8>, String> {
+    png_with(HEAT_SIZE, |root| draw_heatmap(root, m, tol))
+}
+
+fn overview_size(n_maps: usize) -> (u32, u32) {
+    let rows = n_maps.div_ceil(6).max(1) as u32;
+    (1200, 40 + 150 * rows)
+}
+
+/// The pass/fail overview of every path as SVG text.
+pub fn overview_svg(maps: &[PathMap], tol: f64) -> Result<String, String> {
+    svg_with(overview_size(maps.len()), |root| {
+        draw_overview(root, maps, tol)
+    })
+}
+
+/// The pass/fail overview of every path as PNG bytes.
+pub fn overview_png(maps: &[PathMap], tol: f64) -> Result<Vec<u8>, String> {
+    png_with(overview_size(maps.len()), |root| {
+        draw_overview(root, maps, tol)
+    })
+}
+
+/// The overshoot chart: the smallest f32-ulp excess over 1 that makes each path overshoot.
+pub fn overshoot_chart(r: &StabilityReport) -> Chart {
+    let shown: Vec<_> = r
+        .overshoot
+        .iter()
+        .filter(|o| {
+            [
+                "powf",
+                "powf_f32",
+                "schlick",
+                "exp_limit",
+                "cs16_clamp",
+                "cs128_clamp",
+                "minimax16",
+            ]
+            .contains(&o.path.as_str())
+        })
+        .collect();
+    Chart {
+        title: format!(
+            "Inputs above 1: smallest excess (f32 ulps) that lifts the lobe more than {:.2e}",
+            r.grid.tol.value
+        ),
+        x_label: "specular exponent n (log scale)".into(),
+        y_label: "c - 1 at the first overshoot (units of 2^-23)".into(),
+        log_x: true,
+        log_y: true,
+        series: shown
+            .iter()
+            .enumerate()
+            .map(|(i, o)| Series {
+                label: o.path.clone(),
+                points: o
+                    .per_n
+                    .iter()
+                    .filter_map(|&(n, j)| j.map(|j| (f64::from(n), f64::from(j))))
+                    .collect(),
+                line: true,
+                color: hue(i, shown.len()),
+            })
+            .collect(),
+    }
+}
+
+fn deg(c: f64) -> f64 {
+    c.clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// Writes the region table as CSV: one row per path and kind.
+pub fn write_regions_csv(w: &mut impl Write, r: &StabilityReport) -> io::Result<()> {
+    writeln!(
+        w,
+        "path,precision,kind,fails,samples,failing,n_min,n_max,c_min,c_max,theta_min_deg,theta_max_deg,worst_abs_err,worst_n,worst_c,stages"
+    )?;
+    for m in &r.maps {
+        for g in &m.regions {
+            writeln!(
+                w,
+                "{},{},{},{},{},{},{},{},{:e},{:e},{:.4},{:.4},{:e},{},{:e},{}",
+                m.path,
+                m.precision,
+                g.kind,
+                g.fails,
+                g.samples,
+                g.failing,
+                g.n_min,
+                g.n_max,
+                g.c_min,
+                g.c_max,
+                deg(g.c_max),
+                deg(g.c_min),
+                g.worst_abs_err,
+                g.worst_n,
+                g.worst_c,
+                g.stages.join(" ")
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// Writes the special-input outcomes as CSV.
+pub fn write_special_csv(w: &mut impl Write, r: &StabilityReport) -> io::Result<()> {
+    writeln!(w, "path,input,n,output,verdict")?;
+    for s in &r.special {
+        writeln!(
+            w,
+            "{},{},{},{},{}",
+            s.path,
+            s.input,
+            s.n,
+            s.output,
+            s.verdict.name()
+        )?;
+    }
+    Ok(())
+}
+
+/// Writes the overshoot thresholds as CSV: one row per n, one column per float path (empty
+/// where no j up to the maximum overshoots).
+pub fn write_overshoot_csv(w: &mut impl Write, r: &StabilityReport) -> io::Result<()> {
+    write!(w, "n")?;
+    for o in &r.overshoot {
+        write!(w, ",{}", o.path)?;
+    }
+    writeln!(w)?;
+    for (i, &n) in r.grid.n.values().iter().enumerate() {
+        write!(w, "{n}")?;
+        for o in &r.overshoot {
+            match o.per_n[i].1 {
+                Some(j) => write!(w, ",{j}")?,
+                None => write!(w, ",")?,
+            }
+        }
+        writeln!(w)?;
+    }
+    Ok(())
+}
+
+/// The file stem of a path's heat map.
+pub fn heatmap_stem(path: &str) -> String {
+    format!("heatmap_{path}")
+}
+
+/// The stability report as a document: summary, regions, special inputs, overshoot, figures.
+pub fn document(r: &StabilityReport) -> Vec<Block> {
+    let tol = r.grid.tol.value;
+    let ns = r.grid.n.values();
+    let mut doc = vec![
+        Block::Heading(1, "Where the methods fail".into()),
+        Block::Paragraph(format!(
+            "Every path is evaluated at every n = {} and every cosine of its grid in [0, 1] (float paths: steps of 2^-{}; datapaths: every code of their input format), and compared with cos^n in f64. The tolerance is {} = {tol:.3e} on |lobe - cos^n|. A region gathers every sample of a path flagged with one kind; it fails when a sample in it is off by more than the tolerance, or when its kind is a failure by itself (wrap, non-monotonic, non-finite, unrepresentable). Angles are theta = arccos(c).",
+            r.grid.n, r.grid.c_bits, r.grid.tol
+        )),
+        Block::Heading(2, "Kinds".into()),
+        Block::Table {
+            header: vec!["kind".into(), "meaning".into()],
+            rows: Kind::ALL
+                .iter()
+                .map(|k| vec![format!("`{k}`"), k.describe().to_string()])
+                .collect(),
+        },
+        Block::Heading(2, "Overview".into()),
+        Block::Paragraph(format!(
+            "{} of {} paths stay within the tolerance with no failing region.",
+            r.maps.iter().filter(|m| m.passes()).count(),
+            r.maps.len()
+        )),
+        Block::Figure {
+            stem: "overview".into(),
+            caption: "Pass (green) or fail (red) per path, over n (log) and theta.".into(),
+        },
+        Block::Table {
+            header: vec![
+                "path".into(),
+                "precision".into(),
+                "max |err|".into(),
+                "at n".into(),
+                "at theta (deg)".into(),
+                "failing regions".into(),
+                "heat map".into(),
+            ],
+            rows: r
+                .maps
+                .iter()
+                .map(|m| {
+                    let failing: Vec<String> = m
+                        .regions
+                        .iter()
+                        .filter(|g| g.fails)
+                        .map(|g| g.kind.to_string())
+                        .collect();
+                    vec![
+                        m.path.clone(),
+                        m.precision.clone(),
+                        format!("{:.3e}", m.max_abs_err),
+                        m.worst_n.to_string(),
+                        format!("{:.3}", deg(m.worst_c)),
+                        if failing.is_empty() {
+                            "none".into()
+                        } else {
+                            failing.join(", ")
+                        },
+                        format!("{}.png", heatmap_stem(&m.path)),
+                    ]
+                })
+                .collect(),
+        },
+        Block::Heading(2, "Failure regions".into()),
+        Block::Paragraph(
+            "theta range: from the smallest to the largest flagged angle over all n of the region; at n: the extent at the region's last n (largest exponent). Every region's exact extent at every n is in stability.json (`at_n`) for the powers of two, and in the library's `Region::per_n`.".into(),
+        ),
+    ];
+    let mut rows = Vec::new();
+    for m in &r.maps {
+        for g in &m.regions {
+            let last = g.per_n.last();
+            rows.push(vec![
+                m.path.clone(),
+                format!("`{}`", g.kind),
+                if g.fails { "fails" } else { "within tolerance" }.into(),
+                format!("{}..={}", g.n_min, g.n_max),
+                format!("{:.2}..{:.2}", deg(g.c_max), deg(g.c_min)),
+                last.map_or(String::new(), |b| {
+                    let (a, z) = b.theta_deg();
+                    format!("n = {}: {a:.2}..{z:.2}", b.n)
+                }),
+                g.samples.to_string(),
+                g.failing.to_string(),
+                format!("{:.3e}", g.worst_abs_err),
+                format!("n = {}, theta = {:.2}", g.worst_n, deg(g.worst_c)),
+                if let Some(note) = &g.note {
+                    note.clone()
+                } else {
+                    g.stages.join(" ")
+                },
+            ]);
+        }
+    }
+    doc.push(Block::Table {
+        header: vec![
+            "path".into(),
+            "kind".into(),
+            "status".into(),
+            "n".into(),
+            "theta (deg)".into(),
+            "at the last n".into(),
+            "samples".into(),
+            "beyond tol".into(),
+            "worst |err|".into(),
+            "worst at".into(),
+            "stages / note".into(),
+        ],
+        rows,
+    });
+    doc.push(Block::Heading(2, "Special inputs".into()));
+    doc.push(Block::Paragraph(format!(
+        "Each path's lobe for NaN, the infinities, -0 and cosines just outside [0, 1] as float dot products produce them, at n = {}. Datapaths see the input rounded to their format with saturation (NaN and infinities have no code and are left out). Verdicts: `ok` within the tolerance of cos^n(clamp(c, 0, 1)); `absorbed` a NaN or infinite input gave a finite lobe in [0, 1 + tol]; `nan`, `inf`, `negative`; `off` beyond the tolerance. The table shows n = {}; every n is in special_inputs.csv.",
+        SPECIAL_N.map(|n| n.to_string()).join(", "),
+        SPECIAL_N[2]
+    )));
+    let inputs: Vec<String> = {
+        let mut v: Vec<String> = Vec::new();
+        for s in &r.special {
+            if !v.contains(&s.input) {
+                v.push(s.input.clone());
+            }
+        }
+        v
+    };
+    let mut header = vec!["path".to_string()];
+    header.extend(inputs.iter().map(|i| format!("c = {i}")));
+    let mut rows = Vec::new();
+    for m in &r.maps {
+        let mut row = vec![m.path.clone()];
+        for i in &inputs {
+            row.push(
+                r.special
+                    .iter()
+                    .find(|s| s.path == m.path && &s.input == i && s.n == SPECIAL_N[2])
+                    .map_or("-".into(), |s| {
+                        format!("{} ({})", s.output, s.verdict.name())
+                    }),
+            );
+        }
+        rows.push(row);
+    }
+    doc.push(Block::Table { header, rows });
+    doc.push(Block::Heading(2, "Cosines above 1".into()));
+    doc.push(Block::Paragraph(format!(
+        "A dot product of unit vectors computed in floating point can exceed 1 by a few ulps (2^-23 in f32; about 2^-10 with half-precision normals). For each float path and n, the smallest j in 1..={OVERSHOOT_J_MAX} for which c = 1 + j 2^-23 lifts the lobe more than the tolerance above its value at c = 1 (or makes it NaN, infinite or negative). Datapaths clamp codes above 1.0 and never overshoot. Every n is in overshoot.csv."
+    )));
+    doc.push(Block::Figure {
+        stem: "overshoot".into(),
+        caption: "The smallest overshooting excess above 1, per n.".into(),
+    });
+    let n_max = ns[ns.len() - 1];
+    doc.push(Block::Table {
+        header: vec![
+            "path".into(),
+            "smallest n that overshoots".into(),
+            format!("first overshooting j at n = {n_max}"),
+        ],
+        rows: r
+            .overshoot
+            .iter()
+            .map(|o| {
+                vec![
+                    o.path.clone(),
+                    o.n_min.map_or("none".into(), |n| n.to_string()),
+                    o.j_at_n_max.map_or("none".into(), |j| j.to_string()),
+                ]
+            })
+            .collect(),
+    });
+    doc.push(Block::Heading(2, "Heat maps".into()));
+    for m in &r.maps {
+        doc.push(Block::Image {
+            src: format!("{}.png", heatmap_stem(&m.path)),
+            caption: format!(
+                "{}: |lobe - cos^n| over n and theta (crosses: negative base, non-monotonic or wrap; dots: underflow).",
+                m.path
+            ),
+        });
+    }
+    doc
+}
