@@ -146,6 +146,11 @@ fn report_writes_its_files_and_a_summary() {
         "coefficients.csv",
         "budget_baseline/budget.html",
         "budget_baseline/budget.json",
+        "stability/stability.html",
+        "stability/regions.csv",
+        "stability/overview.png",
+        "stability/heatmap_cs16_paper.png",
+        "stability/heatmap_baseline.svg",
         "index.html",
     ] {
         let p = dir.join(name);
@@ -157,6 +162,14 @@ fn report_writes_its_files_and_a_summary() {
     assert!(out.contains("cs16_clamp"));
     let index = std::fs::read_to_string(dir.join("index.html")).unwrap();
     assert!(index.contains("href=\"budget_baseline/budget.html\""));
+    assert!(index.contains("href=\"stability/stability.html\""));
+    assert!(out.contains("stability: "), "{out}");
+    // The baseline's u8.16 coefficient holds coef(n) = 17 n / (32 pi) up to n = 1513.
+    let regions = std::fs::read_to_string(dir.join("stability/regions.csv")).unwrap();
+    assert!(
+        regions.contains("baseline,fixed,unrepresentable,true,0,0,1514,4096,"),
+        "{regions}"
+    );
     let methods = std::fs::read_to_string(dir.join("methods.csv")).unwrap();
     assert_eq!(methods.lines().count(), 1 + 1009);
     // No temporary file is left behind.

@@ -123,6 +123,8 @@ fn the_paper_cutoff_admits_negative_bases_exactly_between_its_cut_and_the_zero_o
     );
     assert!(region(&maps[0], Kind::NegativeBase).fails);
     assert!(region(&maps[1], Kind::NegativeBase).fails);
+    // m = 32: 6/sqrt(n) comes before the zero of the base (6 < sqrt(2 m) for large n).
+    assert!(maps[3].region(Kind::NegativeBase).is_none());
     // The spurious lobe makes the paper cutoff non-monotonic wherever it admits a negative
     // base, and for m = 16 by less than the tolerance.
     assert!(!region(&maps[2], Kind::NonMonotonic).fails);

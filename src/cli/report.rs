@@ -35,16 +35,29 @@ fn emit(
     Ok(path)
 }
 
+/// What the index page summarises.
+struct Results<'a> {
+    paper: &'a specfx::analysis::paper::PaperReproduction,
+    checked: &'a specfx::analysis::check::CheckReport,
+    budget: &'a specfx::analysis::budget::BudgetReport,
+    figures: &'a [specfx::analysis::tradeoff::MethodFigures],
+    stability: &'a specfx::analysis::stability::StabilityReport,
+}
+
 /// A self-contained index page linking (and showing) everything the report wrote.
 fn write_index(
     w: &mut Vec<u8>,
     dir: &Path,
     files: &[PathBuf],
-    paper: &specfx::analysis::paper::PaperReproduction,
-    checked: &specfx::analysis::check::CheckReport,
-    budget: &specfx::analysis::budget::BudgetReport,
-    figures: &[specfx::analysis::tradeoff::MethodFigures],
+    results: &Results<'_>,
 ) -> std::io::Result<()> {
+    let Results {
+        paper,
+        checked,
+        budget,
+        figures,
+        stability,
+    } = *results;
     let rel = |p: &PathBuf| {
         p.strip_prefix(dir)
             .unwrap_or(p)
@@ -91,7 +104,16 @@ fn write_index(
             f.evals_per_s / 1e6
         )?;
     }
-    writeln!(w, "</table><h2>Every file</h2><ul>")?;
+    writeln!(w, "</table>")?;
+    let passing: Vec<&str> = stability
+        .maps
+        .iter()
+        .filter(|m| m.passes())
+        .map(|m| m.path.as_str())
+        .collect();
+    writeln!(w, "<h2>Where the methods fail</h2><p>{} paths mapped over n = {} and theta in [0, 90] degrees against a tolerance of {}; {} stay within it everywhere ({}). Failure regions, special inputs (NaN, infinities, cosines just outside [0, 1]) and one heat map per path: <a href=\"stability/stability.html\">stability/stability.html</a> (also .md, .json, regions.csv).</p><img src=\"stability/overview.png\" alt=\"where each path passes or fails\">",
+        stability.maps.len(), stability.grid.n, stability.grid.tol, passing.len(), passing.join(", "))?;
+    writeln!(w, "<h2>Every file</h2><ul>")?;
     for f in files {
         let r = rel(f);
         writeln!(w, "<li><a href=\"{r}\">{r}</a></li>")?;
@@ -222,8 +244,34 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     written.push(tradeoff_dir.join("speed_accuracy.png"));
     written.push(tradeoff_dir.join("error_vs_n.png"));
 
+    step("mapping where every method and datapath fails (n = 1..=4096, theta 0..90 degrees)");
+    let stability_dir = dir.join("stability");
+    let stability = super::stability::stability(
+        &stability_dir,
+        &specfx::analysis::stability::default_paths(),
+        &specfx::analysis::stability::Grid::default(),
+    )?;
+    for f in [
+        "stability.html",
+        "stability.md",
+        "stability.json",
+        "regions.csv",
+        "special_inputs.csv",
+        "overshoot.csv",
+        "overview.png",
+    ] {
+        written.push(stability_dir.join(f));
+    }
+
     written.push(emit(dir, "index.html", |b| {
-        write_index(b, dir, &written, &paper, &checked, &budget, &figures)
+        let results = Results {
+            paper: &paper,
+            checked: &checked,
+            budget: &budget,
+            figures: &figures,
+            stability: &stability,
+        };
+        write_index(b, dir, &written, &results)
     })?);
 
     let n_claims = paper.forms.len() + 2;
@@ -301,6 +349,20 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             c.ffs.unwrap_or(0)
         )?;
     }
+    let failing: Vec<&str> = stability
+        .maps
+        .iter()
+        .filter(|m| !m.passes())
+        .map(|m| m.path.as_str())
+        .collect();
+    writeln!(
+        out,
+        "  stability: {} of {} paths stay within {} of cos^n over n = {} (details: stability/stability.html)",
+        stability.maps.len() - failing.len(),
+        stability.maps.len(),
+        stability.grid.tol,
+        stability.grid.n
+    )?;
     writeln!(out, "  max |error| against cos^n over n = 16..=1024:")?;
     for e in &errs {
         writeln!(

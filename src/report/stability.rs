@@ -534,7 +534,7 @@ pub fn document(r: &StabilityReport) -> Vec<Block> {
     let mut doc = vec![
         Block::Heading(1, "Where the methods fail".into()),
         Block::Paragraph(format!(
-            "Every path is evaluated at every n = {} and every cosine of its grid in [0, 1] (float paths: steps of 2^-{}; datapaths: every code of their input format), and compared with cos^n in f64. The tolerance is {} = {tol:.3e} on |lobe - cos^n|. A region gathers every sample of a path flagged with one kind; it fails when a sample in it is off by more than the tolerance, or when its kind is a failure by itself (wrap, non-monotonic, non-finite, unrepresentable). Angles are theta = arccos(c).",
+            "Every path is evaluated at every n = {} and every cosine of its grid in [0, 1] (float paths: steps of 2^-{}; datapaths: every code of their input format), and compared with cos^n in f64. The tolerance is {} = {tol:.3e} on |lobe - cos^n|. A region gathers every sample of a path flagged with one kind; it fails when a sample in it is off by more than the tolerance, when the lobe falls by more than the tolerance in it (`non_monotonic`), or when it is `non_finite` or `unrepresentable`. Other regions are shown as within tolerance: they are where a method is fragile, not yet wrong. Angles are theta = arccos(c).",
             r.grid.n, r.grid.c_bits, r.grid.tol
         )),
         Block::Heading(2, "Kinds".into()),
