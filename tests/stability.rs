@@ -7,9 +7,10 @@ use common::specfx;
 use std::f64::consts::PI;
 
 use specfx::analysis::stability::{
-    map, overshoot_threshold, special_outcomes, FloatPath, Grid, Kind, Path, PathMap, Region,
-    Tolerance, Verdict, NARROW_WRAP,
+    map, narrow_datapath, overshoot_threshold, special_outcomes, FloatPath, Grid, Kind, Path,
+    PathMap, Region, Tolerance, Verdict,
 };
+use specfx::fixed::Overflow;
 use specfx::pipeline::Config;
 use specfx::reference::lobe::Cutoff;
 use specfx::reference::method::Method;
@@ -86,10 +87,11 @@ fn the_paper_cutoff_admits_negative_bases_exactly_between_its_cut_and_the_zero_o
         cs(2, Cutoff::Paper),
         cs(3, Cutoff::Paper),
         cs(4, Cutoff::Paper),
+        cs(5, Cutoff::Paper),
     ];
     let maps = run(&paths, &g);
     let scale = f64::from(1u32 << 15);
-    for (k, m) in [2u32, 3, 4].into_iter().zip(&maps) {
+    for (k, m) in [2u32, 3, 4, 5].into_iter().zip(&maps) {
         let mm = 1u64 << k;
         let oracle = |n: u32| {
             let thr = (6.0 / f64::from(n).sqrt()).min(PI).cos();
@@ -262,7 +264,7 @@ fn narrow_wrap_oracle(code: i64, n: i64, coef_raw: i64) -> (i64, i64, bool) {
 #[test]
 fn wrap_around_and_non_monotonic_regions_of_the_narrow_datapath() {
     let g = grid("1..=4096", 9);
-    let cfg = Config::from_toml(NARROW_WRAP).unwrap();
+    let cfg = narrow_datapath(Overflow::Wrap);
     let maps = run(&[Path::Fixed(Box::new(cfg))], &g);
     let m = &maps[0];
     let coef_raw = |n: u32| {
@@ -301,19 +303,9 @@ fn rounding_alone_never_makes_a_datapath_non_monotonic() {
     // of a monotone input, so no region may appear; wrap-around (above) is what breaks it.
     use specfx::fixed::Rounding;
     let g = grid("1..=300", 8);
-    let modes = [
-        Rounding::Trn,
-        Rounding::TrnZero,
-        Rounding::Rnd,
-        Rounding::RndZero,
-        Rounding::RndInf,
-        Rounding::RndMinInf,
-        Rounding::RndConv,
-        Rounding::RndConvOdd,
-    ];
     let mut paths = Vec::new();
-    for (i, mode) in modes.into_iter().enumerate() {
-        let mut cfg = Config::from_toml(&NARROW_WRAP.replace("WRAP", "SAT")).unwrap();
+    for (i, mode) in Rounding::ALL.into_iter().enumerate() {
+        let mut cfg = narrow_datapath(Overflow::Sat);
         cfg.name = format!("sat_{i}");
         cfg.t.rounding = mode;
         cfg.b.rounding = mode;
@@ -549,4 +541,39 @@ fn the_command_writes_maps_tables_and_json_and_refuses_bad_input() {
         assert!(err.contains(what), "{bad:?}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     }
+}
+
+#[test]
+fn a_users_datapath_file_is_mapped() {
+    let dir = std::env::temp_dir().join(format!("specfx-stability-user-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // t in s3.8 with wrap-around: it wraps once n (1 - c) / 16 > 4, first at n = 65, c = 0.
+    let file = dir.join("mine.toml");
+    std::fs::write(
+        &file,
+        "[c]\nformat = \"u1.9\"\n[d]\nformat = \"s1.9\"\n[t]\nformat = \"s3.8\"\nrounding = \"TRN\"\noverflow = \"WRAP\"\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = specfx(&[
+        "stability",
+        "--out",
+        out.to_str().unwrap(),
+        "--n",
+        "60..=70",
+        "--float",
+        "none",
+        "--config",
+        file.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("regions.csv")).unwrap();
+    let wrap = csv
+        .lines()
+        .find(|l| l.starts_with("mine,fixed,wrap,"))
+        .unwrap_or_else(|| panic!("{csv}"));
+    let fields: Vec<&str> = wrap.split(',').collect();
+    assert_eq!((fields[6], fields[7]), ("65", "70"), "{wrap}");
+    assert!(out.join("heatmap_mine.png").is_file());
 }

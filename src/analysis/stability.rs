@@ -412,12 +412,9 @@ impl Path {
     }
 }
 
-/// The built-in fixed-point datapaths of the map: `baseline`, and a narrow datapath (10-bit
-/// input, 9-bit stages, truncation) with saturation and with wrap-around.
-pub const DEFAULT_FIXED: [&str; 2] = [NARROW_SAT, NARROW_WRAP];
-
-/// A narrow datapath with saturation.
-pub const NARROW_SAT: &str = r#"name = "narrow_sat"
+/// The narrow datapath of the map (10-bit input, 9-bit stages, truncation), its overflow mode
+/// left as `{overflow}`.
+const NARROW: &str = r#"name = "narrow_{name}"
 [c]
 format = "u1.9"
 [d]
@@ -425,63 +422,52 @@ format = "s1.9"
 [t]
 format = "s3.8"
 rounding = "TRN"
-overflow = "SAT"
+overflow = "{overflow}"
 [b]
 format = "u1.8"
 rounding = "TRN"
-overflow = "SAT"
+overflow = "{overflow}"
 [square]
 format = "u1.8"
 rounding = "TRN"
-overflow = "SAT"
+overflow = "{overflow}"
 [coef]
 format = "u10.6"
 rounding = "TRN"
 [out]
 format = "u10.6"
 rounding = "TRN"
-overflow = "SAT"
+overflow = "{overflow}"
 "#;
 
-/// The same narrow datapath with wrap-around.
-pub const NARROW_WRAP: &str = r#"name = "narrow_wrap"
-[c]
-format = "u1.9"
-[d]
-format = "s1.9"
-[t]
-format = "s3.8"
-rounding = "TRN"
-overflow = "WRAP"
-[b]
-format = "u1.8"
-rounding = "TRN"
-overflow = "WRAP"
-[square]
-format = "u1.8"
-rounding = "TRN"
-overflow = "WRAP"
-[coef]
-format = "u10.6"
-rounding = "TRN"
-[out]
-format = "u10.6"
-rounding = "TRN"
-overflow = "WRAP"
-"#;
+/// The narrow datapath of the map with saturation (`narrow_sat`) or wrap-around
+/// (`narrow_wrap`) in every stage: a 10-bit input, 9-bit stages, truncation, and a `u10.6`
+/// coefficient that holds every n up to 4096.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::stability::narrow_datapath;
+/// use specfx::fixed::Overflow;
+/// let c = narrow_datapath(Overflow::Wrap);
+/// assert_eq!((c.name.as_str(), c.t.format.to_string()), ("narrow_wrap", "s3.8".to_string()));
+/// ```
+pub fn narrow_datapath(overflow: Overflow) -> Config {
+    let text = NARROW
+        .replace("{name}", &overflow.to_string().to_lowercase())
+        .replace("{overflow}", &overflow.to_string());
+    Config::from_toml(&text).expect("the built-in narrow datapath is valid")
+}
 
 /// The default paths: every float path of [`FloatPath::default_set`], then `baseline`,
-/// `narrow_sat` and `narrow_wrap`.
+/// `narrow_sat` and `narrow_wrap` ([`narrow_datapath`]).
 pub fn default_paths() -> Vec<Path> {
     let mut v: Vec<Path> = FloatPath::default_set()
         .into_iter()
         .map(Path::Float)
         .collect();
     v.push(Path::Fixed(Box::new(Config::baseline())));
-    for text in DEFAULT_FIXED {
-        v.push(Path::Fixed(Box::new(
-            Config::from_toml(text).expect("the built-in narrow datapaths are valid"),
-        )));
+    for overflow in [Overflow::Sat, Overflow::Wrap] {
+        v.push(Path::Fixed(Box::new(narrow_datapath(overflow))));
     }
     v
 }

@@ -126,6 +126,37 @@ impl Shade {
     }
 }
 
+/// The rectangles of a heat map: along each row, a run of cells of equal `key` becomes one
+/// rectangle `[(x0, row), (x1, row + 1)]`, with the run's key.
+fn row_runs<K: PartialEq + Copy>(
+    m: &PathMap,
+    key: impl Fn(usize, usize) -> K,
+) -> Vec<([(f64, f64); 2], K)> {
+    let cols = &m.heat.columns;
+    let x_edge = |col: usize| match cols.get(col + 1) {
+        Some(next) => f64::from(next.0),
+        None => f64::from(cols[col].1) + 1.0,
+    };
+    let mut v = Vec::new();
+    for row in 0..HEAT_ROWS {
+        let mut start = 0;
+        while start < cols.len() {
+            let k = key(start, row);
+            let mut end = start + 1;
+            while end < cols.len() && key(end, row) == k {
+                end += 1;
+            }
+            let y = row as f64;
+            v.push((
+                [(f64::from(cols[start].0), y), (x_edge(end - 1), y + 1.0)],
+                k,
+            ));
+            start = end;
+        }
+    }
+    v
+}
+
 /// Flags drawn as a cross on a heat-map cell.
 const CROSS_FLAGS: [Kind; 3] = [Kind::NegativeBase, Kind::NonMonotonic, Kind::Wrap];
 
@@ -167,34 +198,16 @@ fn draw_heatmap<DB: DrawingBackend>(
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    // Runs of equal shade along each row become one rectangle.
-    let x_edge = |col: usize| {
-        if col + 1 < cols.len() {
-            f64::from(cols[col + 1].0)
-        } else {
-            x_hi
-        }
+    let x_edge = |col: usize| match cols.get(col + 1) {
+        Some(next) => f64::from(next.0),
+        None => x_hi,
     };
-    let mut rects = Vec::new();
-    for row in 0..HEAT_ROWS {
-        let mut start = 0;
-        while start < cols.len() {
-            let shade = Shade::of(m.heat.cell(start, row), tol);
-            let mut end = start + 1;
-            while end < cols.len() && Shade::of(m.heat.cell(end, row), tol) == shade {
-                end += 1;
-            }
+    let rects = row_runs(m, |col, row| Shade::of(m.heat.cell(col, row), tol))
+        .into_iter()
+        .map(|(corners, shade)| {
             let (r, g, b) = shade.rgb();
-            rects.push(Rectangle::new(
-                [
-                    (f64::from(cols[start].0), row as f64),
-                    (x_edge(end - 1), row as f64 + 1.0),
-                ],
-                RGBColor(r, g, b).filled(),
-            ));
-            start = end;
-        }
-    }
+            Rectangle::new(corners, RGBColor(r, g, b).filled())
+        });
     chart.draw_series(rects).map_err(err)?;
     let mark = |bits: u16| {
         let mut v = Vec::new();
@@ -299,13 +312,6 @@ fn draw_overview<DB: DrawingBackend>(
             .margin(4)
             .build_cartesian_2d((x_lo..x_hi).log_scale(), 0f64..90f64)
             .map_err(err)?;
-        let x_edge = |col: usize| {
-            if col + 1 < cols.len() {
-                f64::from(cols[col + 1].0)
-            } else {
-                x_hi
-            }
-        };
         let class = |col: usize, row: usize| {
             let c = m.heat.cell(col, row);
             let structural =
@@ -320,25 +326,9 @@ fn draw_overview<DB: DrawingBackend>(
                 (120, 198, 121)
             }
         };
-        let mut rects = Vec::new();
-        for row in 0..HEAT_ROWS {
-            let mut start = 0;
-            while start < cols.len() {
-                let k = class(start, row);
-                let mut end = start + 1;
-                while end < cols.len() && class(end, row) == k {
-                    end += 1;
-                }
-                rects.push(Rectangle::new(
-                    [
-                        (f64::from(cols[start].0), row as f64),
-                        (x_edge(end - 1), row as f64 + 1.0),
-                    ],
-                    RGBColor(k.0, k.1, k.2).filled(),
-                ));
-                start = end;
-            }
-        }
+        let rects = row_runs(m, class)
+            .into_iter()
+            .map(|(corners, k)| Rectangle::new(corners, RGBColor(k.0, k.1, k.2).filled()));
         chart.draw_series(rects).map_err(err)?;
     }
     root.present().map_err(err)
