@@ -69,3 +69,43 @@ fn tradeoff_lists_every_method_with_figures_that_hold() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn tradeoff_synthesises_the_datapaths_with_yosys_on_request() {
+    // `./scripts/test` installs yosys. Wider squares cost more logic: the 16-bit squares'
+    // datapath needs more iCE40 LUTs than the 8-bit one, and only datapaths are synthesised.
+    let dir = std::env::temp_dir().join(format!("specfx-tradeoff-yosys-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args([
+            "tradeoff",
+            "--n",
+            "64",
+            "--yosys",
+            "ice40",
+            "--json",
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let list = v.as_array().unwrap();
+    let luts = |name: &str| {
+        let m = list.iter().find(|m| m["method"] == name).unwrap();
+        m["yosys"]["luts"].as_u64()
+    };
+    assert_eq!(luts("schlick"), None);
+    let (l8, l16) = (luts("fixed_sq8").unwrap(), luts("fixed_sq16").unwrap());
+    assert!(l8 > 0 && l16 > l8, "{l8} {l16}");
+    let csv = std::fs::read_to_string(dir.join("tradeoff.csv")).unwrap();
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with("yosys_target,yosys_luts,yosys_dsps,yosys_ffs"));
+    assert!(csv
+        .lines()
+        .any(|l| l.starts_with("fixed_sq8,") && l.contains(",ice40,")));
+}

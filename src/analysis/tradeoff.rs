@@ -30,10 +30,26 @@ pub struct MethodFigures {
     pub multipliers: Option<u32>,
     /// Analytic LUTs of the pipelined datapath (fixed-point methods only).
     pub luts: Option<u64>,
+    /// yosys figures of the pipelined datapath (fixed-point methods, with `--yosys`): the
+    /// target, LUTs (logic gates for generic), DSP blocks and flip-flops.
+    pub yosys: Option<YosysFigures>,
     /// Latency in cycles at initiation interval 1 (pipelined, one register per operation).
     pub latency: Option<u64>,
     /// max over c of the error, for each n of the set.
     pub per_n_max_abs_err: Vec<f64>,
+}
+
+/// yosys figures of one datapath.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct YosysFigures {
+    /// The synthesis target (`ice40`, `xilinx`, `generic`, `generic-fast`).
+    pub target: String,
+    /// LUTs (logic gates for the generic targets).
+    pub luts: u64,
+    /// DSP blocks.
+    pub dsps: u64,
+    /// Flip-flops.
+    pub ffs: u64,
 }
 
 /// The f64 methods compared: powf, repeated-squaring powi, Schlick, exp(-n(1-c)), cs_m with
@@ -102,6 +118,7 @@ pub fn f64_figures(name: &str, method: Method, ns: &[u32]) -> MethodFigures {
         evals_per_s: (ns.len() * cs.len()) as f64 / secs,
         multipliers,
         luts: None,
+        yosys: None,
         latency,
         per_n_max_abs_err: per_n,
     }
@@ -136,6 +153,7 @@ pub fn powi_figures(ns: &[u32]) -> MethodFigures {
         evals_per_s: (ns.len() * cs.len()) as f64 / secs,
         multipliers: None,
         luts: None,
+        yosys: None,
         latency: None,
         per_n_max_abs_err: per_n,
     }
@@ -196,6 +214,7 @@ pub fn fixed_figures(dp: &Datapath) -> MethodFigures {
         evals_per_s: (dp.constants().len() * codes.len()) as f64 / secs,
         multipliers: Some(dp.config().k + 2),
         luts: Some(cost.luts),
+        yosys: None,
         latency: Some(cost.latency),
         per_n_max_abs_err: per_n,
     }

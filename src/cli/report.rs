@@ -239,7 +239,11 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
 
     step("speed against accuracy of every method (the trade-off charts)");
     let tradeoff_dir = dir.join("tradeoff");
-    let figures = super::tradeoff::tradeoff(&tradeoff_dir, &specfx::nset::NSet::range(16, 1024)?)?;
+    let figures = super::tradeoff::tradeoff(
+        &tradeoff_dir,
+        &specfx::nset::NSet::range(16, 1024)?,
+        yosys_present.then_some(specfx::hdl::cost::Target::Ice40),
+    )?;
     written.push(tradeoff_dir.join("tradeoff.csv"));
     written.push(tradeoff_dir.join("speed_accuracy.png"));
     written.push(tradeoff_dir.join("error_vs_n.png"));

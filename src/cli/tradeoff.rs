@@ -11,7 +11,7 @@ use super::output::{print_json, write_atomic};
 use super::Outcome;
 use specfx::analysis::tradeoff::{
     f64_figures, f64_methods, fixed_config, fixed_figures, per_n_chart, powi_figures, speed_chart,
-    MethodFigures,
+    MethodFigures, YosysFigures,
 };
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
@@ -26,6 +26,10 @@ pub struct TradeoffArgs {
     /// Exponents.
     #[arg(long, default_value = "16..=1024")]
     n: NSet,
+    /// Also synthesise the fixed-point datapaths with yosys for this target (ice40, xilinx,
+    /// generic, generic-fast): a few seconds each.
+    #[arg(long)]
+    yosys: Option<specfx::hdl::cost::Target>,
     /// Print the figures as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -38,8 +42,13 @@ fn write_chart(dir: &std::path::Path, stem: &str, chart: &Chart) -> Result<()> {
     write_atomic(&dir.join(format!("{stem}.png")), &png)
 }
 
-/// Computes every method's figures and writes CSV, JSON and charts into `dir`.
-pub fn tradeoff(dir: &std::path::Path, ns: &NSet) -> Result<Vec<MethodFigures>> {
+/// Computes every method's figures (with yosys figures of the datapaths for `yosys`) and
+/// writes CSV, JSON and charts into `dir`.
+pub fn tradeoff(
+    dir: &std::path::Path,
+    ns: &NSet,
+    yosys: Option<specfx::hdl::cost::Target>,
+) -> Result<Vec<MethodFigures>> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let ns_v = ns.values();
     let mut figures = Vec::new();
@@ -54,18 +63,34 @@ pub fn tradeoff(dir: &std::path::Path, ns: &NSet) -> Result<Vec<MethodFigures>> 
         cfg.n = ns.clone();
         let dp = Datapath::new(cfg)?;
         eprintln!("tradeoff: {}", dp.config().name);
-        figures.push(fixed_figures(&dp));
+        let mut f = fixed_figures(&dp);
+        if let Some(target) = yosys {
+            eprintln!(
+                "tradeoff: synthesising {} with yosys ({target})",
+                dp.config().name
+            );
+            let hdl = super::cost::hdl_ref_dir(None);
+            let (cost, _, _) =
+                super::cost::run_yosys(&dp, specfx::cycle::Arch::Pipelined, target, &hdl)?;
+            f.yosys = Some(YosysFigures {
+                target: target.to_string(),
+                luts: cost.luts,
+                dsps: cost.dsps,
+                ffs: cost.ffs,
+            });
+        }
+        figures.push(f);
     }
     let mut csv = Vec::new();
     writeln!(
         csv,
-        "method,kind,max_abs_err,mean_abs_err,evals_per_s,multipliers,luts,latency"
+        "method,kind,max_abs_err,mean_abs_err,evals_per_s,multipliers,luts,latency,yosys_target,yosys_luts,yosys_dsps,yosys_ffs"
     )?;
     let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
     for f in &figures {
         writeln!(
             csv,
-            "{},{},{:e},{:e},{:e},{},{},{}",
+            "{},{},{:e},{:e},{:e},{},{},{},{},{},{},{}",
             f.method,
             f.kind,
             f.max_abs_err,
@@ -73,7 +98,11 @@ pub fn tradeoff(dir: &std::path::Path, ns: &NSet) -> Result<Vec<MethodFigures>> 
             f.evals_per_s,
             opt(f.multipliers.map(u64::from)),
             opt(f.luts),
-            opt(f.latency)
+            opt(f.latency),
+            f.yosys.as_ref().map_or("", |y| y.target.as_str()),
+            opt(f.yosys.as_ref().map(|y| y.luts)),
+            opt(f.yosys.as_ref().map(|y| y.dsps)),
+            opt(f.yosys.as_ref().map(|y| y.ffs))
         )?;
     }
     write_atomic(&dir.join("tradeoff.csv"), &csv)?;
@@ -102,7 +131,7 @@ pub fn tradeoff(dir: &std::path::Path, ns: &NSet) -> Result<Vec<MethodFigures>> 
 
 /// Runs `specfx tradeoff`.
 pub fn run(args: &TradeoffArgs) -> Result<Outcome> {
-    let figures = tradeoff(&args.out, &args.n)?;
+    let figures = tradeoff(&args.out, &args.n, args.yosys)?;
     if args.json {
         print_json(&figures)?;
     } else {
