@@ -3,23 +3,24 @@
 
 use std::process::Command;
 
-#[test]
-fn tradeoff_lists_every_method_with_figures_that_hold() {
-    let dir = std::env::temp_dir().join(format!("specfx-tradeoff-{}", std::process::id()));
+/// Runs `specfx tradeoff --json --out <temp dir named after tag>` with `args`; returns the
+/// parsed JSON and the directory.
+fn tradeoff_json(tag: &str, args: &[&str]) -> (serde_json::Value, std::path::PathBuf) {
+    let dir = std::env::temp_dir().join(format!("specfx-tradeoff-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args([
-            "tradeoff",
-            "--n",
-            "64,256",
-            "--json",
-            "--out",
-            dir.to_str().unwrap(),
-        ])
+        .arg("tradeoff")
+        .args(args)
+        .args(["--json", "--out", dir.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    (serde_json::from_slice(&o.stdout).unwrap(), dir)
+}
+
+#[test]
+fn tradeoff_lists_every_method_with_figures_that_hold() {
+    let (v, dir) = tradeoff_json("all", &["--n", "64,256"]);
     let list = v.as_array().unwrap();
     let names: Vec<&str> = list.iter().map(|m| m["method"].as_str().unwrap()).collect();
     for want in [
@@ -74,23 +75,7 @@ fn tradeoff_lists_every_method_with_figures_that_hold() {
 fn tradeoff_synthesises_the_datapaths_with_yosys_on_request() {
     // `./scripts/test` installs yosys. Wider squares cost more logic: the 16-bit squares'
     // datapath needs more iCE40 LUTs than the 8-bit one, and only datapaths are synthesised.
-    let dir = std::env::temp_dir().join(format!("specfx-tradeoff-yosys-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args([
-            "tradeoff",
-            "--n",
-            "64",
-            "--yosys",
-            "ice40",
-            "--json",
-            "--out",
-            dir.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (v, dir) = tradeoff_json("yosys", &["--n", "64", "--yosys", "ice40"]);
     let list = v.as_array().unwrap();
     let luts = |name: &str| {
         let m = list.iter().find(|m| m["method"] == name).unwrap();

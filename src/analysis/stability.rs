@@ -846,31 +846,35 @@ struct FixedPlan {
     rows: Vec<usize>,
 }
 
-fn fixed_plan(config: &Config, ns: &[u32]) -> Result<FixedPlan, Error> {
+/// The datapath of `config` over the exponents of `ns` it can hold (`None` if it holds none),
+/// with why the first one it cannot hold is refused. An error that names no exponent is the
+/// configuration's own and is returned.
+fn representable(config: &Config, ns: &[u32]) -> Result<(Option<Datapath>, Option<String>), Error> {
     let mut good = Vec::new();
     let mut reason = None;
     for &n in ns {
         let mut cfg = config.clone();
         cfg.n = NSet::range(n, n)?;
-        match Datapath::new(cfg) {
-            Ok(_) => good.push(n),
-            Err(e) => {
-                // An error that names no per-n constant is the configuration's own.
-                let text = e.to_string();
-                if !text.contains(&format!("n = {n}")) {
-                    return Err(e);
-                }
-                reason.get_or_insert(text);
+        if let Err(e) = Datapath::new(cfg) {
+            let text = e.to_string();
+            if !text.contains(&format!("n = {n}")) {
+                return Err(e);
             }
+            reason.get_or_insert(text);
+        } else {
+            good.push(n);
         }
     }
-    let dp = if good.is_empty() {
-        None
-    } else {
-        let mut cfg = config.clone();
-        cfg.n = NSet::from_values(&good)?;
-        Some(Datapath::new(cfg)?)
-    };
+    if good.is_empty() {
+        return Ok((None, reason));
+    }
+    let mut cfg = config.clone();
+    cfg.n = NSet::from_values(&good)?;
+    Ok((Some(Datapath::new(cfg)?), reason))
+}
+
+fn fixed_plan(config: &Config, ns: &[u32]) -> Result<FixedPlan, Error> {
+    let (dp, reason) = representable(config, ns)?;
     let (codes, lobe_scale, out_scale, c_scale) = match &dp {
         Some(dp) => {
             let scale =
@@ -1404,25 +1408,11 @@ pub fn special_outcomes(paths: &[Path], tol: f64) -> Result<Vec<SpecialOutcome>,
     let mut v = Vec::new();
     for path in paths {
         let fixed = match path {
-            Path::Fixed(c) => {
-                let mut cfg = (**c).clone();
-                cfg.n = NSet::from_values(&SPECIAL_N)?;
-                // Exponents it cannot hold are skipped.
-                let ok: Vec<u32> = SPECIAL_N
-                    .iter()
-                    .copied()
-                    .filter(|&n| {
-                        let mut one = cfg.clone();
-                        one.n = NSet::range(n, n).expect("valid");
-                        Datapath::new(one).is_ok()
-                    })
-                    .collect();
-                if ok.is_empty() {
-                    continue;
-                }
-                cfg.n = NSet::from_values(&ok)?;
-                Some(Datapath::new(cfg)?)
-            }
+            // Exponents it cannot hold are skipped.
+            Path::Fixed(c) => match representable(c, &SPECIAL_N)?.0 {
+                Some(dp) => Some(dp),
+                None => continue,
+            },
             Path::Float(_) => None,
         };
         for input in special_inputs() {

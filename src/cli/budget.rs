@@ -10,7 +10,7 @@ use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
 
-use super::output::{print_json, write_atomic};
+use super::output::{print_json, write_atomic, write_chart};
 use super::Outcome;
 use specfx::analysis::budget::{analyse, BudgetReport, FormalBound};
 use specfx::analysis::gappa;
@@ -18,7 +18,6 @@ use specfx::analysis::optimize::Budget;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
 use specfx::report::budget::{charts, document};
-use specfx::report::chart::{render_png, render_svg};
 use specfx::report::doc::{write_html, write_markdown};
 
 /// Arguments of `specfx budget`.
@@ -189,10 +188,7 @@ pub fn budget(
     }
     let mut svgs = Vec::new();
     for (stem, chart) in charts(&report) {
-        let svg = render_svg(&chart).map_err(anyhow::Error::msg)?;
-        let png = render_png(&chart).map_err(anyhow::Error::msg)?;
-        write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
-        write_atomic(&dir.join(format!("{stem}.png")), &png)?;
+        let svg = write_chart(dir, &stem, &chart)?;
         svgs.push((stem, svg));
     }
     let doc = document(&report);

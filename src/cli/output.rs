@@ -30,6 +30,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .with_context(|| format!("cannot rename {} to {}", tmp.display(), path.display()))
 }
 
+/// Writes a figure as `dir/stem.svg` and `dir/stem.png`, each atomically.
+pub fn write_figure(dir: &Path, stem: &str, svg: &str, png: &[u8]) -> Result<()> {
+    write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    write_atomic(&dir.join(format!("{stem}.png")), png)
+}
+
+/// Renders a chart to SVG and PNG, writes both with [`write_figure`] and returns the SVG.
+pub fn write_chart(dir: &Path, stem: &str, chart: &specfx::report::chart::Chart) -> Result<String> {
+    let svg = specfx::report::chart::render_svg(chart).map_err(anyhow::Error::msg)?;
+    let png = specfx::report::chart::render_png(chart).map_err(anyhow::Error::msg)?;
+    write_figure(dir, stem, &svg, &png)?;
+    Ok(svg)
+}
+
 /// Renders into a buffer with a writer function, then prints it to stdout in one go.
 pub fn print_with(render: impl FnOnce(&mut Vec<u8>) -> io::Result<()>) -> Result<()> {
     let mut buf = Vec::new();

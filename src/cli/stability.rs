@@ -9,13 +9,12 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::output::{print_json, write_atomic};
+use super::output::{print_json, write_atomic, write_chart, write_figure};
 use super::Outcome;
 use specfx::analysis::stability::{
     analyse, default_paths, FloatPath, Grid, Path as MapPath, StabilityReport, Tolerance,
 };
 use specfx::nset::NSet;
-use specfx::report::chart::{render_png, render_svg};
 use specfx::report::doc::{write_html, write_markdown};
 use specfx::report::stability::{
     document, heatmap_png, heatmap_stem, heatmap_svg, overshoot_chart, overview_png, overview_svg,
@@ -92,11 +91,6 @@ fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
     Ok(paths)
 }
 
-fn write_chart_files(dir: &Path, stem: &str, svg: String, png: Vec<u8>) -> Result<()> {
-    write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
-    write_atomic(&dir.join(format!("{stem}.png")), &png)
-}
-
 /// Maps every path of `paths` over `grid` and writes the report into `dir`; returns the report.
 pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<StabilityReport> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -140,28 +134,21 @@ pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<Stability
     eprintln!("stability: writing heat maps and tables");
     let tol = grid.tol.value;
     for m in &report.maps {
-        write_chart_files(
+        write_figure(
             dir,
             &heatmap_stem(&m.path),
-            heatmap_svg(m, tol).map_err(anyhow::Error::msg)?,
-            heatmap_png(m, tol).map_err(anyhow::Error::msg)?,
+            &heatmap_svg(m, tol).map_err(anyhow::Error::msg)?,
+            &heatmap_png(m, tol).map_err(anyhow::Error::msg)?,
         )?;
     }
     let overview = overview_svg(&report.maps, tol).map_err(anyhow::Error::msg)?;
-    write_chart_files(
+    write_figure(
         dir,
         "overview",
-        overview.clone(),
-        overview_png(&report.maps, tol).map_err(anyhow::Error::msg)?,
+        &overview,
+        &overview_png(&report.maps, tol).map_err(anyhow::Error::msg)?,
     )?;
-    let chart = overshoot_chart(&report);
-    let overshoot = render_svg(&chart).map_err(anyhow::Error::msg)?;
-    write_chart_files(
-        dir,
-        "overshoot",
-        overshoot.clone(),
-        render_png(&chart).map_err(anyhow::Error::msg)?,
-    )?;
+    let overshoot = write_chart(dir, "overshoot", &overshoot_chart(&report))?;
     let mut buf = Vec::new();
     write_regions_csv(&mut buf, &report)?;
     write_atomic(&dir.join("regions.csv"), &buf)?;

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 
-use super::output::{print_json, write_atomic};
+use super::output::{print_json, write_atomic, write_chart};
 use super::Outcome;
 use specfx::analysis::tradeoff::{
     f64_figures, f64_methods, fixed_config, fixed_figures, per_n_chart, powi_figures, speed_chart,
@@ -15,7 +15,6 @@ use specfx::analysis::tradeoff::{
 };
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
-use specfx::report::chart::{render_png, render_svg, Chart};
 
 /// Arguments of `specfx tradeoff`.
 #[derive(Debug, Args)]
@@ -33,13 +32,6 @@ pub struct TradeoffArgs {
     /// Print the figures as JSON on stdout.
     #[arg(long)]
     json: bool,
-}
-
-fn write_chart(dir: &std::path::Path, stem: &str, chart: &Chart) -> Result<()> {
-    let svg = render_svg(chart).map_err(anyhow::Error::msg)?;
-    write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
-    let png = render_png(chart).map_err(anyhow::Error::msg)?;
-    write_atomic(&dir.join(format!("{stem}.png")), &png)
 }
 
 /// Computes every method's figures (with yosys figures of the datapaths for `yosys`) and

@@ -126,6 +126,16 @@ impl Shade {
     }
 }
 
+/// Where column `col` of a heat map ends on the n axis: the next column's first n (the last
+/// column ends one past its last n).
+fn column_end(m: &PathMap, col: usize) -> f64 {
+    let cols = &m.heat.columns;
+    match cols.get(col + 1) {
+        Some(next) => f64::from(next.0),
+        None => f64::from(cols[col].1) + 1.0,
+    }
+}
+
 /// The rectangles of a heat map: along each row, a run of cells of equal `key` becomes one
 /// rectangle `[(x0, row), (x1, row + 1)]`, with the run's key.
 fn row_runs<K: PartialEq + Copy>(
@@ -133,10 +143,7 @@ fn row_runs<K: PartialEq + Copy>(
     key: impl Fn(usize, usize) -> K,
 ) -> Vec<([(f64, f64); 2], K)> {
     let cols = &m.heat.columns;
-    let x_edge = |col: usize| match cols.get(col + 1) {
-        Some(next) => f64::from(next.0),
-        None => f64::from(cols[col].1) + 1.0,
-    };
+    let x_edge = |col: usize| column_end(m, col);
     let mut v = Vec::new();
     for row in 0..HEAT_ROWS {
         let mut start = 0;
@@ -198,10 +205,6 @@ fn draw_heatmap<DB: DrawingBackend>(
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    let x_edge = |col: usize| match cols.get(col + 1) {
-        Some(next) => f64::from(next.0),
-        None => x_hi,
-    };
     let rects = row_runs(m, |col, row| Shade::of(m.heat.cell(col, row), tol))
         .into_iter()
         .map(|(corners, shade)| {
@@ -214,7 +217,7 @@ fn draw_heatmap<DB: DrawingBackend>(
         for (col, &(first, _)) in cols.iter().enumerate() {
             for row in 0..HEAT_ROWS {
                 if m.heat.cell(col, row).flags & bits != 0 {
-                    let x = (f64::from(first) * x_edge(col)).sqrt();
+                    let x = (f64::from(first) * column_end(m, col)).sqrt();
                     v.push((x, row as f64 + 0.5));
                 }
             }
