@@ -1,5 +1,8 @@
 //! Properties of the datapath on random configurations: the batch kernels equal the plain
-//! model bit for bit, and TOML round trips.
+//! model bit for bit, and TOML round trips. Two generators: everyday configurations, and
+//! configurations at the edges of what validation accepts (fraction bits from -300 to 300,
+//! shifts of 62 to 600 bits, 64-bit and one-bit formats), where the batch plan must fall back
+//! to the exact kernel.
 
 use proptest::prelude::*;
 use specfx::fixed::{Event, Format, Overflow, Rounding};
@@ -77,6 +80,110 @@ prop_compose! {
     }
 }
 
+/// Fraction bits weighted towards the edges: far negative, around zero, far positive.
+fn edge_frac() -> impl Strategy<Value = i32> {
+    prop_oneof![-300i32..=-40, -40i32..=40, 40i32..=300, Just(62), Just(-62)]
+}
+
+/// A format of any accepted width (1 to 64 bits, unsigned up to 63) with edge fraction bits.
+fn edge_format() -> impl Strategy<Value = Format> {
+    (
+        any::<bool>(),
+        prop_oneof![1u32..=4, 5u32..=40, 41u32..=64],
+        edge_frac(),
+    )
+        .prop_map(|(signed, width, frac)| {
+            let width = if signed { width } else { width.min(63) };
+            fmt(signed, width as i32 - frac, frac)
+        })
+}
+
+fn edge_stage() -> impl Strategy<Value = StageSpec> {
+    (
+        edge_format(),
+        prop::sample::select(Rounding::ALL.to_vec()),
+        prop::sample::select(Overflow::ALL.to_vec()),
+    )
+        .prop_map(|(format, rounding, overflow)| StageSpec {
+            format,
+            rounding,
+            overflow,
+        })
+}
+
+/// A stage that is either an everyday one or an edge one, so that configurations mix both
+/// and enough of them pass validation.
+fn mixed_stage() -> impl Strategy<Value = StageSpec> {
+    prop_oneof![stage(), edge_stage()]
+}
+
+prop_compose! {
+    fn edge_config()(
+        base in config(),
+        wide_d in 0i32..=40,
+        t in mixed_stage(),
+        b in mixed_stage(),
+        squares in prop::collection::vec(mixed_stage(), 7),
+        out in mixed_stage(),
+        coef_frac in prop_oneof![-3i32..=2, 2i32..=20, 20i32..=54],
+        a_frac in 4i32..=40,
+    ) -> Config {
+        let mut cfg = base;
+        let c = cfg.c.format;
+        cfg.d.format = fmt(true, c.int_bits() + 1, c.frac_bits() + wide_d);
+        cfg.t = t;
+        cfg.b = b;
+        cfg.square = squares[..cfg.k as usize].to_vec();
+        cfg.out = out;
+        cfg.coef.format = fmt(false, 9, coef_frac);
+        cfg.minimax.a_format = fmt(false, 8, a_frac);
+        cfg
+    }
+}
+
+/// Every code of a small input format, or a spread of codes and both ends of a wide one.
+fn codes_of(dp: &Datapath) -> Vec<i64> {
+    let codes = dp.input_codes();
+    let (lo, hi) = (*codes.start(), *codes.end());
+    if hi - lo <= 20_000 {
+        return codes.collect();
+    }
+    let step = (hi - lo) / 10_000;
+    let one = dp.one_code();
+    let mut v: Vec<i64> = (0..=10_000).map(|i| lo + i * step).collect();
+    v.extend([hi, one - 1, one, one + 1]);
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// `eval_batch` against `eval` on every code of `codes_of`, events included.
+fn batch_equals_scalar(dp: &Datapath) -> Result<(), TestCaseError> {
+    let codes = codes_of(dp);
+    let mut cols = ProbeColumns::default();
+    for nc in dp.constants() {
+        dp.eval_batch(nc, &codes, &mut cols);
+        let mut counts = vec![[0u64; 3]; dp.stages().len()];
+        for (i, &code) in codes.iter().enumerate() {
+            let p = dp.eval(code, nc);
+            let row = cols.row(i);
+            prop_assert_eq!(&row.values[..], &p.values[..], "n={} code={}", nc.n, code);
+            prop_assert_eq!(row.cut, p.cut);
+            prop_assert_eq!(row.input_clamped, p.input_clamped);
+            for (stage_idx, e) in p.events.iter().take(dp.stages().len()).enumerate() {
+                match e {
+                    Event::None => {}
+                    Event::Wrapped => counts[stage_idx][0] += 1,
+                    Event::Saturated => counts[stage_idx][1] += 1,
+                    Event::Zeroed => counts[stage_idx][2] += 1,
+                }
+            }
+        }
+        prop_assert_eq!(&counts, &cols.event_counts, "n={}", nc.n);
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(96))]
 
@@ -85,30 +192,23 @@ proptest! {
         // A configuration the validation refuses has nothing to compare.
         let dp = Datapath::new(cfg.clone());
         prop_assume!(dp.is_ok());
-        let dp = dp.unwrap();
-        let codes: Vec<i64> = dp.input_codes().collect();
-        let mut cols = ProbeColumns::default();
-        for nc in dp.constants() {
-            dp.eval_batch(nc, &codes, &mut cols);
-            let mut counts = vec![[0u64; 3]; dp.stages().len()];
-            for (i, &code) in codes.iter().enumerate() {
-                let p = dp.eval(code, nc);
-                let row = cols.row(i);
-                prop_assert_eq!(&row.values[..], &p.values[..], "n={} code={}", nc.n, code);
-                prop_assert_eq!(row.cut, p.cut);
-                prop_assert_eq!(row.input_clamped, p.input_clamped);
-                for (stage_idx, e) in p.events.iter().take(dp.stages().len()).enumerate() {
-                    match e {
-                        Event::None => {}
-                        Event::Wrapped => counts[stage_idx][0] += 1,
-                        Event::Saturated => counts[stage_idx][1] += 1,
-                        Event::Zeroed => counts[stage_idx][2] += 1,
-                    }
-                }
-            }
-            prop_assert_eq!(&counts, &cols.event_counts);
-        }
+        batch_equals_scalar(&dp.unwrap())?;
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, max_global_rejects: 100_000, ..ProptestConfig::default() })]
+
+    #[test]
+    fn batch_kernels_equal_the_plain_model_at_the_edges(cfg in edge_config()) {
+        let dp = Datapath::new(cfg.clone());
+        prop_assume!(dp.is_ok());
+        batch_equals_scalar(&dp.unwrap())?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(96))]
 
     #[test]
     fn any_configuration_round_trips_through_toml(cfg in config()) {

@@ -6,9 +6,11 @@
 //! [`Event`] in the [`Probes`].
 
 use crate::error::Error;
-use crate::fixed::{quantize, quantize_i64, Event, Exact, Format, Overflow, Quantized};
-use crate::pipeline::config::{Config, StageSpec, Variant};
-use crate::pipeline::fast::{run_stage, EventCounts, FastPlan, Pre, StageQ};
+use crate::fixed::{quantize, Event, Exact, Format, Overflow, Quantized};
+use crate::pipeline::config::{Config, Variant};
+use crate::pipeline::fast::{
+    constant_bits, count_event, magnitude_bits, quantize_to, BatchPlan, EventCounts, Kernel, Pre,
+};
 use crate::reference::lobe::{m_of_k, Cutoff, PAPER_CUTOFF_CONSTANT};
 use crate::reference::minimax;
 use crate::reference::normalisation::coefficient;
@@ -148,7 +150,7 @@ pub struct Datapath {
     constants: Vec<NConstants>,
     one_raw: i64,
     d_shift: u32,
-    fast: Option<FastPlan>,
+    plan: BatchPlan,
 }
 
 fn config_error(key: &str, problem: String) -> Error {
@@ -168,20 +170,6 @@ fn sum_bits(a: Format, b: Format) -> u32 {
     let frac = a.frac_bits().max(b.frac_bits());
     let int = a.int_bits().max(b.int_bits());
     u32::try_from(i64::from(int) + i64::from(frac) + 1).unwrap_or(u32::MAX)
-}
-
-/// Quantizes an exact value `raw * 2^-frac` to a stage's spec.
-#[inline]
-fn quantize_to(raw: i128, frac: i32, spec: &StageSpec) -> Quantized {
-    match i64::try_from(raw) {
-        Ok(r) => quantize_i64(r, frac, spec.format, spec.rounding, spec.overflow),
-        Err(_) => quantize(
-            Exact::new(raw, frac),
-            spec.format,
-            spec.rounding,
-            spec.overflow,
-        ),
-    }
 }
 
 /// Rounds an f64 constant into a format; it must fit.
@@ -270,7 +258,7 @@ impl Datapath {
             ));
         }
         let d_shift = d_shift as u32;
-        if i128::from(cf.min_raw() - one_raw) << d_shift < i128::from(df.min_raw()) {
+        if (i128::from(cf.min_raw()) - i128::from(one_raw)) << d_shift < i128::from(df.min_raw()) {
             return Err(config_error(
                 "d.format",
                 format!("cannot hold {d_min} exactly, got {df}"),
@@ -309,7 +297,6 @@ impl Datapath {
             "out".to_string(),
             product_bits(prev.width(), config.coef.format.width()),
         ));
-        let fits_i64 = checks.iter().all(|&(_, bits)| bits <= 62);
         for (stage, bits) in checks {
             if bits > MAX_EXACT_BITS {
                 return Err(config_error(
@@ -347,38 +334,66 @@ impl Datapath {
             name: "out".into(),
             format: config.out.format,
         });
-        let fast = fits_i64.then(|| Self::fast_plan(&config, &constants));
+        let plan = Self::batch_plan(&config, &constants);
         Ok(Datapath {
             config,
             stages,
             constants,
             one_raw,
             d_shift,
-            fast,
+            plan,
         })
     }
 
-    fn fast_plan(config: &Config, constants: &[NConstants]) -> FastPlan {
+    /// Chooses each stage's batch kernel from a bound on its exact input: the magnitude bits
+    /// of the formats and constants feeding it (a product adds its factors' bits, a sum takes
+    /// the larger aligned term's bits plus one).
+    fn batch_plan(config: &Config, constants: &[NConstants]) -> BatchPlan {
         // The slope's and offset's fraction bits are the same for every n.
         let (slope_frac, offset_frac) = constants
             .first()
             .map_or((0, 0), |c| (c.slope_frac, c.offset_frac));
+        let slope_bits = constant_bits(constants.iter().map(|c| c.slope_raw));
+        let offset_bits = constant_bits(constants.iter().map(|c| c.offset_raw));
+        let coef_bits = constant_bits(constants.iter().map(|c| c.coef_raw));
         let ft = config.t.format.frac_bits();
         let fb = ft.max(offset_frac);
+        let t_align = (fb - ft) as u32;
+        let offset_align = (fb - offset_frac) as u32;
+        let sum_bits = (magnitude_bits(config.t.format).saturating_add(t_align))
+            .max(offset_bits.saturating_add(offset_align))
+            .saturating_add(1);
         let mut squares = Vec::with_capacity(config.square.len());
-        let mut fs = config.b.format.frac_bits();
+        let mut prev = config.b.format;
         for spec in &config.square {
-            squares.push(StageQ::new(2 * fs, spec));
-            fs = spec.format.frac_bits();
+            squares.push(Kernel::for_stage(
+                2 * prev.frac_bits(),
+                2 * magnitude_bits(prev),
+                spec,
+            ));
+            prev = spec.format;
         }
-        FastPlan {
-            t: StageQ::new(config.d.format.frac_bits() + slope_frac, &config.t),
-            t_align: (fb - ft) as u32,
-            offset_align: (fb - offset_frac) as u32,
-            b: StageQ::new(fb, &config.b),
+        BatchPlan {
+            t: Kernel::for_stage(
+                config.d.format.frac_bits() + slope_frac,
+                magnitude_bits(config.d.format) + slope_bits,
+                &config.t,
+            ),
+            t_align,
+            offset_align,
+            b: Kernel::for_stage(fb, sum_bits, &config.b),
             squares,
-            out: StageQ::new(fs + config.coef.format.frac_bits(), &config.out),
+            out: Kernel::for_stage(
+                prev.frac_bits() + config.coef.format.frac_bits(),
+                magnitude_bits(prev) + coef_bits,
+                &config.out,
+            ),
         }
+    }
+
+    /// The batch plan: which stages run the `i64` kernels and which the exact fallback.
+    pub fn batch_plan_of(&self) -> &BatchPlan {
+        &self.plan
     }
 
     fn constants_of(config: &Config, n: u32, one_raw: i64) -> Result<NConstants, Error> {
@@ -607,23 +622,7 @@ impl Datapath {
     pub fn eval_batch(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
         let n_stages = self.stages.len();
         cols.reset(n_stages, codes.len());
-        let Some(plan) = &self.fast else {
-            for (i, &code) in codes.iter().enumerate() {
-                let p = self.eval(code, nc);
-                for stage_idx in 0..n_stages {
-                    cols.values[stage_idx][i] = p.values[stage_idx];
-                    match p.events[stage_idx] {
-                        Event::None => {}
-                        Event::Wrapped => cols.event_counts[stage_idx][0] += 1,
-                        Event::Saturated => cols.event_counts[stage_idx][1] += 1,
-                        Event::Zeroed => cols.event_counts[stage_idx][2] += 1,
-                    }
-                }
-                cols.cut[i] = p.cut;
-                cols.input_clamped[i] = p.input_clamped;
-            }
-            return;
-        };
+        let plan = &self.plan;
         let one = self.one_raw;
         let d_shift = self.d_shift;
         for ((d, clamped), &code) in cols.values[STAGE_D]
@@ -634,20 +633,36 @@ impl Datapath {
             *clamped = code > one;
             *d = (code.min(one) - one) << d_shift;
         }
-        let stage = |cols: &mut ProbeColumns, q: &StageQ, pre: Pre, from: usize, to: usize| {
+        let stage = |cols: &mut ProbeColumns, kernel: &Kernel, pre: Pre, from: usize, to: usize| {
             let (head, tail) = cols.values.split_at_mut(to);
-            run_stage(
-                q,
-                pre,
-                &head[from],
-                &mut tail[0],
-                &mut cols.event_counts[to],
-            );
+            kernel.run(pre, &head[from], &mut tail[0], &mut cols.event_counts[to]);
         };
         stage(cols, &plan.t, Pre::Mul(nc.slope_raw), STAGE_D, STAGE_T);
         // The exact sum and the cutoff, then the b stage.
-        let offset = nc.offset_raw << plan.offset_align;
-        let t_align = plan.t_align;
+        if plan.b.is_fast() {
+            self.b_stage_i64(nc, codes, cols);
+        } else {
+            self.b_stage_exact(nc, codes, cols);
+        }
+        for (i, kernel) in plan.squares.iter().enumerate() {
+            stage(cols, kernel, Pre::Square, STAGE_SQ0 + i - 1, STAGE_SQ0 + i);
+        }
+        let coef_idx = STAGE_SQ0 + plan.squares.len();
+        cols.values[coef_idx].fill(nc.coef_raw);
+        stage(
+            cols,
+            &plan.out,
+            Pre::Mul(nc.coef_raw),
+            coef_idx - 1,
+            coef_idx + 1,
+        );
+    }
+
+    /// The b stage of a batch when its exact sums are proven to fit in `i64`.
+    fn b_stage_i64(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
+        let one = self.one_raw;
+        let offset = nc.offset_raw << self.plan.offset_align;
+        let t_align = self.plan.t_align;
         let threshold = nc.threshold.unwrap_or(i64::MIN);
         let cutoff = self.config.cutoff;
         let mut sums = std::mem::take(&mut cols.scratch);
@@ -671,26 +686,24 @@ impl Datapath {
                     }
                 }),
         );
-        run_stage(
-            &plan.b,
+        self.plan.b.run(
             Pre::Identity,
             &sums,
             &mut cols.values[STAGE_B],
             &mut cols.event_counts[STAGE_B],
         );
         cols.scratch = sums;
-        for (i, q) in plan.squares.iter().enumerate() {
-            stage(cols, q, Pre::Square, STAGE_SQ0 + i - 1, STAGE_SQ0 + i);
+    }
+
+    /// The b stage of a batch through [`Datapath::op_add_b`], one element at a time.
+    fn b_stage_exact(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
+        let one = self.one_raw;
+        for (i, &code) in codes.iter().enumerate() {
+            let (b, cut) = self.op_add_b(cols.values[STAGE_T][i], code.min(one), nc);
+            cols.values[STAGE_B][i] = b.raw;
+            cols.cut[i] = cut;
+            count_event(&mut cols.event_counts[STAGE_B], b.event);
         }
-        let coef_idx = STAGE_SQ0 + plan.squares.len();
-        cols.values[coef_idx].fill(nc.coef_raw);
-        stage(
-            cols,
-            &plan.out,
-            Pre::Mul(nc.coef_raw),
-            coef_idx - 1,
-            coef_idx + 1,
-        );
     }
 }
 

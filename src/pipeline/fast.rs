@@ -4,8 +4,13 @@
 //!
 //! These kernels are an optimisation of [`crate::pipeline::Datapath::eval`], which is the
 //! plain transcription of the arithmetic; the tests compare the two on random configurations.
+//!
+//! A kernel is used only where it is proven exact: [`StageQ::proven`] takes a bound on the
+//! stage's exact input and accepts the stage only when every shift is below 63 bits and every
+//! intermediate, shifted, stays below 2^62. Any other stage runs [`Kernel::Exact`], the same
+//! `i128` quantization as `eval`, one element at a time.
 
-use crate::fixed::{Format, Overflow, Rounding};
+use crate::fixed::{quantize, quantize_i64, Event, Exact, Format, Overflow, Quantized, Rounding};
 use crate::pipeline::config::StageSpec;
 
 /// Event codes counted by the kernels: index 0 wrapped, 1 saturated, 2 zeroed.
@@ -40,12 +45,43 @@ pub struct StageQ {
     overflow: Overflow,
 }
 
+/// The largest number of magnitude bits an `i64` kernel handles: every exact input, and every
+/// value shifted left, stays below `2^MAX_KERNEL_BITS`, so no `i64` operation can overflow.
+pub const MAX_KERNEL_BITS: u32 = 62;
+
 impl StageQ {
-    /// A stage receiving exact values with `frac_in` fraction bits; the caller guarantees the
-    /// shift is below 63 and every value fits in `i64`.
-    pub fn new(frac_in: i32, spec: &StageSpec) -> StageQ {
-        let shift = frac_in - spec.format.frac_bits();
-        let right = shift.max(0) as u32;
+    /// The `i64` kernel of a stage receiving exact values with `frac_in` fraction bits whose
+    /// magnitudes are below `2^in_bits`, or `None` when it would not be exact: a right shift of
+    /// 63 bits or more, or an input or a left-shifted value that may reach `2^62`.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::fixed::{Overflow, Rounding};
+    /// use specfx::pipeline::fast::StageQ;
+    /// use specfx::pipeline::StageSpec;
+    /// let spec = |f: &str| StageSpec {
+    ///     format: f.parse().unwrap(),
+    ///     rounding: Rounding::Rnd,
+    ///     overflow: Overflow::Sat,
+    /// };
+    /// // u1.15 x u8.16 (40 bits, 31 fraction bits) into s1.62: a left shift by 31.
+    /// assert!(StageQ::proven(31, 40, &spec("s1.62")).is_none());
+    /// assert!(StageQ::proven(31, 40, &spec("u8.16")).is_some());
+    /// // 19 fraction bits into s60.-56: a right shift by 75.
+    /// assert!(StageQ::proven(19, 27, &spec("s60.-56")).is_none());
+    /// ```
+    pub fn proven(frac_in: i32, in_bits: u32, spec: &StageSpec) -> Option<StageQ> {
+        let shift = i64::from(frac_in) - i64::from(spec.format.frac_bits());
+        let right = u32::try_from(shift.max(0)).ok()?;
+        let left = u32::try_from((-shift).max(0)).ok()?;
+        let exact = right <= MAX_KERNEL_BITS
+            && in_bits
+                .checked_add(left)
+                .is_some_and(|bits| bits <= MAX_KERNEL_BITS);
+        exact.then(|| StageQ::new(right, left, spec))
+    }
+
+    fn new(right: u32, left: u32, spec: &StageSpec) -> StageQ {
         let (mask, half) = if right == 0 {
             (0, 0)
         } else {
@@ -54,7 +90,7 @@ impl StageQ {
         let format: Format = spec.format;
         StageQ {
             right,
-            left: (-shift).max(0) as u32,
+            left,
             mask,
             half,
             unused: 64 - format.width(),
@@ -226,21 +262,119 @@ fn run_stage_any(
     }
 }
 
-/// The `i64` plan of a whole datapath.
+/// Quantizes an exact value `raw * 2^-frac` to a stage's spec: the plain transcription that
+/// [`Datapath::eval`](crate::pipeline::Datapath::eval) uses, and the kernels' fallback.
+#[inline]
+pub fn quantize_to(raw: i128, frac: i32, spec: &StageSpec) -> Quantized {
+    match i64::try_from(raw) {
+        Ok(r) => quantize_i64(r, frac, spec.format, spec.rounding, spec.overflow),
+        Err(_) => quantize(
+            Exact::new(raw, frac),
+            spec.format,
+            spec.rounding,
+            spec.overflow,
+        ),
+    }
+}
+
+/// Adds one quantization's overflow event to a stage's counts.
+#[inline]
+pub fn count_event(counts: &mut EventCounts, event: Event) {
+    match event {
+        Event::None => {}
+        Event::Wrapped => counts[0] += 1,
+        Event::Saturated => counts[1] += 1,
+        Event::Zeroed => counts[2] += 1,
+    }
+}
+
+/// How a batch computes one stage: the specialised `i64` loop where it is proven exact, the
+/// `i128` transcription otherwise.
 #[derive(Debug, Clone)]
-pub struct FastPlan {
+pub enum Kernel {
+    /// The `i64` loop (see [`StageQ::proven`]).
+    Fast(StageQ),
+    /// Exact `i128` products and [`quantize_to`], one element at a time.
+    Exact {
+        /// Fraction bits of the exact input.
+        frac_in: i32,
+        /// The stage's format and modes.
+        spec: StageSpec,
+    },
+}
+
+impl Kernel {
+    /// The fastest exact kernel of a stage whose exact input has `frac_in` fraction bits and
+    /// magnitudes below `2^in_bits`.
+    pub fn for_stage(frac_in: i32, in_bits: u32, spec: &StageSpec) -> Kernel {
+        match StageQ::proven(frac_in, in_bits, spec) {
+            Some(q) => Kernel::Fast(q),
+            None => Kernel::Exact {
+                frac_in,
+                spec: *spec,
+            },
+        }
+    }
+
+    /// Whether this is the `i64` loop.
+    pub fn is_fast(&self) -> bool {
+        matches!(self, Kernel::Fast(_))
+    }
+
+    /// Applies the stage to a column: `output[i] = quantize(pre(input[i]))`, counting events.
+    pub fn run(&self, pre: Pre, input: &[i64], output: &mut [i64], counts: &mut EventCounts) {
+        match self {
+            Kernel::Fast(q) => run_stage(q, pre, input, output, counts),
+            Kernel::Exact { frac_in, spec } => {
+                for (x, y) in input.iter().zip(output.iter_mut()) {
+                    let x = i128::from(*x);
+                    let exact = match pre {
+                        Pre::Mul(c) => x * i128::from(c),
+                        Pre::Square => x * x,
+                        Pre::Identity => x,
+                    };
+                    let q = quantize_to(exact, *frac_in, spec);
+                    *y = q.raw;
+                    count_event(counts, q.event);
+                }
+            }
+        }
+    }
+}
+
+/// Bits needed for the magnitude of a raw value of `format`: every raw `x` has
+/// `|x| < 2^bits`.
+pub fn magnitude_bits(format: Format) -> u32 {
+    let m = format
+        .min_raw()
+        .unsigned_abs()
+        .max(format.max_raw().unsigned_abs());
+    64 - m.leading_zeros()
+}
+
+/// Bits needed for the magnitude of a constant's raw values.
+pub fn constant_bits(raws: impl Iterator<Item = i64>) -> u32 {
+    raws.map(|r| 64 - r.unsigned_abs().leading_zeros())
+        .max()
+        .unwrap_or(0)
+}
+
+/// The batch plan of a whole datapath: one kernel per quantizing stage.
+#[derive(Debug, Clone)]
+pub struct BatchPlan {
     /// The t stage (input: d * slope).
-    pub t: StageQ,
+    pub t: Kernel,
     /// Left shift aligning t on the exact sum's fraction bits.
     pub t_align: u32,
     /// Left shift aligning the offset on the exact sum's fraction bits.
     pub offset_align: u32,
-    /// The b stage (input: the exact sum after the cutoff).
-    pub b: StageQ,
+    /// The b stage (input: the exact sum after the cutoff); when it is [`Kernel::Fast`] the
+    /// sum itself is proven to fit in `i64`.
+    pub b: Kernel,
     /// The squaring stages.
-    pub squares: Vec<StageQ>,
+    pub squares: Vec<Kernel>,
     /// The output stage (input: sq_k * coef).
-    pub out: StageQ,
+    pub out: Kernel,
 }
 
 #[cfg(test)]
@@ -267,7 +401,7 @@ mod tests {
                             rounding,
                             overflow,
                         };
-                        let q = StageQ::new(frac_in, &spec);
+                        let q = StageQ::proven(frac_in, 10, &spec).expect("small shifts");
                         let input: Vec<i64> = (-300..=300).collect();
                         let mut out = vec![0; input.len()];
                         let mut counts = [0; 3];
