@@ -18,6 +18,7 @@
 
 pub mod analysis;
 pub mod cycle;
+pub mod engine;
 pub mod error;
 pub mod fixed;
 pub mod golden;

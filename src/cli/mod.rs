@@ -16,6 +16,7 @@ mod report;
 mod sim;
 pub mod stability;
 mod sweep;
+mod throughput;
 pub mod tradeoff;
 pub mod vectors;
 
@@ -61,6 +62,8 @@ enum Command {
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
     Minimax(reference::MinimaxArgs),
+    /// Measures how fast the engine computes a datapath's outputs, with a checksum.
+    Throughput(throughput::ThroughputArgs),
 }
 
 /// What a command reports back besides errors.
@@ -105,6 +108,7 @@ pub fn main() -> ExitCode {
         Command::Tradeoff(args) => tradeoff::run(&args),
         Command::Stability(args) => stability::run(&args),
         Command::Hdl(args) => hdl::run(&args),
+        Command::Throughput(args) => throughput::run(&args),
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,

@@ -151,6 +151,7 @@ pub struct Datapath {
     one_raw: i64,
     d_shift: u32,
     plan: BatchPlan,
+    chain: std::sync::OnceLock<Option<ChainTable>>,
 }
 
 fn config_error(key: &str, problem: String) -> Error {
@@ -342,6 +343,7 @@ impl Datapath {
             one_raw,
             d_shift,
             plan,
+            chain: std::sync::OnceLock::new(),
         })
     }
 
@@ -639,11 +641,16 @@ impl Datapath {
         };
         stage(cols, &plan.t, Pre::Mul(nc.slope_raw), STAGE_D, STAGE_T);
         // The exact sum and the cutoff, then the b stage.
-        if plan.b.is_fast() {
-            self.b_stage_i64(nc, codes, cols);
-        } else {
-            self.b_stage_exact(nc, codes, cols);
-        }
+        let (head, tail) = cols.values.split_at_mut(STAGE_B);
+        self.b_column(
+            nc,
+            codes,
+            &head[STAGE_T],
+            &mut tail[0],
+            &mut cols.cut,
+            &mut cols.scratch,
+            &mut cols.event_counts[STAGE_B],
+        );
         for (i, kernel) in plan.squares.iter().enumerate() {
             stage(cols, kernel, Pre::Square, STAGE_SQ0 + i - 1, STAGE_SQ0 + i);
         }
@@ -658,20 +665,39 @@ impl Datapath {
         );
     }
 
-    /// The b stage of a batch when its exact sums are proven to fit in `i64`.
-    fn b_stage_i64(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
+    /// The b stage over columns: the exact sum `t + offset`, the cutoff, then b's kernel (the
+    /// `i64` loop when the sums are proven to fit, [`Datapath::op_add_b`] per element
+    /// otherwise).
+    #[allow(clippy::too_many_arguments)]
+    fn b_column(
+        &self,
+        nc: &NConstants,
+        codes: &[i64],
+        t: &[i64],
+        b: &mut [i64],
+        cut: &mut [bool],
+        sums: &mut Vec<i64>,
+        counts: &mut EventCounts,
+    ) {
         let one = self.one_raw;
+        if !self.plan.b.is_fast() {
+            for (i, &code) in codes.iter().enumerate() {
+                let (q, was_cut) = self.op_add_b(t[i], code.min(one), nc);
+                b[i] = q.raw;
+                cut[i] = was_cut;
+                count_event(counts, q.event);
+            }
+            return;
+        }
         let offset = nc.offset_raw << self.plan.offset_align;
         let t_align = self.plan.t_align;
         let threshold = nc.threshold.unwrap_or(i64::MIN);
         let cutoff = self.config.cutoff;
-        let mut sums = std::mem::take(&mut cols.scratch);
         sums.clear();
         sums.extend(
-            cols.values[STAGE_T]
-                .iter()
+            t.iter()
                 .zip(codes)
-                .zip(cols.cut.iter_mut())
+                .zip(cut.iter_mut())
                 .map(|((&t, &code), cut)| {
                     let sum = (t << t_align) + offset;
                     *cut = match cutoff {
@@ -686,25 +712,111 @@ impl Datapath {
                     }
                 }),
         );
-        self.plan.b.run(
-            Pre::Identity,
-            &sums,
-            &mut cols.values[STAGE_B],
-            &mut cols.event_counts[STAGE_B],
-        );
-        cols.scratch = sums;
+        self.plan.b.run(Pre::Identity, sums, b, counts);
     }
 
-    /// The b stage of a batch through [`Datapath::op_add_b`], one element at a time.
-    fn b_stage_exact(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
-        let one = self.one_raw;
-        for (i, &code) in codes.iter().enumerate() {
-            let (b, cut) = self.op_add_b(cols.values[STAGE_T][i], code.min(one), nc);
-            cols.values[STAGE_B][i] = b.raw;
-            cols.cut[i] = cut;
-            count_event(&mut cols.event_counts[STAGE_B], b.event);
-        }
+    /// The last squaring's raw value as a function of b's raw value, tabulated once per
+    /// datapath when b has at most [`MAX_CHAIN_TABLE`] codes (the squaring chain does not
+    /// depend on n).
+    fn chain_table(&self) -> Option<&ChainTable> {
+        self.chain
+            .get_or_init(|| {
+                let b = self.config.b.format;
+                let (lo, hi) = (b.min_raw(), b.max_raw());
+                let codes = u64::try_from(i128::from(hi) - i128::from(lo) + 1).ok()?;
+                if codes > MAX_CHAIN_TABLE {
+                    return None;
+                }
+                let last = (lo..=hi)
+                    .map(|x| (0..self.config.k as usize).fold(x, |s, i| self.op_square(i, s).raw))
+                    .collect();
+                Some(ChainTable { b_min: lo, last })
+            })
+            .as_ref()
     }
+
+    /// Evaluates the output code of each input code for one n: the same `out` as
+    /// [`Datapath::eval`], without the other probes and the event counts, and faster (the
+    /// squaring chain is looked up from b where it is tabulated).
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::{Config, Datapath, OutputScratch};
+    /// let dp = Datapath::new(Config::baseline()).unwrap();
+    /// let nc = dp.constants_for(100).unwrap();
+    /// let codes: Vec<i64> = (32_000..=32_768).collect();
+    /// let mut out = vec![0; codes.len()];
+    /// dp.eval_outputs(nc, &codes, &mut out, &mut OutputScratch::default());
+    /// assert_eq!(out[700], dp.eval(32_700, nc).values[dp.stage_out()]);
+    /// ```
+    pub fn eval_outputs(
+        &self,
+        nc: &NConstants,
+        codes: &[i64],
+        out: &mut [i64],
+        scratch: &mut OutputScratch,
+    ) {
+        let len = codes.len();
+        let s = scratch;
+        for col in [&mut s.a, &mut s.b] {
+            col.clear();
+            col.resize(len, 0);
+        }
+        s.cut.clear();
+        s.cut.resize(len, false);
+        let one = self.one_raw;
+        let d_shift = self.d_shift;
+        for (d, &code) in s.a.iter_mut().zip(codes) {
+            *d = (code.min(one) - one) << d_shift;
+        }
+        let mut counts = [0; 3];
+        self.plan
+            .t
+            .run(Pre::Mul(nc.slope_raw), &s.a, &mut s.b, &mut counts);
+        // t is in b; the base goes to a.
+        self.b_column(
+            nc,
+            codes,
+            &s.b,
+            &mut s.a,
+            &mut s.cut,
+            &mut s.sums,
+            &mut counts,
+        );
+        if let Some(table) = self.chain_table() {
+            for (sq, &b) in s.b.iter_mut().zip(&s.a) {
+                *sq = table.last[(b - table.b_min) as usize];
+            }
+        } else {
+            for kernel in &self.plan.squares {
+                kernel.run(Pre::Square, &s.a, &mut s.b, &mut counts);
+                std::mem::swap(&mut s.a, &mut s.b);
+            }
+            std::mem::swap(&mut s.a, &mut s.b);
+        }
+        self.plan
+            .out
+            .run(Pre::Mul(nc.coef_raw), &s.b, out, &mut counts);
+    }
+}
+
+/// The most b codes for which the squaring chain is tabulated (8 MiB of `i64`).
+pub const MAX_CHAIN_TABLE: u64 = 1 << 20;
+
+/// The last squaring as a function of b's raw value: `last[b - b_min]`.
+#[derive(Debug, Clone)]
+struct ChainTable {
+    b_min: i64,
+    last: Vec<i64>,
+}
+
+/// Reusable columns for [`Datapath::eval_outputs`].
+#[derive(Debug, Clone, Default)]
+pub struct OutputScratch {
+    a: Vec<i64>,
+    b: Vec<i64>,
+    sums: Vec<i64>,
+    cut: Vec<bool>,
 }
 
 /// The paper cutoff's threshold code for n: the smallest input code whose value is at least

@@ -21,4 +21,6 @@ pub mod datapath;
 pub mod fast;
 
 pub use config::{CoefSpec, Config, FormatSpec, LatencySpec, MinimaxSpec, StageSpec, Variant};
-pub use datapath::{Datapath, NConstants, ProbeColumns, Probes, StageInfo, MAX_STAGES};
+pub use datapath::{
+    Datapath, NConstants, OutputScratch, ProbeColumns, Probes, StageInfo, MAX_STAGES,
+};
