@@ -11,8 +11,8 @@ use proptest::prelude::*;
 use specfx::fixed::{Event, Format, Overflow, Rounding};
 use specfx::nset::NSet;
 use specfx::pipeline::{
-    CoefSpec, Config, Datapath, FormatSpec, LatencySpec, MinimaxSpec, ProbeColumns, StageSpec,
-    Variant,
+    CoefSpec, Config, Datapath, FormatSpec, LatencySpec, MinimaxSpec, OutputScratch, ProbeColumns,
+    StageSpec, Variant,
 };
 use specfx::reference::lobe::Cutoff;
 use specfx::reference::normalisation::{CoefSource, Form};
@@ -187,6 +187,37 @@ fn batch_equals_scalar(dp: &Datapath) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// `eval_outputs_range` (dead prefix filled, squaring chain tabulated) and `eval_outputs` against
+/// `eval`'s output on every code of a small input format, or a window around 1.0 and both ends
+/// of a wide one.
+fn outputs_equal_scalar(dp: &Datapath) -> Result<(), TestCaseError> {
+    let all = dp.input_codes();
+    let (lo, hi) = (*all.start(), *all.end());
+    let ranges = if hi - lo <= 20_000 {
+        vec![lo..hi + 1]
+    } else {
+        let one = dp.one_code();
+        vec![lo..lo + 3000, one - 3000..one + 3000, hi - 3000..hi + 1]
+    };
+    let mut scratch = OutputScratch::default();
+    for nc in dp.constants() {
+        for range in &ranges {
+            let len = (range.end - range.start) as usize;
+            let mut got = vec![0; len];
+            dp.eval_outputs_range(nc, range.clone(), &mut got, &mut scratch);
+            let codes: Vec<i64> = range.clone().collect();
+            let mut plain = vec![0; len];
+            dp.eval_outputs(nc, &codes, &mut plain, &mut scratch);
+            for (i, &code) in codes.iter().enumerate() {
+                let want = dp.eval(code, nc).values[dp.stage_out()];
+                prop_assert_eq!(got[i], want, "range: n={} code={}", nc.n, code);
+                prop_assert_eq!(plain[i], want, "codes: n={} code={}", nc.n, code);
+            }
+        }
+    }
+    Ok(())
+}
+
 /// `eval` against the independent big-integer oracle (`tests/common/oracle.rs`, written from
 /// `docs/arithmetic.md`) on about 100 codes per n, ends and 1.0 included.
 fn scalar_equals_oracle(dp: &Datapath) -> Result<(), TestCaseError> {
@@ -228,7 +259,9 @@ proptest! {
         // A configuration the validation refuses has nothing to compare.
         let dp = Datapath::new(cfg.clone());
         prop_assume!(dp.is_ok());
-        batch_equals_scalar(&dp.unwrap())?;
+        let dp = dp.unwrap();
+        batch_equals_scalar(&dp)?;
+        outputs_equal_scalar(&dp)?;
     }
 }
 
@@ -241,6 +274,7 @@ proptest! {
         prop_assume!(dp.is_ok());
         let dp = dp.unwrap();
         batch_equals_scalar(&dp)?;
+        outputs_equal_scalar(&dp)?;
         scalar_equals_oracle(&dp)?;
     }
 }

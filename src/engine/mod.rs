@@ -101,22 +101,16 @@ pub fn output_sum(dp: &Datapath, codes: Range<i64>) -> OutputSum {
     let parts = map_items(dp, &all, |nc, range| {
         let mut scratch = crate::pipeline::OutputScratch::default();
         let mut out = vec![0i64; BATCH_CODES];
-        let mut codes_buf = Vec::with_capacity(BATCH_CODES);
         let mut sum = 0u64;
         let mut start = range.start;
+        let n = u64::from(nc.n);
         while start < range.end {
             let end = (start + BATCH_CODES as i64).min(range.end);
-            codes_buf.clear();
-            codes_buf.extend(start..end);
-            let out = &mut out[..codes_buf.len()];
-            dp.eval_outputs(nc, &codes_buf, out, &mut scratch);
-            let n = u64::from(nc.n);
-            for (&c, &o) in codes_buf.iter().zip(out.iter()) {
-                sum = sum.wrapping_add(
-                    (o as u64)
-                        .wrapping_mul((c as u64).wrapping_add(1))
-                        .wrapping_mul(n),
-                );
+            let out = &mut out[..(end - start) as usize];
+            dp.eval_outputs_range(nc, start..end, out, &mut scratch);
+            for (c, &o) in (start..end).zip(out.iter()) {
+                let weight = (c as u64).wrapping_add(1).wrapping_mul(n);
+                sum = sum.wrapping_add((o as u64).wrapping_mul(weight));
             }
             start = end;
         }

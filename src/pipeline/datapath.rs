@@ -152,6 +152,7 @@ pub struct Datapath {
     d_shift: u32,
     plan: BatchPlan,
     chain: std::sync::OnceLock<Option<ChainTable>>,
+    cut_is_prefix: bool,
 }
 
 fn config_error(key: &str, problem: String) -> Error {
@@ -336,6 +337,17 @@ impl Datapath {
             format: config.out.format,
         });
         let plan = Self::batch_plan(&config, &constants);
+        // t is non-decreasing in c when every slope is >= 0 and t saturates (every rounding
+        // mode is monotone; WRAP and SAT_ZERO are not): then so is t + offset, and the clamp
+        // cuts a prefix of the codes. The paper cutoff cuts the codes below a threshold.
+        let cut_is_prefix = match config.cutoff {
+            Cutoff::Paper => true,
+            Cutoff::Clamp => {
+                matches!(config.t.overflow, Overflow::Sat | Overflow::SatSym)
+                    && constants.iter().all(|c| c.slope_raw >= 0)
+            }
+            Cutoff::None => false,
+        };
         Ok(Datapath {
             config,
             stages,
@@ -344,6 +356,7 @@ impl Datapath {
             d_shift,
             plan,
             chain: std::sync::OnceLock::new(),
+            cut_is_prefix,
         })
     }
 
@@ -800,6 +813,66 @@ impl Datapath {
     }
 }
 
+impl Datapath {
+    /// Whether the cutoff forces the base of input `c_raw` to zero for this n.
+    pub fn is_cut(&self, c_raw: i64, nc: &NConstants) -> bool {
+        let (c, d) = self.op_sub(c_raw);
+        let t = self.op_mul_t(d, nc);
+        self.op_add_b(t.raw, c, nc).1
+    }
+
+    /// The first code of `codes` whose base is not cut, found by bisection where the cut
+    /// codes are proven to be a prefix (the paper cutoff; the clamp with a saturating,
+    /// non-negative t); `codes.start` otherwise.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::{Config, Datapath};
+    /// let dp = Datapath::new(Config::baseline()).unwrap();
+    /// let nc = dp.constants_for(1024).unwrap();
+    /// // The base (1024/16)(c - 1) + 1 is positive from c > 1 - 1/64, code 32256.
+    /// assert_eq!(dp.first_live_code(nc, 0..32769), 32257);
+    /// ```
+    pub fn first_live_code(&self, nc: &NConstants, codes: std::ops::Range<i64>) -> i64 {
+        if !self.cut_is_prefix {
+            return codes.start;
+        }
+        let (mut lo, mut hi) = (codes.start, codes.end);
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if self.is_cut(mid, nc) {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    }
+
+    /// [`Datapath::eval_outputs`] over a range of codes, `out[i]` for code `codes.start + i`:
+    /// the cut prefix (see [`Datapath::first_live_code`]) is filled with its one output, the
+    /// rest is evaluated.
+    pub fn eval_outputs_range(
+        &self,
+        nc: &NConstants,
+        codes: std::ops::Range<i64>,
+        out: &mut [i64],
+        scratch: &mut OutputScratch,
+    ) {
+        let live = self.first_live_code(nc, codes.clone());
+        let n_dead = (live - codes.start) as usize;
+        if n_dead > 0 {
+            let dead = self.eval(codes.start, nc).values[self.stage_out()];
+            out[..n_dead].fill(dead);
+        }
+        let mut live_codes = std::mem::take(&mut scratch.codes);
+        live_codes.clear();
+        live_codes.extend(live..codes.end);
+        self.eval_outputs(nc, &live_codes, &mut out[n_dead..], scratch);
+        scratch.codes = live_codes;
+    }
+}
+
 /// The most b codes for which the squaring chain is tabulated (8 MiB of `i64`).
 pub const MAX_CHAIN_TABLE: u64 = 1 << 20;
 
@@ -813,6 +886,7 @@ struct ChainTable {
 /// Reusable columns for [`Datapath::eval_outputs`].
 #[derive(Debug, Clone, Default)]
 pub struct OutputScratch {
+    codes: Vec<i64>,
     a: Vec<i64>,
     b: Vec<i64>,
     sums: Vec<i64>,

@@ -1,0 +1,64 @@
+//! The batch engine: its output fingerprint equals one computed from `eval` code by code, and
+//! is the same with one and two threads.
+
+use specfx::engine::{items, output_sum, ITEM_CODES};
+use specfx::pipeline::{Config, Datapath};
+
+/// The fingerprint of `OutputSum`, from `eval` one code at a time.
+fn slow_sum(dp: &Datapath, codes: std::ops::Range<i64>) -> u64 {
+    let mut sum = 0u64;
+    for nc in dp.constants() {
+        for c in codes.clone() {
+            let out = dp.eval(c, nc).values[dp.stage_out()];
+            let w = (c as u64 + 1).wrapping_mul(u64::from(nc.n));
+            sum = sum.wrapping_add((out as u64).wrapping_mul(w));
+        }
+    }
+    sum
+}
+
+fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+#[test]
+fn output_sum_equals_the_scalar_model_with_any_thread_count() {
+    let configs = [
+        Config::baseline(),
+        Config::from_toml("cutoff = \"paper\"\nk = 5\n").unwrap(),
+        // t wraps: the cut codes are no prefix and every code is evaluated.
+        Config::from_toml("[t]\nformat = \"s2.12\"\noverflow = \"WRAP\"\n").unwrap(),
+        Config::from_toml("variant = \"minimax\"\n[b]\nformat = \"u1.24\"\n").unwrap(),
+    ];
+    for mut cfg in configs {
+        cfg.n = "16,17,100,555,1024".parse().unwrap();
+        let dp = Datapath::new(cfg).unwrap();
+        let codes = 0..dp.one_code() + 100;
+        let want = slow_sum(&dp, codes.clone());
+        for threads in [1, 2] {
+            let got = in_pool(threads, || output_sum(&dp, codes.clone()));
+            assert_eq!(got.checksum, want, "{} threads", threads);
+            assert_eq!(got.evaluations, 5 * (codes.end - codes.start) as u64);
+        }
+    }
+}
+
+#[test]
+fn items_cover_every_code_once_in_order() {
+    let mut cfg = Config::baseline();
+    cfg.n = "16,20".parse().unwrap();
+    let dp = Datapath::new(cfg).unwrap();
+    let all = items(&dp, -5..(2 * ITEM_CODES as i64 + 7));
+    assert_eq!(all.len(), 6);
+    for pair in all.windows(2) {
+        let same_n = pair[0].n_idx == pair[1].n_idx;
+        assert!(!same_n || pair[0].codes.end == pair[1].codes.start);
+    }
+    assert_eq!(all[0].codes.start, -5);
+    assert_eq!(all[2].codes.end, 2 * ITEM_CODES as i64 + 7);
+    assert_eq!(all[3].n_idx, 1);
+}
