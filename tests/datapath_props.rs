@@ -218,6 +218,33 @@ fn outputs_equal_scalar(dp: &Datapath) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// The corner codes of `golden::cases` (found by bisection where the cut is a proven prefix)
+/// against a brute-force scan of `eval`'s cut flag over every code up to 1.0.
+fn corners_equal_brute_force(dp: &Datapath) -> Result<(), TestCaseError> {
+    let codes = dp.input_codes();
+    let (lo, hi) = (*codes.start(), *codes.end());
+    if hi - lo > 20_000 {
+        return Ok(());
+    }
+    let one = dp.one_code();
+    let mut cols = ProbeColumns::default();
+    for nc in dp.constants() {
+        let got = specfx::golden::cases::corner_codes(dp, nc.n, &mut cols).unwrap();
+        let mut want = std::collections::BTreeSet::new();
+        for c in [lo, lo + 1, 0, 1, one - 1, one, one + 1, hi - 1, hi] {
+            want.insert(c);
+        }
+        for c in lo + 1..=hi.min(one) {
+            if dp.eval(c, nc).cut != dp.eval(c - 1, nc).cut {
+                want.extend([c - 2, c - 1, c, c + 1]);
+            }
+        }
+        want.retain(|c| (lo..=hi).contains(c));
+        prop_assert_eq!(got, want, "n={}", nc.n);
+    }
+    Ok(())
+}
+
 /// `eval` against the independent big-integer oracle (`tests/common/oracle.rs`, written from
 /// `docs/arithmetic.md`) on about 100 codes per n, ends and 1.0 included.
 fn scalar_equals_oracle(dp: &Datapath) -> Result<(), TestCaseError> {
@@ -262,6 +289,7 @@ proptest! {
         let dp = dp.unwrap();
         batch_equals_scalar(&dp)?;
         outputs_equal_scalar(&dp)?;
+        corners_equal_brute_force(&dp)?;
     }
 }
 
@@ -275,6 +303,7 @@ proptest! {
         let dp = dp.unwrap();
         batch_equals_scalar(&dp)?;
         outputs_equal_scalar(&dp)?;
+        corners_equal_brute_force(&dp)?;
         scalar_equals_oracle(&dp)?;
     }
 }

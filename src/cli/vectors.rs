@@ -62,6 +62,8 @@ pub fn write_dir(
     seed: u64,
     force: bool,
 ) -> Result<u64> {
+    let cases = cases::select(dp, selection, seed)
+        .with_context(|| format!("config {}", dp.config().name))?;
     if out.exists() && !force {
         bail!(
             "{} already exists: pass --force to replace it",
@@ -77,7 +79,6 @@ pub fn write_dir(
     }
     fs::create_dir_all(&partial).with_context(|| format!("cannot create {}", partial.display()))?;
 
-    let cases = cases::select(dp, selection, seed);
     let ports = ports(dp);
     let open = |name: &str| -> Result<HashingWriter<BufWriter<File>>> {
         let path = partial.join(name);

@@ -9,6 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use crate::error::Error;
+use crate::pipeline::datapath::CutStructure;
 use crate::pipeline::{Datapath, ProbeColumns};
 
 /// A selection of cases, written `corner`, `exhaustive`, `random:N` or a comma list of them.
@@ -79,44 +80,85 @@ impl fmt::Display for CaseSelection {
     }
 }
 
+/// The most cutoff evaluations a corner-case scan may take per exponent, where the cut codes
+/// are not proven to be a prefix and every code up to 1.0 must be looked at.
+pub const MAX_SCAN_CODES: u64 = 1 << 22;
+
+/// The most (n, c) cases a selection may hold.
+pub const MAX_CASES: u64 = 1 << 26;
+
 /// The corner codes of one n: the ends of the code range, 0, 1.0 and its neighbours, and
 /// every place where the cutoff switches between two consecutive codes, +-1 code.
-pub fn corner_codes(dp: &Datapath, n: u32, cols: &mut ProbeColumns) -> BTreeSet<i64> {
+///
+/// The switching points cost what they are: none without a cutoff, one bisection where the
+/// cut codes are proven to be a prefix ([`Datapath::first_live_code`]); only a clamp behind a
+/// wrapping or zeroing t scans every code up to 1.0, at most [`MAX_SCAN_CODES`] of them.
+///
+/// # Errors
+/// When a scan would take more than [`MAX_SCAN_CODES`] evaluations.
+pub fn corner_codes(
+    dp: &Datapath,
+    n: u32,
+    cols: &mut ProbeColumns,
+) -> Result<BTreeSet<i64>, Error> {
     let codes = dp.input_codes();
     let (lo, hi) = (*codes.start(), *codes.end());
     let one = dp.one_code();
     let mut set = BTreeSet::new();
-    for c in [lo, lo + 1, 0, 1, one - 1, one, one + 1, hi - 1, hi] {
+    let add = |set: &mut BTreeSet<i64>, c: i64| {
         if (lo..=hi).contains(&c) {
             set.insert(c);
         }
+    };
+    for c in [lo, lo + 1, 0, 1, one - 1, one, one + 1, hi - 1, hi] {
+        add(&mut set, c);
     }
     let Some(nc) = dp.constants_for(n) else {
-        return set;
+        return Ok(set);
     };
-    // Scan codes up to 1.0 for the cutoff's switching points.
-    const CHUNK: i64 = 4096;
-    let mut prev: Option<bool> = None;
-    let mut start = lo;
     let last = hi.min(one);
-    while start <= last {
-        let end = (start + CHUNK - 1).min(last);
-        let chunk: Vec<i64> = (start..=end).collect();
-        dp.eval_batch(nc, &chunk, cols);
-        for (i, &cut) in cols.cut.iter().enumerate() {
-            if prev.is_some_and(|p| p != cut) {
-                let c = chunk[i];
-                for x in [c - 2, c - 1, c, c + 1] {
-                    if (lo..=hi).contains(&x) {
-                        set.insert(x);
-                    }
+    match dp.cut_structure() {
+        CutStructure::Never => {}
+        CutStructure::Prefix => {
+            let live = dp.first_live_code(nc, lo..last + 1);
+            if live > lo && live <= last {
+                for x in [live - 2, live - 1, live, live + 1] {
+                    add(&mut set, x);
                 }
             }
-            prev = Some(cut);
         }
-        start = end + 1;
+        CutStructure::Scan => {
+            let n_codes = (last - lo + 1).max(0) as u64;
+            if n_codes > MAX_SCAN_CODES {
+                return Err(Error::OutOfRange {
+                    what: "the corner-case scan",
+                    expected: format!(
+                        "at most {MAX_SCAN_CODES} codes up to 1.0 per n when t wraps or zeroes under the clamp cutoff (every code must be looked at)"
+                    ),
+                    got: format!("{n_codes} codes of c.format {}", dp.config().c.format),
+                });
+            }
+            const CHUNK: i64 = 4096;
+            let mut prev: Option<bool> = None;
+            let mut start = lo;
+            while start <= last {
+                let end = (start + CHUNK - 1).min(last);
+                let chunk: Vec<i64> = (start..=end).collect();
+                dp.eval_batch(nc, &chunk, cols);
+                for (i, &cut) in cols.cut.iter().enumerate() {
+                    if prev.is_some_and(|p| p != cut) {
+                        let c = chunk[i];
+                        for x in [c - 2, c - 1, c, c + 1] {
+                            add(&mut set, x);
+                        }
+                    }
+                    prev = Some(cut);
+                }
+                start = end + 1;
+            }
+        }
     }
-    set
+    Ok(set)
 }
 
 /// The (n, c_raw) pairs of a selection, sorted by n then c, without duplicates. Corner cases
@@ -125,10 +167,32 @@ pub fn corner_codes(dp: &Datapath, n: u32, cols: &mut ProbeColumns) -> BTreeSet<
 /// Random pairs are drawn from ChaCha8 seeded with `seed`, uniformly over the n set and the
 /// input codes, until `random` pairs not already selected have been added (or every pair is
 /// selected). The same arguments give the same cases on every machine.
-pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Vec<(u32, i64)> {
+///
+/// # Errors
+/// When the selection would hold more than [`MAX_CASES`] cases, or a corner-case scan is too
+/// long (see [`corner_codes`]).
+pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Vec<(u32, i64)>, Error> {
     let ns = dp.config().n.values();
     let codes = dp.input_codes();
     let (lo, hi) = (*codes.start(), *codes.end());
+    let per_n = u64::try_from(i128::from(hi) - i128::from(lo) + 1).unwrap_or(u64::MAX);
+    let exhaustive = if sel.exhaustive {
+        per_n.saturating_mul(ns.len() as u64)
+    } else {
+        0
+    };
+    let asked = exhaustive.saturating_add(sel.random);
+    if asked > MAX_CASES {
+        return Err(Error::OutOfRange {
+            what: "the number of vectors",
+            expected: format!("at most {MAX_CASES}"),
+            got: format!(
+                "{asked} ({} exponents x {per_n} input codes exhaustive, {} random)",
+                ns.len(),
+                sel.random
+            ),
+        });
+    }
     let mut set: BTreeSet<(u32, i64)> = BTreeSet::new();
     if sel.exhaustive {
         for &n in ns {
@@ -138,7 +202,7 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Vec<(u32, i64)> 
         // Corner cases are always included, whatever else is selected.
         let mut cols = ProbeColumns::default();
         for &n in ns {
-            set.extend(corner_codes(dp, n, &mut cols).into_iter().map(|c| (n, c)));
+            set.extend(corner_codes(dp, n, &mut cols)?.into_iter().map(|c| (n, c)));
         }
     }
     if sel.random > 0 {
@@ -151,5 +215,5 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Vec<(u32, i64)> 
             set.insert((n, c));
         }
     }
-    set.into_iter().collect()
+    Ok(set.into_iter().collect())
 }

@@ -155,6 +155,18 @@ pub struct Datapath {
     cut_is_prefix: bool,
 }
 
+/// Where the cutoff can force the base to zero, as far as the configuration proves it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CutStructure {
+    /// Never (`cutoff = "none"`).
+    Never,
+    /// On a prefix of the input codes for every n: the paper cutoff, or the clamp behind a
+    /// saturating t with non-negative slopes.
+    Prefix,
+    /// Anywhere: the clamp behind a t that wraps or overflows to zero.
+    Scan,
+}
+
 fn config_error(key: &str, problem: String) -> Error {
     Error::Config {
         key: key.to_string(),
@@ -814,6 +826,15 @@ impl Datapath {
 }
 
 impl Datapath {
+    /// Where the cutoff can cut, as proven from the configuration.
+    pub fn cut_structure(&self) -> CutStructure {
+        match (self.config.cutoff, self.cut_is_prefix) {
+            (Cutoff::None, _) => CutStructure::Never,
+            (_, true) => CutStructure::Prefix,
+            (_, false) => CutStructure::Scan,
+        }
+    }
+
     /// Whether the cutoff forces the base of input `c_raw` to zero for this n.
     pub fn is_cut(&self, c_raw: i64, nc: &NConstants) -> bool {
         let (c, d) = self.op_sub(c_raw);
