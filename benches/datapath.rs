@@ -1,8 +1,30 @@
-//! Criterion benchmarks of the bit-accurate datapath: batch evaluation and the exhaustive check.
+//! Criterion benchmarks of the bit-accurate datapath: one evaluation, the batch path, the
+//! outputs over every code and n, the exhaustive check, one sweep point and the cycle model.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use specfx::analysis::check::check;
+use specfx::analysis::sweep::{evaluate, Space};
+use specfx::cycle::sim::{random_inputs, simulate, Stimulus, Stop};
+use specfx::cycle::Arch;
+use specfx::engine::output_sum;
 use specfx::pipeline::{Config, Datapath, ProbeColumns};
+
+fn baseline_all_n() -> Datapath {
+    let mut cfg = Config::baseline();
+    cfg.n = "16..=1024".parse().unwrap();
+    Datapath::new(cfg).unwrap()
+}
+
+fn one_evaluation(c: &mut Criterion) {
+    let dp = Datapath::new(Config::baseline()).unwrap();
+    let nc = *dp.constants_for(256).unwrap();
+    let mut g = c.benchmark_group("eval");
+    g.throughput(Throughput::Elements(1));
+    g.bench_function("baseline/scalar", |b| {
+        b.iter(|| dp.eval(std::hint::black_box(32_700), &nc))
+    });
+    g.finish();
+}
 
 fn batch_eval(c: &mut Criterion) {
     let dp = Datapath::new(Config::baseline()).unwrap();
@@ -25,10 +47,19 @@ fn batch_eval(c: &mut Criterion) {
     g.finish();
 }
 
+fn outputs(c: &mut Criterion) {
+    let dp = baseline_all_n();
+    let mut g = c.benchmark_group("outputs");
+    g.sample_size(20);
+    g.throughput(Throughput::Elements(1009 * 32_769));
+    g.bench_function("baseline/16..=1024", |b| {
+        b.iter(|| output_sum(&dp, 0..32_769))
+    });
+    g.finish();
+}
+
 fn exhaustive_check(c: &mut Criterion) {
-    let mut cfg = Config::baseline();
-    cfg.n = "16..=1024".parse().unwrap();
-    let dp = Datapath::new(cfg).unwrap();
+    let dp = baseline_all_n();
     let mut g = c.benchmark_group("check");
     g.sample_size(10);
     g.throughput(Throughput::Elements(1009 * 32_769));
@@ -36,5 +67,46 @@ fn exhaustive_check(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, batch_eval, exhaustive_check);
+fn sweep_point(c: &mut Criterion) {
+    // One point of a space holding only the baseline: validation, exhaustive check and cost.
+    let space = Space::from_toml("n = \"16..=1024\"\n[vary]\nk = [4]\n").unwrap();
+    let mut g = c.benchmark_group("sweep");
+    g.sample_size(10);
+    g.bench_function("point/baseline", |b| b.iter(|| evaluate(&space, 0)));
+    g.finish();
+}
+
+fn cycle_model(c: &mut Criterion) {
+    let dp = Datapath::new(Config::baseline()).unwrap();
+    const CYCLES: u64 = 100_000;
+    let mut g = c.benchmark_group("cycle");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(CYCLES));
+    for arch in [Arch::Pipelined, Arch::Folded] {
+        g.bench_function(format!("{arch}/baseline"), |b| {
+            b.iter(|| {
+                let mut stimulus = Stimulus::new(1, 0.0, 0.0);
+                simulate(
+                    &dp,
+                    arch,
+                    random_inputs(&dp, 1),
+                    &mut stimulus,
+                    Stop::Cycles(CYCLES),
+                    0,
+                )
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    one_evaluation,
+    batch_eval,
+    outputs,
+    exhaustive_check,
+    sweep_point,
+    cycle_model
+);
 criterion_main!(benches);

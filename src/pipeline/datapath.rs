@@ -851,8 +851,8 @@ impl Datapath {
     /// use specfx::pipeline::{Config, Datapath};
     /// let dp = Datapath::new(Config::baseline()).unwrap();
     /// let nc = dp.constants_for(1024).unwrap();
-    /// // The base (1024/16)(c - 1) + 1 is positive from c > 1 - 1/64, code 32256.
-    /// assert_eq!(dp.first_live_code(nc, 0..32769), 32257);
+    /// // The base (1024/16)(c - 1) + 1 is negative, and cut, below c = 1 - 1/64 (code 32256).
+    /// assert_eq!(dp.first_live_code(nc, 0..32769), 32256);
     /// ```
     pub fn first_live_code(&self, nc: &NConstants, codes: std::ops::Range<i64>) -> i64 {
         if !self.cut_is_prefix {
