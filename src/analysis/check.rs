@@ -9,7 +9,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::pipeline::datapath::{STAGE_B, STAGE_D, STAGE_T};
+use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
 use crate::pipeline::fast::EventCounts;
 use crate::pipeline::{Datapath, NConstants, ProbeColumns, MAX_STAGES};
 use crate::reference::lobe::Cutoff;
@@ -225,6 +225,19 @@ impl Acc {
         self.raw_max = raws.iter().copied().fold(self.raw_max, i64::max);
     }
 
+    /// Adds a column whose every error is exactly +0.0, non-decreasing from `raw_first` to
+    /// `raw_last`: the same state as [`Acc::add_column`] would reach on it.
+    fn add_exact_column(&mut self, raw_first: i64, raw_last: i64, count: u64, at: (u32, i64)) {
+        if 0.0 > self.max_abs {
+            self.max_abs = 0.0;
+            self.worst = at;
+        }
+        self.n_correct += count;
+        self.n_faithful += count;
+        self.raw_min = self.raw_min.min(raw_first);
+        self.raw_max = self.raw_max.max(raw_last);
+    }
+
     /// Adds `count` evaluations of a constant (the coefficient) against its f64 value.
     fn add_constant(&mut self, raw: i64, lsb: f64, reference: f64, count: u64, at: (u32, i64)) {
         let err = raw as f64 * lsb - reference;
@@ -386,7 +399,65 @@ pub fn reference_probes(dp: &Datapath, nc: &NConstants, c: f64) -> [f64; MAX_STA
 /// Codes evaluated per batch: small enough for the columns to stay in cache.
 const CHUNK: usize = 2048;
 
-fn check_one_n(dp: &Datapath, nc: &NConstants, codes: &[i64], ln_c: &[f64]) -> PerN {
+/// The f64 base of the same algorithm: `t + offset` after the cutoff (`cut_by_threshold`: the
+/// clamped input is below the paper cutoff's threshold code).
+#[inline]
+fn reference_base(cutoff: Cutoff, t: f64, offset: f64, cut_by_threshold: bool) -> f64 {
+    let sum = t + offset;
+    match cutoff {
+        Cutoff::Clamp => sum.max(0.0),
+        Cutoff::Paper if cut_by_threshold => 0.0,
+        Cutoff::Paper | Cutoff::None => sum,
+    }
+}
+
+/// The end of the dead prefix of one n: every code below it is cut in the fixed-point model
+/// and has a base of 0 in the f64 model, so its b..out stages need no evaluation. Both
+/// boundaries are found by bisection where they are proven monotone: the fixed-point cut by
+/// [`Datapath::first_live_code`], the f64 base because `c - 1`, the product with a positive
+/// slope, the sum and the clamp are each monotone in f64. `codes[0]` where nothing is proven.
+fn dead_prefix_end(dp: &Datapath, nc: &NConstants, codes: &[i64]) -> i64 {
+    let (lo, end) = (codes[0], codes[codes.len() - 1] + 1);
+    if dp.cut_structure() != CutStructure::Prefix {
+        return lo;
+    }
+    let fixed = dp.first_live_code(nc, lo..end);
+    let cfg = dp.config();
+    if cfg.cutoff == Cutoff::Paper {
+        // The f64 base is 0 exactly where the clamped code is below the threshold, which is
+        // also where the fixed-point base is cut.
+        return fixed;
+    }
+    if nc.slope.is_nan() || nc.slope <= 0.0 {
+        return lo;
+    }
+    let one = dp.one_code();
+    let c_lsb = cfg.c.format.lsb();
+    let positive = |k: i64| {
+        let d = (k.min(one) as f64 * c_lsb) - 1.0;
+        reference_base(cfg.cutoff, nc.slope * d, nc.offset, false) != 0.0
+    };
+    let (mut a, mut b) = (lo, fixed);
+    while a < b {
+        let mid = a + (b - a) / 2;
+        if positive(mid) {
+            b = mid;
+        } else {
+            a = mid + 1;
+        }
+    }
+    a
+}
+
+/// Per-code inputs shared by every n: the codes, ln c and d's f64 reference.
+struct CodeColumns {
+    codes: Vec<i64>,
+    ln_c: Vec<f64>,
+    ref_d: Vec<f64>,
+}
+
+fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
+    let codes = &shared.codes[..];
     let cfg = dp.config();
     let stages = dp.stages();
     let n_stages = stages.len();
@@ -417,8 +488,23 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, codes: &[i64], ln_c: &[f64]) -> P
     let mut live_codes: Vec<i64> = Vec::with_capacity(CHUNK);
     let mut live_raws: Vec<i64> = Vec::with_capacity(CHUNK);
     let mut live_refs: Vec<f64> = Vec::with_capacity(CHUNK);
-    for (chunk, ln_chunk) in codes.chunks(CHUNK).zip(ln_c.chunks(CHUNK)) {
-        dp.eval_batch(nc, chunk, &mut cols);
+    let dead_end = dead_prefix_end(dp, nc, codes);
+    // d = c - 1 is exact in its format; when c has at most 52 bits and d at most 53, its f64
+    // reference and its fixed-point value are the same f64 for every code, so every error is
+    // +0.0 and d's figures follow without computing them (the same bits as computing them).
+    let d_is_exact = cfg.c.format.width() <= 52 && cfg.d.format.width() <= 53;
+    for ((chunk, ln_chunk), ref_d_chunk) in codes
+        .chunks(CHUNK)
+        .zip(shared.ln_c.chunks(CHUNK))
+        .zip(shared.ref_d.chunks(CHUNK))
+    {
+        // A chunk below the dead prefix's end: every base is cut, and 0 in the f64 model too.
+        let dead_chunk = chunk[chunk.len() - 1] < dead_end;
+        if dead_chunk {
+            dp.eval_batch_cut(nc, chunk, &mut cols);
+        } else {
+            dp.eval_batch(nc, chunk, &mut cols);
+        }
         for (a, counts) in acc.iter_mut().zip(&cols.event_counts) {
             a.add_events(counts);
         }
@@ -426,28 +512,44 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, codes: &[i64], ln_c: &[f64]) -> P
         for r in refs.iter_mut() {
             r.clear();
         }
-        refs[STAGE_D].extend(chunk.iter().map(|&k| (k.min(one) as f64 * c_lsb) - 1.0));
+        // d's f64 reference, needed by t's (and by d's own figures when it is not exact).
+        refs[STAGE_D].extend_from_slice(ref_d_chunk);
         let (head, tail) = refs.split_at_mut(STAGE_T);
         tail[0].extend(head[STAGE_D].iter().map(|&d| nc.slope * d));
-        let (head, tail) = refs.split_at_mut(STAGE_B);
-        tail[0].extend(head[STAGE_T].iter().zip(chunk).map(|(&t, &k)| {
-            let sum = t + nc.offset;
-            match cfg.cutoff {
-                Cutoff::Clamp => sum.max(0.0),
-                Cutoff::Paper if k.min(one) < threshold => 0.0,
-                Cutoff::Paper | Cutoff::None => sum,
-            }
-        }));
-        for stage_idx in [STAGE_D, STAGE_T] {
-            acc[stage_idx].add_column(
-                &cols.values[stage_idx],
-                lsb[stage_idx],
-                &refs[stage_idx],
+        if !dead_chunk {
+            let (head, tail) = refs.split_at_mut(STAGE_B);
+            tail[0].extend(
+                head[STAGE_T].iter().zip(chunk).map(|(&t, &k)| {
+                    reference_base(cfg.cutoff, t, nc.offset, k.min(one) < threshold)
+                }),
+            );
+        }
+        if d_is_exact {
+            let d = &cols.values[STAGE_D];
+            acc[STAGE_D].add_exact_column(
+                d[0],
+                d[d.len() - 1],
+                chunk.len() as u64,
+                (nc.n, chunk[0]),
+            );
+        } else {
+            acc[STAGE_D].add_column(
+                &cols.values[STAGE_D],
+                lsb[STAGE_D],
+                &refs[STAGE_D],
                 chunk,
                 nc.n,
                 &mut errs,
             );
         }
+        acc[STAGE_T].add_column(
+            &cols.values[STAGE_T],
+            lsb[STAGE_T],
+            &refs[STAGE_T],
+            chunk,
+            nc.n,
+            &mut errs,
+        );
         acc[coef_idx].add_constant(
             nc.coef_raw,
             lsb[coef_idx],
@@ -459,15 +561,22 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, codes: &[i64], ln_c: &[f64]) -> P
         // From b on, an input whose base is 0 in both models stays exactly 0 in both: such
         // inputs count as exact without being looked at again.
         live.clear();
-        live.extend(
-            (0..chunk.len()).filter(|&i| cols.values[STAGE_B][i] != 0 || refs[STAGE_B][i] != 0.0),
-        );
+        if !dead_chunk {
+            live.extend(
+                (0..chunk.len())
+                    .filter(|&i| cols.values[STAGE_B][i] != 0 || refs[STAGE_B][i] != 0.0),
+            );
+        }
         let n_dead = (chunk.len() - live.len()) as u64;
         if n_dead > 0 {
-            let largest_dead = (0..chunk.len())
-                .rev()
-                .find(|&i| cols.values[STAGE_B][i] == 0 && refs[STAGE_B][i] == 0.0)
-                .expect("a dead input exists");
+            let largest_dead = if dead_chunk {
+                chunk.len() - 1
+            } else {
+                (0..chunk.len())
+                    .rev()
+                    .find(|&i| cols.values[STAGE_B][i] == 0 && refs[STAGE_B][i] == 0.0)
+                    .expect("a dead input exists")
+            };
             if zero_lobe_code.is_none_or(|(k, _)| chunk[largest_dead] > k) {
                 zero_lobe_code = Some((chunk[largest_dead], ln_chunk[largest_dead]));
             }
@@ -517,8 +626,15 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, codes: &[i64], ln_c: &[f64]) -> P
             }
         }
 
-        n_cut += cols.cut.iter().filter(|&&c| c).count() as u64;
-        for (&o, &code) in cols.values[out].iter().zip(chunk) {
+        // A dead chunk is all cut with all outputs 0: only its first output can fall below
+        // the one before it.
+        let (n_chunk_cut, checked) = if dead_chunk {
+            (chunk.len() as u64, 1)
+        } else {
+            (cols.cut.iter().filter(|&&c| c).count() as u64, chunk.len())
+        };
+        n_cut += n_chunk_cut;
+        for (&o, &code) in cols.values[out].iter().zip(chunk).take(checked) {
             if let Some(prev) = prev_out {
                 if o < prev {
                     n_violations += 1;
@@ -582,11 +698,19 @@ pub fn check(dp: &Datapath) -> Result<CheckReport, String> {
     }
     let codes: Vec<i64> = (*codes_all.start()..=last).collect();
     let c_lsb = dp.config().c.format.lsb();
-    let ln_c: Vec<f64> = codes.iter().map(|&k| (k as f64 * c_lsb).ln()).collect();
+    let one = dp.one_code();
+    let shared = CodeColumns {
+        ln_c: codes.iter().map(|&k| (k as f64 * c_lsb).ln()).collect(),
+        ref_d: codes
+            .iter()
+            .map(|&k| (k.min(one) as f64 * c_lsb) - 1.0)
+            .collect(),
+        codes,
+    };
     let per_n: Vec<PerN> = dp
         .constants()
         .par_iter()
-        .map(|nc| check_one_n(dp, nc, &codes, &ln_c))
+        .map(|nc| check_one_n(dp, nc, &shared))
         .collect();
 
     let stages = dp.stages();

@@ -102,21 +102,27 @@ pub struct ProbeColumns {
     pub cut: Vec<bool>,
     /// `input_clamped[i]`: the input was above 1.0.
     pub input_clamped: Vec<bool>,
+    /// The b..out columns (all but coef) hold zeros written by
+    /// [`Datapath::eval_batch_cut`] and nothing has written them since.
+    zero_tail: bool,
 }
 
 impl ProbeColumns {
+    /// Gives every column `len` rows and clears the event counts. The rows keep whatever they
+    /// held: every evaluation writes every row of the columns it promises.
     fn reset(&mut self, n_stages: usize, len: usize) {
-        self.values.resize_with(n_stages, Vec::new);
+        let same = self.values.len() == n_stages && self.cut.len() == len;
+        if !same {
+            self.zero_tail = false;
+            self.values.resize_with(n_stages, Vec::new);
+            for col in &mut self.values {
+                col.resize(len, 0);
+            }
+            self.cut.resize(len, false);
+            self.input_clamped.resize(len, false);
+        }
         self.event_counts.clear();
         self.event_counts.resize(n_stages, [0; 3]);
-        for col in &mut self.values {
-            col.clear();
-            col.resize(len, 0);
-        }
-        self.cut.clear();
-        self.cut.resize(len, false);
-        self.input_clamped.clear();
-        self.input_clamped.resize(len, false);
     }
 
     /// The number of evaluations held.
@@ -649,6 +655,7 @@ impl Datapath {
     pub fn eval_batch(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
         let n_stages = self.stages.len();
         cols.reset(n_stages, codes.len());
+        cols.zero_tail = false;
         let plan = &self.plan;
         let one = self.one_raw;
         let d_shift = self.d_shift;
@@ -868,6 +875,43 @@ impl Datapath {
             }
         }
         lo
+    }
+
+    /// [`Datapath::eval_batch`] for a batch of codes that are all cut (every code below
+    /// [`Datapath::first_live_code`]): d and t are evaluated, and every later stage holds
+    /// what a cut base gives, 0 (the quantization of 0 is 0 in every format and mode, with no
+    /// overflow event). The caller guarantees the codes are cut.
+    pub fn eval_batch_cut(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
+        let n_stages = self.stages.len();
+        cols.reset(n_stages, codes.len());
+        let one = self.one_raw;
+        let d_shift = self.d_shift;
+        for ((d, clamped), &code) in cols.values[STAGE_D]
+            .iter_mut()
+            .zip(cols.input_clamped.iter_mut())
+            .zip(codes)
+        {
+            *clamped = code > one;
+            *d = (code.min(one) - one) << d_shift;
+        }
+        let (head, tail) = cols.values.split_at_mut(STAGE_T);
+        self.plan.t.run(
+            Pre::Mul(nc.slope_raw),
+            &head[STAGE_D],
+            &mut tail[0],
+            &mut cols.event_counts[STAGE_T],
+        );
+        cols.cut.fill(true);
+        let coef_idx = self.stage_coef();
+        cols.values[coef_idx].fill(nc.coef_raw);
+        if !cols.zero_tail {
+            for (stage_idx, col) in cols.values.iter_mut().enumerate().skip(STAGE_B) {
+                if stage_idx != coef_idx {
+                    col.fill(0);
+                }
+            }
+            cols.zero_tail = true;
+        }
     }
 
     /// [`Datapath::eval_outputs`] over a range of codes, `out[i]` for code `codes.start + i`:
