@@ -166,6 +166,18 @@ pub trait Machine: Clone {
     /// The registers after the clock edge, given this cycle's transferred input (if any) and
     /// `out_ready`.
     fn next(&self, dp: &Datapath, input: Option<Item>, out_ready: bool) -> Self;
+    /// [`Machine::next`] written into `next` (whose old registers are overwritten), so that a
+    /// simulator can keep two register sets and swap them without allocating.
+    fn next_into(&self, dp: &Datapath, input: Option<Item>, out_ready: bool, next: &mut Self) {
+        *next = self.next(dp, input, out_ready);
+    }
+    /// Adds 1 to `counts[unit]` for every unit that holds valid data now (the units of
+    /// [`Machine::unit_names`], in order).
+    fn count_occupancy(&self, counts: &mut [u64]) {
+        for (count, busy) in counts.iter_mut().zip(self.occupancy()) {
+            *count += u64::from(busy);
+        }
+    }
     /// Names of the units whose occupancy is measured.
     fn unit_names(&self) -> Vec<String>;
     /// Whether each unit holds valid data now.
@@ -183,6 +195,8 @@ pub struct Pipelined {
     owner: Vec<Op>,
     /// The registers, input side first.
     regs: Vec<Option<Token>>,
+    /// The registers of each unit (of `op_units(owner)`), a contiguous range each.
+    unit_regs: Vec<std::ops::Range<usize>>,
 }
 
 impl Pipelined {
@@ -202,7 +216,19 @@ impl Pipelined {
             }
         }
         let regs = vec![None; ops.len()];
-        Pipelined { ops, owner, regs }
+        let mut unit_regs: Vec<std::ops::Range<usize>> = Vec::new();
+        for (r, &op) in owner.iter().enumerate() {
+            match unit_regs.last_mut() {
+                Some(range) if owner[range.start] == op => range.end = r + 1,
+                _ => unit_regs.push(r..r + 1),
+            }
+        }
+        Pipelined {
+            ops,
+            owner,
+            regs,
+            unit_regs,
+        }
     }
 }
 
@@ -230,11 +256,17 @@ impl Machine for Pipelined {
     }
 
     fn next(&self, dp: &Datapath, input: Option<Item>, out_ready: bool) -> Pipelined {
+        let mut next = self.clone();
+        self.next_into(dp, input, out_ready, &mut next);
+        next
+    }
+
+    fn next_into(&self, dp: &Datapath, input: Option<Item>, out_ready: bool, next: &mut Self) {
         if !self.in_ready(out_ready) {
             // Rule 5: a stalled pipeline holds everything (and accepts nothing).
-            return self.clone();
+            next.regs.copy_from_slice(&self.regs);
+            return;
         }
-        let mut next = self.clone();
         for r in 0..self.regs.len() {
             let incoming = if r == 0 {
                 input.map(|it| Token {
@@ -251,7 +283,12 @@ impl Machine for Pipelined {
                 None => incoming,
             };
         }
-        next
+    }
+
+    fn count_occupancy(&self, counts: &mut [u64]) {
+        for (count, range) in counts.iter_mut().zip(&self.unit_regs) {
+            *count += u64::from(self.regs[range.clone()].iter().any(Option::is_some));
+        }
     }
 
     fn unit_names(&self) -> Vec<String> {
