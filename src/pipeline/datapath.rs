@@ -657,16 +657,7 @@ impl Datapath {
         cols.reset(n_stages, codes.len());
         cols.zero_tail = false;
         let plan = &self.plan;
-        let one = self.one_raw;
-        let d_shift = self.d_shift;
-        for ((d, clamped), &code) in cols.values[STAGE_D]
-            .iter_mut()
-            .zip(cols.input_clamped.iter_mut())
-            .zip(codes)
-        {
-            *clamped = code > one;
-            *d = (code.min(one) - one) << d_shift;
-        }
+        self.d_column(codes, &mut cols.values[STAGE_D], &mut cols.input_clamped);
         let stage = |cols: &mut ProbeColumns, kernel: &Kernel, pre: Pre, from: usize, to: usize| {
             let (head, tail) = cols.values.split_at_mut(to);
             kernel.run(pre, &head[from], &mut tail[0], &mut cols.event_counts[to]);
@@ -695,6 +686,16 @@ impl Datapath {
             coef_idx - 1,
             coef_idx + 1,
         );
+    }
+
+    /// The d stage over columns: each code clamped to 1.0, then `d = c - 1`, exact.
+    fn d_column(&self, codes: &[i64], d: &mut [i64], clamped: &mut [bool]) {
+        let one = self.one_raw;
+        let d_shift = self.d_shift;
+        for ((d, clamped), &code) in d.iter_mut().zip(clamped.iter_mut()).zip(codes) {
+            *clamped = code > one;
+            *d = (code.min(one) - one) << d_shift;
+        }
     }
 
     /// The b stage over columns: the exact sum `t + offset`, the cutoff, then b's kernel (the
@@ -884,16 +885,7 @@ impl Datapath {
     pub fn eval_batch_cut(&self, nc: &NConstants, codes: &[i64], cols: &mut ProbeColumns) {
         let n_stages = self.stages.len();
         cols.reset(n_stages, codes.len());
-        let one = self.one_raw;
-        let d_shift = self.d_shift;
-        for ((d, clamped), &code) in cols.values[STAGE_D]
-            .iter_mut()
-            .zip(cols.input_clamped.iter_mut())
-            .zip(codes)
-        {
-            *clamped = code > one;
-            *d = (code.min(one) - one) << d_shift;
-        }
+        self.d_column(codes, &mut cols.values[STAGE_D], &mut cols.input_clamped);
         let (head, tail) = cols.values.split_at_mut(STAGE_T);
         self.plan.t.run(
             Pre::Mul(nc.slope_raw),
