@@ -1,6 +1,8 @@
 //! The batch engine: its output fingerprint equals one computed from `eval` code by code, and
 //! is the same with one and two threads.
 
+mod common;
+
 use specfx::engine::{items, output_sum, ITEM_CODES};
 use specfx::pipeline::{Config, Datapath};
 
@@ -61,4 +63,36 @@ fn items_cover_every_code_once_in_order() {
     assert_eq!(all[0].codes.start, -5);
     assert_eq!(all[2].codes.end, 2 * ITEM_CODES as i64 + 7);
     assert_eq!(all[3].n_idx, 1);
+}
+
+#[test]
+fn the_throughput_command_prints_the_checksum_of_the_outputs() {
+    let mut cfg = Config::baseline();
+    cfg.n = "16..=20".parse().unwrap();
+    let dp = Datapath::new(cfg).unwrap();
+    let want = slow_sum(&dp, 0..32_769);
+    for threads in ["1", "2"] {
+        let run = common::specfx(&[
+            "throughput",
+            "--n",
+            "16..=20",
+            "--threads",
+            threads,
+            "--repeat",
+            "1",
+            "--json",
+        ]);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        assert_eq!(v["checksum"], want.to_string());
+        assert_eq!(v["evaluations"], 5 * 32_769);
+        assert_eq!(v["threads"], threads.parse::<u64>().unwrap());
+    }
+    let bad = common::specfx(&["throughput", "--threads", "0"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&bad.stderr).lines().count(), 1);
 }
