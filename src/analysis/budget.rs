@@ -16,7 +16,8 @@ use serde::Serialize;
 use crate::analysis::check::{check, CheckReport, Input};
 use crate::analysis::optimize::{metric_value, Budget, Metric};
 use crate::fixed::{quantize_f64, Format};
-use crate::pipeline::{Datapath, NConstants, ProbeColumns, StageSpec, Variant};
+use crate::pipeline::walk::{walk, Arithmetic, Stage};
+use crate::pipeline::{Datapath, NConstants, ProbeColumns, StageSpec, Variant, MAX_STAGES};
 use crate::reference::lobe::Cutoff;
 
 /// An error source: a quantization the datapath performs that the f64 model does not.
@@ -94,8 +95,142 @@ fn quantize_spec(x: f64, spec: &StageSpec) -> f64 {
         .map_or(x, |q| spec.format.to_f64(q.raw))
 }
 
+/// The `f64` interpreter of the datapath's walk ([`walk`]): every step in `f64`, the sources in
+/// `mask` quantized as the datapath quantizes them and every other step exact. With `mask = 0`
+/// it is the same algorithm without rounding, the reference of `check`.
+pub struct F64Walk<'a> {
+    dp: &'a Datapath,
+    nc: &'a NConstants,
+    /// The input, clamped to 1.0.
+    c: f64,
+    below: bool,
+    mask: u32,
+    slope: f64,
+    offset: f64,
+    /// The value of every stage, indexed like the datapath's probes.
+    pub values: [f64; MAX_STAGES],
+}
+
+impl<'a> F64Walk<'a> {
+    /// The interpreter for an input value `c` (clamped to 1.0 here); `below_threshold` says
+    /// whether the paper cutoff cuts it.
+    pub fn new(
+        dp: &'a Datapath,
+        nc: &'a NConstants,
+        c: f64,
+        below_threshold: bool,
+        mask: u32,
+    ) -> F64Walk<'a> {
+        let on = mask & Source::Constants.mask() != 0;
+        let (slope, offset) = if on {
+            (
+                nc.slope_raw as f64 * (-f64::from(nc.slope_frac)).exp2(),
+                nc.offset_raw as f64 * (-f64::from(nc.offset_frac)).exp2(),
+            )
+        } else {
+            (nc.slope, nc.offset)
+        };
+        F64Walk {
+            dp,
+            nc,
+            c: c.min(1.0),
+            below: below_threshold,
+            mask,
+            slope,
+            offset,
+            values: [0.0; MAX_STAGES],
+        }
+    }
+
+    /// The interpreter for a raw input code (clamped to 1.0, exact in `f64`).
+    pub fn at_code(dp: &'a Datapath, nc: &'a NConstants, c_raw: i64, mask: u32) -> F64Walk<'a> {
+        let code = c_raw.min(dp.one_code());
+        let c = code as f64 * dp.config().c.format.lsb();
+        F64Walk::new(dp, nc, c, nc.below_threshold(code), mask)
+    }
+
+    /// Walks the datapath: returns (lobe, output); every stage's value is in `values`.
+    pub fn run(&mut self) -> (f64, f64) {
+        let cfg = self.dp.config();
+        let w = walk(self, cfg.cutoff, cfg.k as usize);
+        (w.lobe, w.out)
+    }
+
+    fn on(&self, s: Source) -> bool {
+        self.mask & s.mask() != 0
+    }
+
+    fn record(&mut self, stage: Stage, x: f64) -> f64 {
+        self.values[stage.index(self.dp.config().k as usize)] = x;
+        x
+    }
+}
+
+impl Arithmetic for F64Walk<'_> {
+    type Value = f64;
+
+    fn sub(&mut self) -> f64 {
+        self.record(Stage::D, self.c - 1.0)
+    }
+
+    fn below_threshold(&self) -> bool {
+        self.below
+    }
+
+    fn mul_t(&mut self, d: f64) -> f64 {
+        let mut t = self.slope * d;
+        if self.on(Source::T) {
+            t = quantize_spec(t, &self.dp.config().t);
+        }
+        self.record(Stage::T, t)
+    }
+
+    fn add_offset(&mut self, t: f64) -> f64 {
+        t + self.offset
+    }
+
+    fn is_negative(&self, sum: f64) -> bool {
+        sum < 0.0
+    }
+
+    fn zero(&self) -> f64 {
+        0.0
+    }
+
+    fn quant_b(&mut self, mut base: f64) -> f64 {
+        if self.on(Source::B) {
+            base = quantize_spec(base, &self.dp.config().b);
+        }
+        self.record(Stage::B, base)
+    }
+
+    fn square(&mut self, i: usize, x: f64) -> f64 {
+        let mut s = x * x;
+        if self.on(Source::Square(i)) {
+            s = quantize_spec(s, &self.dp.config().square[i]);
+        }
+        self.record(Stage::Square(i), s)
+    }
+
+    fn mul_out(&mut self, s: f64) -> f64 {
+        let cfg = self.dp.config();
+        let coef = if self.on(Source::Coef) {
+            cfg.coef.format.to_f64(self.nc.coef_raw)
+        } else {
+            self.nc.coef
+        };
+        self.record(Stage::Coef, coef);
+        let mut out = s * coef;
+        if self.on(Source::Out) {
+            out = quantize_spec(out, &cfg.out);
+        }
+        self.record(Stage::Out, out)
+    }
+}
+
 /// The f64 model of the datapath with the sources in `mask` quantized as the datapath
-/// quantizes them and everything else exact: returns (lobe, output).
+/// quantizes them and everything else exact: returns (lobe, output). It is [`F64Walk`] at a
+/// raw input code.
 ///
 /// With `mask = 0` this is the reference of `check` ([`crate::analysis::check::reference_probes`]);
 /// with [`ALL_SOURCES`] it is the datapath itself whenever every f64 product is exact.
@@ -111,49 +246,7 @@ fn quantize_spec(x: f64, spec: &StageSpec) -> f64 {
 /// assert_eq!(out, dp.stages()[dp.stage_out()].format.to_f64(fixed));
 /// ```
 pub fn mixed_eval(dp: &Datapath, nc: &NConstants, c_raw: i64, mask: u32) -> (f64, f64) {
-    let cfg = dp.config();
-    let on = |s: Source| mask & s.mask() != 0;
-    let code = c_raw.min(dp.one_code());
-    let c = code as f64 * cfg.c.format.lsb();
-    let d = c - 1.0;
-    let (slope, offset) = if on(Source::Constants) {
-        (
-            nc.slope_raw as f64 * (-f64::from(nc.slope_frac)).exp2(),
-            nc.offset_raw as f64 * (-f64::from(nc.offset_frac)).exp2(),
-        )
-    } else {
-        (nc.slope, nc.offset)
-    };
-    let mut t = slope * d;
-    if on(Source::T) {
-        t = quantize_spec(t, &cfg.t);
-    }
-    let sum = t + offset;
-    let cut = match cfg.cutoff {
-        Cutoff::Clamp => sum < 0.0,
-        Cutoff::Paper => nc.threshold.is_some_and(|thr| code < thr),
-        Cutoff::None => false,
-    };
-    let mut s = if cut { 0.0 } else { sum };
-    if on(Source::B) {
-        s = quantize_spec(s, &cfg.b);
-    }
-    for (i, spec) in cfg.square.iter().enumerate() {
-        s *= s;
-        if on(Source::Square(i)) {
-            s = quantize_spec(s, spec);
-        }
-    }
-    let coef = if on(Source::Coef) {
-        cfg.coef.format.to_f64(nc.coef_raw)
-    } else {
-        nc.coef
-    };
-    let mut out = s * coef;
-    if on(Source::Out) {
-        out = quantize_spec(out, &cfg.out);
-    }
-    (s, out)
+    F64Walk::at_code(dp, nc, c_raw, mask).run()
 }
 
 /// Error figures of one source (or of the whole datapath) at the output.

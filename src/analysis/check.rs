@@ -9,6 +9,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::analysis::budget::F64Walk;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
 use crate::pipeline::fast::EventCounts;
 use crate::pipeline::{Datapath, NConstants, ProbeColumns, MAX_STAGES};
@@ -368,32 +369,11 @@ struct PerN {
 /// assert_eq!(r[6], 0.5f64.powi(16)); // sq4 = b^16
 /// ```
 pub fn reference_probes(dp: &Datapath, nc: &NConstants, c: f64) -> [f64; MAX_STAGES] {
-    let cfg = dp.config();
-    let mut r = [0.0; MAX_STAGES];
-    let c = c.min(1.0);
-    r[STAGE_D] = c - 1.0;
-    r[STAGE_T] = nc.slope * r[STAGE_D];
-    let sum = r[STAGE_T] + nc.offset;
-    r[STAGE_B] = match cfg.cutoff {
-        Cutoff::Clamp => sum.max(0.0),
-        Cutoff::Paper => {
-            let code = c * dp.one_code() as f64;
-            if nc.threshold.is_some_and(|thr| code < thr as f64) {
-                0.0
-            } else {
-                sum
-            }
-        }
-        Cutoff::None => sum,
-    };
-    let mut s = r[STAGE_B];
-    for i in 0..cfg.k as usize {
-        s *= s;
-        r[STAGE_B + 1 + i] = s;
-    }
-    r[dp.stage_coef()] = nc.coef;
-    r[dp.stage_out()] = nc.coef * s;
-    r
+    let code = c.min(1.0) * dp.one_code() as f64;
+    let below = nc.threshold.is_some_and(|thr| code < thr as f64);
+    let mut model = F64Walk::new(dp, nc, c, below, 0);
+    model.run();
+    model.values
 }
 
 /// Codes evaluated per batch: small enough for the columns to stay in cache.
@@ -404,10 +384,10 @@ const CHUNK: usize = 2048;
 #[inline]
 fn reference_base(cutoff: Cutoff, t: f64, offset: f64, cut_by_threshold: bool) -> f64 {
     let sum = t + offset;
-    match cutoff {
-        Cutoff::Clamp => sum.max(0.0),
-        Cutoff::Paper if cut_by_threshold => 0.0,
-        Cutoff::Paper | Cutoff::None => sum,
+    if cutoff.cuts(sum < 0.0, cut_by_threshold) {
+        0.0
+    } else {
+        sum
     }
 }
 

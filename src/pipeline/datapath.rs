@@ -11,6 +11,7 @@ use crate::pipeline::config::{Config, Variant};
 use crate::pipeline::fast::{
     constant_bits, count_event, magnitude_bits, quantize_to, BatchPlan, EventCounts, Kernel, Pre,
 };
+use crate::pipeline::walk::{walk, Arithmetic};
 use crate::reference::lobe::{m_of_k, Cutoff, PAPER_CUTOFF_CONSTANT};
 use crate::reference::minimax;
 use crate::reference::normalisation::coefficient;
@@ -555,29 +556,30 @@ impl Datapath {
     /// This is the plain transcription of the arithmetic (exact intermediates in `i128`,
     /// quantized by [`quantize`]); [`Datapath::eval_batch`] is its fast twin.
     pub fn eval(&self, c_raw: i64, nc: &NConstants) -> Probes {
-        let mut p = Probes::default();
-        let (c, d) = self.op_sub(c_raw);
-        p.input_clamped = c != c_raw;
-        p.values[STAGE_D] = d;
-        let t = self.op_mul_t(d, nc);
-        p.values[STAGE_T] = t.raw;
-        p.events[STAGE_T] = t.event;
-        let (b, cut) = self.op_add_b(t.raw, c, nc);
-        p.cut = cut;
-        p.values[STAGE_B] = b.raw;
-        p.events[STAGE_B] = b.event;
-        let mut s = b.raw;
-        for i in 0..self.config.k as usize {
-            let q = self.op_square(i, s);
-            p.values[STAGE_SQ0 + i] = q.raw;
-            p.events[STAGE_SQ0 + i] = q.event;
-            s = q.raw;
-        }
-        p.values[self.stage_coef()] = nc.coef_raw;
-        let o = self.op_mul_out(s, nc);
-        p.values[self.stage_out()] = o.raw;
-        p.events[self.stage_out()] = o.event;
+        let mut fixed = FixedWalk {
+            dp: self,
+            nc,
+            c_raw,
+            c: c_raw,
+            probes: Probes::default(),
+        };
+        let walked = walk(&mut fixed, self.config.cutoff, self.config.k as usize);
+        let mut p = fixed.probes;
+        p.cut = walked.cut;
         p
+    }
+
+    /// The exact sum `t + offset` on the larger of their fraction bits (`b_frac`).
+    fn exact_sum(&self, t: i64, nc: &NConstants) -> i128 {
+        let ft = self.config.t.format.frac_bits();
+        let fb = self.b_frac(nc);
+        (i128::from(t) << (fb - ft) as u32)
+            + (i128::from(nc.offset_raw) << (fb - nc.offset_frac) as u32)
+    }
+
+    /// Fraction bits of the exact sum `t + offset`.
+    fn b_frac(&self, nc: &NConstants) -> i32 {
+        self.config.t.format.frac_bits().max(nc.offset_frac)
     }
 
     /// Operation `sub`: clamps the input code to 1.0 and returns it with d = c - 1, exact in
@@ -600,20 +602,10 @@ impl Datapath {
     /// Operation `add_b`: b = t + offset, exact on the larger fraction, then the cutoff (which
     /// needs the clamped input code `c`), then b's stage. Returns b and whether it was cut.
     pub fn op_add_b(&self, t: i64, c: i64, nc: &NConstants) -> (Quantized, bool) {
-        let cfg = &self.config;
-        let ft = cfg.t.format.frac_bits();
-        let fb = ft.max(nc.offset_frac);
-        let mut sum = (i128::from(t) << (fb - ft) as u32)
-            + (i128::from(nc.offset_raw) << (fb - nc.offset_frac) as u32);
-        let cut = match cfg.cutoff {
-            Cutoff::Clamp => sum < 0,
-            Cutoff::Paper => nc.threshold.is_some_and(|thr| c < thr),
-            Cutoff::None => false,
-        };
-        if cut {
-            sum = 0;
-        }
-        (quantize_to(sum, fb, &cfg.b), cut)
+        let sum = self.exact_sum(t, nc);
+        let cut = self.config.cutoff.cuts(sum < 0, nc.below_threshold(c));
+        let base = if cut { 0 } else { sum };
+        (quantize_to(base, self.b_frac(nc), &self.config.b), cut)
     }
 
     /// Operation `square` number `i` (0-based): the exact square of the previous stage's raw
@@ -927,6 +919,74 @@ impl Datapath {
         live_codes.extend(live..codes.end);
         self.eval_outputs(nc, &live_codes, &mut out[n_dead..], scratch);
         scratch.codes = live_codes;
+    }
+}
+
+/// The bit-accurate interpreter of the walk: raw values (exact sums in `i128`), every stage's
+/// probe and overflow event recorded as the walk goes.
+struct FixedWalk<'a> {
+    dp: &'a Datapath,
+    nc: &'a NConstants,
+    c_raw: i64,
+    /// The input clamped to 1.0 (set by `sub`).
+    c: i64,
+    probes: Probes,
+}
+
+impl FixedWalk<'_> {
+    fn record(&mut self, stage_idx: usize, q: Quantized) -> i128 {
+        self.probes.values[stage_idx] = q.raw;
+        self.probes.events[stage_idx] = q.event;
+        i128::from(q.raw)
+    }
+}
+
+impl Arithmetic for FixedWalk<'_> {
+    type Value = i128;
+
+    fn sub(&mut self) -> i128 {
+        let (c, d) = self.dp.op_sub(self.c_raw);
+        self.c = c;
+        self.probes.input_clamped = c != self.c_raw;
+        self.probes.values[STAGE_D] = d;
+        i128::from(d)
+    }
+
+    fn below_threshold(&self) -> bool {
+        self.nc.below_threshold(self.c)
+    }
+
+    fn mul_t(&mut self, d: i128) -> i128 {
+        let q = self.dp.op_mul_t(d as i64, self.nc);
+        self.record(STAGE_T, q)
+    }
+
+    fn add_offset(&mut self, t: i128) -> i128 {
+        self.dp.exact_sum(t as i64, self.nc)
+    }
+
+    fn is_negative(&self, sum: i128) -> bool {
+        sum < 0
+    }
+
+    fn zero(&self) -> i128 {
+        0
+    }
+
+    fn quant_b(&mut self, base: i128) -> i128 {
+        let q = quantize_to(base, self.dp.b_frac(self.nc), &self.dp.config.b);
+        self.record(STAGE_B, q)
+    }
+
+    fn square(&mut self, i: usize, x: i128) -> i128 {
+        let q = self.dp.op_square(i, x as i64);
+        self.record(STAGE_SQ0 + i, q)
+    }
+
+    fn mul_out(&mut self, s: i128) -> i128 {
+        self.probes.values[self.dp.stage_coef()] = self.nc.coef_raw;
+        let q = self.dp.op_mul_out(s as i64, self.nc);
+        self.record(self.dp.stage_out(), q)
     }
 }
 

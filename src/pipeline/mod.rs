@@ -19,6 +19,7 @@
 pub mod config;
 pub mod datapath;
 pub mod fast;
+pub mod walk;
 
 pub use config::{CoefSpec, Config, FormatSpec, LatencySpec, MinimaxSpec, StageSpec, Variant};
 pub use datapath::{

@@ -38,6 +38,28 @@ impl Cutoff {
             Cutoff::None => "none",
         }
     }
+
+    /// Whether a datapath cuts its base to zero: the clamp when the exact sum `t + offset` is
+    /// negative, the paper rule when the input is below its threshold, `none` never. This is
+    /// the one place the datapaths' cutoff rule is written; every model of a datapath (bit
+    /// accurate, batch, `f64`, mixed) asks it.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::reference::lobe::Cutoff;
+    /// assert!(Cutoff::Clamp.cuts(true, false));
+    /// assert!(!Cutoff::Clamp.cuts(false, true));
+    /// assert!(Cutoff::Paper.cuts(false, true));
+    /// assert!(!Cutoff::None.cuts(true, true));
+    /// ```
+    #[inline]
+    pub fn cuts(self, sum_is_negative: bool, below_threshold: bool) -> bool {
+        match self {
+            Cutoff::Clamp => sum_is_negative,
+            Cutoff::Paper => below_threshold,
+            Cutoff::None => false,
+        }
+    }
 }
 
 crate::names::named_enum!(Cutoff, "cutoff", "clamp, paper or none");
