@@ -50,16 +50,24 @@ impl Source {
         }
     }
 
-    /// The name reports use: `constants`, `t`, `b`, `sq1`.., `coef`, `out`.
-    pub fn name(self) -> String {
+    /// The stage this source quantizes (`None` for the minimax constants, which feed t and
+    /// b but are no stage of their own).
+    pub fn stage(self) -> Option<Stage> {
         match self {
-            Source::Constants => "constants".into(),
-            Source::T => "t".into(),
-            Source::B => "b".into(),
-            Source::Square(i) => format!("sq{}", i + 1),
-            Source::Coef => "coef".into(),
-            Source::Out => "out".into(),
+            Source::Constants => None,
+            Source::T => Some(Stage::T),
+            Source::B => Some(Stage::B),
+            Source::Square(i) => Some(Stage::Square(i)),
+            Source::Coef => Some(Stage::Coef),
+            Source::Out => Some(Stage::Out),
         }
+    }
+
+    /// The name reports use: `constants`, or the stage's name (`t`, `b`, `sq1`.., `coef`,
+    /// `out`).
+    pub fn name(self) -> String {
+        self.stage()
+            .map_or_else(|| "constants".to_string(), |s| s.to_string())
     }
 }
 

@@ -26,6 +26,7 @@ pub mod vcd;
 
 use serde::Serialize;
 
+use crate::pipeline::walk::Stage;
 use crate::pipeline::Datapath;
 
 /// The two microarchitectures.
@@ -127,8 +128,19 @@ impl Op {
             Op::Sub => "sub".into(),
             Op::MulT => "mul_t".into(),
             Op::AddB => "add_b".into(),
-            Op::Square(i) => format!("sq{}", i + 1),
+            Op::Square(i) => Stage::Square(i).to_string(),
             Op::MulOut => "mul_out".into(),
+        }
+    }
+
+    /// The stage whose value this operation computes.
+    pub fn stage(self) -> Stage {
+        match self {
+            Op::Sub => Stage::D,
+            Op::MulT => Stage::T,
+            Op::AddB => Stage::B,
+            Op::Square(i) => Stage::Square(i),
+            Op::MulOut => Stage::Out,
         }
     }
 
@@ -309,15 +321,8 @@ impl Machine for Pipelined {
 
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
         let stages = dp.stages();
-        let width_of = |op: Op| -> u32 {
-            match op {
-                Op::Sub => stages[0].format.width(),
-                Op::MulT => stages[1].format.width(),
-                Op::AddB => stages[2].format.width(),
-                Op::Square(i) => stages[3 + i].format.width(),
-                Op::MulOut => stages[dp.stage_out()].format.width(),
-            }
-        };
+        let k = dp.config().k as usize;
+        let width_of = |op: Op| -> u32 { stages[op.stage().index(k)].format.width() };
         let mut index_in_op = 0;
         self.owner
             .iter()

@@ -125,7 +125,7 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
     let mut prev = cfg.b.format;
     for (i, sq) in cfg.square.iter().enumerate() {
         products.push(Multiplier {
-            name: format!("sq{}", i + 1),
+            name: crate::pipeline::walk::Stage::Square(i).to_string(),
             a_bits: w(prev),
             b_bits: w(prev),
         });

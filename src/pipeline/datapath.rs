@@ -11,7 +11,7 @@ use crate::pipeline::config::{Config, Variant};
 use crate::pipeline::fast::{
     constant_bits, count_event, magnitude_bits, quantize_to, BatchPlan, EventCounts, Kernel, Pre,
 };
-use crate::pipeline::walk::{walk, Arithmetic};
+use crate::pipeline::walk::{walk, Arithmetic, Stage};
 use crate::reference::lobe::{m_of_k, Cutoff, PAPER_CUTOFF_CONSTANT};
 use crate::reference::minimax;
 use crate::reference::normalisation::coefficient;
@@ -34,7 +34,9 @@ const MAX_EXACT_BITS: u32 = 126;
 /// A stage as reports and vector files name it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct StageInfo {
-    /// `d`, `t`, `b`, `sq1`..`sqk`, `coef` or `out`.
+    /// The stage.
+    pub stage: Stage,
+    /// Its name: `d`, `t`, `b`, `sq1`..`sqk`, `coef` or `out`.
     pub name: String,
     /// The format of the stage's value.
     pub format: Format,
@@ -327,34 +329,21 @@ impl Datapath {
             }
         }
 
-        let mut stages = vec![
-            StageInfo {
-                name: "d".into(),
-                format: df,
-            },
-            StageInfo {
-                name: "t".into(),
-                format: config.t.format,
-            },
-            StageInfo {
-                name: "b".into(),
-                format: config.b.format,
-            },
-        ];
-        for (i, sq) in config.square.iter().enumerate() {
-            stages.push(StageInfo {
-                name: format!("sq{}", i + 1),
-                format: sq.format,
-            });
-        }
-        stages.push(StageInfo {
-            name: "coef".into(),
-            format: config.coef.format,
-        });
-        stages.push(StageInfo {
-            name: "out".into(),
-            format: config.out.format,
-        });
+        let stages = Stage::all(k as usize)
+            .into_iter()
+            .map(|stage| StageInfo {
+                stage,
+                name: stage.to_string(),
+                format: match stage {
+                    Stage::D => df,
+                    Stage::T => config.t.format,
+                    Stage::B => config.b.format,
+                    Stage::Square(i) => config.square[i].format,
+                    Stage::Coef => config.coef.format,
+                    Stage::Out => config.out.format,
+                },
+            })
+            .collect();
         let plan = Self::batch_plan(&config, &constants);
         // t is non-decreasing in c when every slope is >= 0 and t saturates (every rounding
         // mode is monotone; WRAP and SAT_ZERO are not): then so is t + offset, and the clamp
