@@ -58,6 +58,44 @@ pub enum Error {
         /// The parser's message, on one line.
         message: String,
     },
+    /// An input format with more codes than an exhaustive analysis evaluates.
+    #[error("c.format {format} has {n_codes} input codes up to 1.0; an exhaustive check evaluates at most {limit}")]
+    TooManyCodes {
+        /// The input format.
+        format: String,
+        /// Its codes up to 1.0.
+        n_codes: u64,
+        /// The most an exhaustive check evaluates.
+        limit: u64,
+    },
+    /// A sweep shard that is not `I/N` with `0 <= I < N`.
+    #[error("expected a shard I/N with 0 <= I < N, got '{got}'")]
+    Shard {
+        /// What was given.
+        got: String,
+    },
+    /// A chart or document that could not be drawn.
+    #[error("{message}")]
+    Render {
+        /// The drawing library's complaint.
+        message: String,
+    },
+    /// An external tool (yosys, gappa) failed or answered something that cannot be read.
+    #[error("{message}")]
+    Tool {
+        /// The tool.
+        tool: &'static str,
+        /// What went wrong.
+        message: String,
+    },
+    /// A formal bound that cannot be proved this way for one exponent.
+    #[error("{reason}")]
+    Unprovable {
+        /// The exponent.
+        n: u32,
+        /// Why.
+        reason: String,
+    },
     /// The minimax table has no entry for this (n, k).
     #[error("no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..=7")]
     NoMinimaxEntry {

@@ -15,6 +15,7 @@ use serde::Serialize;
 
 use crate::analysis::check::{check, CheckReport, Input};
 use crate::analysis::optimize::{metric_value, Budget, Metric};
+use crate::error::Error;
 use crate::fixed::{quantize_f64, Format};
 use crate::pipeline::walk::{walk, Arithmetic, Stage};
 use crate::pipeline::{Datapath, NConstants, ProbeColumns, StageSpec, Variant, MAX_STAGES};
@@ -817,7 +818,7 @@ fn source_spec(dp: &Datapath, src: Source) -> (Format, String) {
 /// assert_eq!(r.attribution.sources.len(), 8);
 /// assert!(r.attribution.total.max_abs <= r.attribution.sum_of_max_abs + r.attribution.residual_max_abs);
 /// ```
-pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, String> {
+pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, Error> {
     let report = check(dp)?;
     let cfg = dp.config();
     let c_lsb = cfg.c.format.lsb();

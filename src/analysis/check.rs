@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::analysis::budget::F64Walk;
+use crate::error::Error;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
 use crate::pipeline::fast::EventCounts;
 use crate::pipeline::{Datapath, NConstants, ProbeColumns, MAX_STAGES};
@@ -654,7 +655,8 @@ pub const MAX_CHECK_CODES: u64 = 1 << 24;
 
 /// Checks a datapath exhaustively: every input code up to 1.0, every n of its set.
 ///
-/// Returns an error message when the input format has more than [`MAX_CHECK_CODES`] codes.
+/// Returns [`Error::TooManyCodes`] when the input format has more than [`MAX_CHECK_CODES`]
+/// codes up to 1.0.
 ///
 /// # Examples
 /// ```
@@ -666,15 +668,16 @@ pub const MAX_CHECK_CODES: u64 = 1 << 24;
 /// assert_eq!(r.n_evaluations, 32769);
 /// assert!(r.monotonic);
 /// ```
-pub fn check(dp: &Datapath) -> Result<CheckReport, String> {
+pub fn check(dp: &Datapath) -> Result<CheckReport, Error> {
     let codes_all = dp.input_codes();
     let last = (*codes_all.end()).min(dp.one_code());
     let n_codes = (last - codes_all.start() + 1) as u64;
     if n_codes > MAX_CHECK_CODES {
-        return Err(format!(
-            "c.format {} has {n_codes} input codes up to 1.0; an exhaustive check evaluates at most {MAX_CHECK_CODES}",
-            dp.config().c.format
-        ));
+        return Err(Error::TooManyCodes {
+            format: dp.config().c.format.to_string(),
+            n_codes,
+            limit: MAX_CHECK_CODES,
+        });
     }
     let codes: Vec<i64> = (*codes_all.start()..=last).collect();
     let c_lsb = dp.config().c.format.lsb();

@@ -17,6 +17,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::analysis::budget::mixed_eval;
+use crate::error::Error;
 use crate::fixed::{Event, Exact, Rounding};
 use crate::pipeline::{Datapath, NConstants, StageSpec};
 use crate::reference::lobe::Cutoff;
@@ -98,12 +99,13 @@ fn first_code(one: i64, holds: impl Fn(i64) -> bool) -> i64 {
 /// assert_eq!(j.upper_from, Some(0)); // n = m: the base is c, never cut
 /// assert!(j.script.contains("@r_t = fixed<-16,nu>;")); // RND: to nearest, ties up
 /// ```
-pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, String> {
+pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, Error> {
+    let unprovable = |reason: String| Error::Unprovable { n: nc.n, reason };
     let cfg = dp.config();
     let one = dp.one_code();
     let c_lo = *dp.input_codes().start();
     if c_lo < 0 {
-        return Err("signed input formats are not covered".into());
+        return Err(unprovable("signed input formats are not covered".into()));
     }
     let upper_from = match cfg.cutoff {
         Cutoff::None => 0,
@@ -121,9 +123,9 @@ pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, String> {
         0.0
     } else {
         if (0..upper_from).any(|code| dp.eval(code, nc).events.contains(&Event::Wrapped)) {
-            return Err(format!(
+            return Err(unprovable(format!(
                 "a stage wraps below code {upper_from}, so the lower region is not monotone"
-            ));
+            )));
         }
         let below = upper_from - 1;
         let fixed = dp
@@ -263,12 +265,16 @@ pub fn parse_number(text: &str) -> Option<f64> {
 /// assert_eq!(r["t"], (-1.0, 0.0));
 /// assert_eq!(r["out - Mout"], (-3.0 / 1048576.0, 1.0 / 524288.0));
 /// ```
-pub fn parse_results(text: &str) -> Result<BTreeMap<String, (f64, f64)>, String> {
+pub fn parse_results(text: &str) -> Result<BTreeMap<String, (f64, f64)>, Error> {
+    let unreadable = |message: String| Error::Tool {
+        tool: "gappa",
+        message,
+    };
     let mut map = BTreeMap::new();
     let body = text
         .split_once("Results:")
         .map(|(_, b)| b)
-        .ok_or_else(|| format!("gappa printed no results: {}", first_line(text)))?;
+        .ok_or_else(|| unreadable(format!("gappa printed no results: {}", first_line(text))))?;
     for line in body.lines() {
         let Some((name, interval)) = line.trim().split_once(" in [") else {
             continue;
@@ -284,7 +290,12 @@ pub fn parse_results(text: &str) -> Result<BTreeMap<String, (f64, f64)>, String>
             (Some(lo), Some(hi)) => {
                 map.insert(name.trim().to_string(), (lo, hi));
             }
-            _ => return Err(format!("cannot read gappa's interval '{}'", line.trim())),
+            _ => {
+                return Err(unreadable(format!(
+                    "cannot read gappa's interval '{}'",
+                    line.trim()
+                )))
+            }
         }
     }
     Ok(map)
@@ -299,25 +310,26 @@ fn first_line(text: &str) -> &str {
 
 /// The bound of one job from gappa's output: max(|proved error| over the upper region, the
 /// lower region's bound), after checking that every stage's proved range fits its format.
-pub fn bound(job: &Job, gappa_output: &str) -> Result<f64, String> {
+pub fn bound(job: &Job, gappa_output: &str) -> Result<f64, Error> {
+    let unproved = |reason: String| Error::Unprovable { n: job.n, reason };
     if job.upper_from.is_none() {
         return Ok(job.lower_bound);
     }
     let results = parse_results(gappa_output)?;
     let (lo, hi) = *results.get("out - Mout").ok_or_else(|| {
-        format!(
+        unproved(format!(
             "gappa did not bound the error: {}",
             first_line(gappa_output)
-        )
+        ))
     })?;
     for (name, fmin, fmax) in &job.ranges {
         let (rlo, rhi) = results
             .get(name.as_str())
-            .ok_or_else(|| format!("gappa did not bound stage {name}"))?;
+            .ok_or_else(|| unproved(format!("gappa did not bound stage {name}")))?;
         if *rlo < *fmin || *rhi > *fmax {
-            return Err(format!(
+            return Err(unproved(format!(
                 "stage {name} may leave its format: gappa proves only [{rlo}, {rhi}] against {fmin}..={fmax}"
-            ));
+            )));
         }
     }
     Ok(lo.abs().max(hi.abs()).max(job.lower_bound))

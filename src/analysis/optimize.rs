@@ -21,6 +21,7 @@ use serde::Serialize;
 use crate::analysis::check::{check, CheckReport};
 use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
+use crate::pipeline::walk::Stage;
 use crate::pipeline::StageSpec;
 use crate::pipeline::{Config, Datapath, Variant};
 
@@ -175,42 +176,27 @@ impl Budget {
 
 /// The searched stages: `t`, `b`, `sq1`..`sqk`. The output format is the interface the
 /// design must deliver (and the unit of `out <= N ulp`), so it is kept as the base has it.
-fn stage_names(k: u32) -> Vec<String> {
-    let mut v = vec!["t".to_string(), "b".to_string()];
-    v.extend((1..=k).map(|i| format!("sq{i}")));
+fn searched_stages(k: u32) -> Vec<Stage> {
+    let mut v = vec![Stage::T, Stage::B];
+    v.extend((0..k as usize).map(Stage::Square));
     v
 }
 
-/// The spec of a searched stage (or `out`) by name.
-fn spec_mut<'a>(cfg: &'a mut Config, stage: &str) -> Result<&'a mut StageSpec, String> {
-    Ok(match stage {
-        "t" => &mut cfg.t,
-        "b" => &mut cfg.b,
-        "out" => &mut cfg.out,
-        s => {
-            let i: usize = s
-                .get(2..)
-                .and_then(|x| x.parse().ok())
-                .ok_or_else(|| format!("bad stage {s}"))?;
-            cfg.square
-                .get_mut(i.wrapping_sub(1))
-                .ok_or_else(|| format!("bad stage {s}"))?
-        }
-    })
+/// The spec of a quantizing stage: t, b, a squaring or out (d and coef have none).
+fn spec_mut(cfg: &mut Config, stage: Stage) -> &mut StageSpec {
+    match stage {
+        Stage::T => &mut cfg.t,
+        Stage::B => &mut cfg.b,
+        Stage::Square(i) => &mut cfg.square[i],
+        Stage::Out => &mut cfg.out,
+        Stage::D | Stage::Coef => unreachable!("the optimiser moves only quantizing stages"),
+    }
 }
 
-fn set_frac(cfg: &mut Config, stage: &str, frac: i32) -> Result<(), String> {
-    let spec = match stage {
-        "t" => &mut cfg.t,
-        "b" => &mut cfg.b,
-        "out" => &mut cfg.out,
-        s => {
-            let i: usize = s[2..].parse().map_err(|_| format!("bad stage {s}"))?;
-            &mut cfg.square[i - 1]
-        }
-    };
-    spec.format = Format::new(spec.format.is_signed(), spec.format.int_bits(), frac)
-        .map_err(|e| e.to_string())?;
+/// Gives a stage `frac` fraction bits, keeping its integer bits.
+fn set_frac(cfg: &mut Config, stage: Stage, frac: i32) -> Result<(), Error> {
+    let spec = spec_mut(cfg, stage);
+    spec.format = Format::new(spec.format.is_signed(), spec.format.int_bits(), frac)?;
     Ok(())
 }
 
@@ -262,12 +248,12 @@ pub fn optimize(
     budget: &Budget,
     choices: &Choices,
     start_frac: i32,
-    cost: &mut dyn FnMut(&Datapath) -> Result<f64, String>,
+    cost: &mut dyn FnMut(&Datapath) -> Result<f64, Error>,
     progress: &mut dyn FnMut(&str),
-) -> Result<OptimizeResult, String> {
+) -> Result<OptimizeResult, Error> {
     let mut n_eval = 0u64;
     let mut memo: BTreeMap<String, Option<Candidate>> = BTreeMap::new();
-    let mut evaluate = |cfg: &Config, n_eval: &mut u64| -> Result<Option<Candidate>, String> {
+    let mut evaluate = |cfg: &Config, n_eval: &mut u64| -> Result<Option<Candidate>, Error> {
         let key = cfg.to_toml();
         if let Some(c) = memo.get(&key) {
             return Ok(c.clone());
@@ -297,8 +283,8 @@ pub fn optimize(
                 cfg.k = k;
                 cfg.square = vec![base.square[0]; k as usize];
                 cfg.variant = variant;
-                let stages = stage_names(k);
-                for s in &stages {
+                let stages = searched_stages(k);
+                for &s in &stages {
                     set_frac(&mut cfg, s, start_frac)?;
                 }
                 cfg.t.rounding = rounding;
@@ -324,17 +310,9 @@ pub fn optimize(
                 let mut current = start;
                 loop {
                     let mut changed = false;
-                    for s in &stages {
-                        let frac_of = |c: &Config| -> i32 {
-                            match s.as_str() {
-                                "t" => c.t.format.frac_bits(),
-                                "b" => c.b.format.frac_bits(),
-                                "out" => c.out.format.frac_bits(),
-                                x => c.square[x[2..].parse::<usize>().unwrap_or(1) - 1]
-                                    .format
-                                    .frac_bits(),
-                            }
-                        };
+                    for &s in &stages {
+                        let frac_of =
+                            |c: &Config| -> i32 { spec_mut(&mut c.clone(), s).format.frac_bits() };
                         let (mut lo, mut hi) = (-1, frac_of(&current.config));
                         // Invariant: hi feasible; find the smallest feasible in (lo, hi], down
                         // to 0 fraction bits.
@@ -371,17 +349,17 @@ pub fn optimize(
     // no single move is both feasible and cheaper.
     let mut n_moves = 0u64;
     if let Some(mut current) = best.take() {
-        let mut stages = stage_names(current.config.k);
-        stages.push("out".into());
+        let mut stages = searched_stages(current.config.k);
+        stages.push(Stage::Out);
         loop {
             let mut improved = false;
-            for s in &stages {
-                let spec = *spec_mut(&mut current.config.clone(), s)?;
+            for &s in &stages {
+                let spec = *spec_mut(&mut current.config.clone(), s);
                 let mut trials = Vec::new();
                 for r in Rounding::ALL.into_iter().filter(|&r| r != spec.rounding) {
                     let mut trial = current.config.clone();
-                    spec_mut(&mut trial, s)?.rounding = r;
-                    if s != "out" {
+                    spec_mut(&mut trial, s).rounding = r;
+                    if s != Stage::Out {
                         let mut fewer = trial.clone();
                         if set_frac(&mut fewer, s, spec.format.frac_bits() - 1).is_ok() {
                             trials.push(fewer);
@@ -391,14 +369,14 @@ pub fn optimize(
                 }
                 for o in Overflow::ALL.into_iter().filter(|&o| o != spec.overflow) {
                     let mut trial = current.config.clone();
-                    spec_mut(&mut trial, s)?.overflow = o;
+                    spec_mut(&mut trial, s).overflow = o;
                     trials.push(trial);
                 }
                 for trial in trials {
                     n_moves += 1;
                     if let Some(c) = evaluate(&trial, &mut n_eval)? {
                         if c.feasible && c.cost < current.cost {
-                            let now = *spec_mut(&mut c.config.clone(), s)?;
+                            let now = *spec_mut(&mut c.config.clone(), s);
                             progress(&format!(
                                 "  local search: {s} {} {} {}: {:.0} LUTs",
                                 now.format, now.rounding, now.overflow, c.cost
@@ -429,17 +407,10 @@ pub fn optimize(
         minimality.push(format!(
             "then a local search over every stage's rounding and overflow modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried, none of the final ones both feasible and cheaper"
         ));
-        for s in stage_names(b.config.k) {
+        for s in searched_stages(b.config.k) {
             let mut trial = b.config.clone();
-            let frac = match s.as_str() {
-                "t" => trial.t.format.frac_bits(),
-                "b" => trial.b.format.frac_bits(),
-                "out" => trial.out.format.frac_bits(),
-                x => trial.square[x[2..].parse::<usize>().unwrap_or(1) - 1]
-                    .format
-                    .frac_bits(),
-            };
-            let verdict = if set_frac(&mut trial, &s, frac - 1).is_err() {
+            let frac = spec_mut(&mut trial, s).format.frac_bits();
+            let verdict = if set_frac(&mut trial, s, frac - 1).is_err() {
                 "cannot lose a bit (format limit)".to_string()
             } else {
                 match evaluate(&trial, &mut n_eval)? {

@@ -192,11 +192,11 @@ impl Space {
     }
 
     /// The configuration and architecture of point `index`.
-    pub fn point(&self, index: u64) -> Result<(Config, Arch), String> {
+    pub fn point(&self, index: u64) -> Result<(Config, Arch), Error> {
         let mut cfg = self.base.clone();
         let mut arch = Arch::Pipelined;
         for (key, v) in self.point_values(index) {
-            apply(&mut cfg, &mut arch, &key, &v).map_err(|p| format!("{key}: {p}"))?;
+            apply(&mut cfg, &mut arch, &key, &v).map_err(|problem| space_error(&key, problem))?;
         }
         cfg.name = format!("point{index}");
         Ok((cfg, arch))
@@ -353,7 +353,7 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
     };
     let (cfg, arch) = match space.point(index) {
         Ok(p) => p,
-        Err(e) => return empty(e),
+        Err(e) => return empty(e.to_string()),
     };
     let dp = match Datapath::new(cfg) {
         Ok(dp) => dp,
@@ -361,7 +361,7 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
     };
     let r = match check(&dp) {
         Ok(r) => r,
-        Err(e) => return empty(e),
+        Err(e) => return empty(e.to_string()),
     };
     let cost = analytic_cost(&dp, arch, Target::Generic);
     PointResult {
@@ -482,8 +482,8 @@ pub fn chart(points: &[PointResult]) -> crate::report::chart::Chart {
 /// assert_eq!(parse_shard("1/4").unwrap(), (1, 4));
 /// assert!(parse_shard("4/4").is_err());
 /// ```
-pub fn parse_shard(s: &str) -> Result<(u64, u64), String> {
-    let bad = || format!("expected a shard I/N with 0 <= I < N, got '{s}'");
+pub fn parse_shard(s: &str) -> Result<(u64, u64), Error> {
+    let bad = || Error::Shard { got: s.to_string() };
     let (i, n) = s.split_once('/').ok_or_else(bad)?;
     let (i, n) = (
         i.trim().parse::<u64>().map_err(|_| bad())?,

@@ -95,7 +95,7 @@ fn run_gappa(script: &str) -> Result<Option<String>> {
 
 /// Proves bounds with gappa for the chosen exponents and adds them to the report.
 fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Result<()> {
-    let jobs: Vec<(u32, Result<gappa::Job, String>)> = ns
+    let jobs: Vec<(u32, Result<gappa::Job, specfx::Error>)> = ns
         .iter()
         .filter_map(|&n| dp.constants_for(n).map(|nc| (n, gappa::job(dp, nc))))
         .collect();
@@ -104,7 +104,7 @@ fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Re
         .map(|(n, job)| {
             let job = match job {
                 Ok(j) => j,
-                Err(why) => return Ok(Some((*n, f64::NAN, why.clone()))),
+                Err(why) => return Ok(Some((*n, f64::NAN, why.to_string()))),
             };
             let output = if job.upper_from.is_some() {
                 match run_gappa(&job.script)? {
@@ -126,7 +126,7 @@ fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Re
                     };
                     (*n, b, how)
                 }
-                Err(why) => (*n, f64::NAN, why),
+                Err(why) => (*n, f64::NAN, why.to_string()),
             }))
         })
         .collect();

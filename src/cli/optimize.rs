@@ -62,11 +62,14 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     };
     let hdl = super::cost::hdl_ref_dir(None);
     let arch = args.arch;
-    let mut cost = |dp: &Datapath| -> Result<f64, String> {
+    let mut cost = |dp: &Datapath| -> Result<f64, specfx::Error> {
         if yosys {
             super::cost::run_yosys(dp, arch, Target::Ice40, &hdl)
                 .map(|(c, _, _)| c.luts as f64)
-                .map_err(|e| format!("{e:#}"))
+                .map_err(|e| specfx::Error::Tool {
+                    tool: "yosys",
+                    message: format!("{e:#}"),
+                })
         } else {
             Ok(analytic_cost(dp, arch, Target::Generic).luts as f64)
         }

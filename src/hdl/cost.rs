@@ -1,6 +1,7 @@
 //! Hardware cost: a fast analytic model from the formats, and the yosys script and statistics
 //! parser behind `specfx cost` (which runs yosys; nothing here starts a process).
 
+use crate::error::Error;
 use std::collections::BTreeMap;
 
 use serde::Serialize;
@@ -276,13 +277,17 @@ pub struct YosysCost {
 }
 
 /// Classifies yosys's `stat -json` output (the `design` totals).
-pub fn parse_stat_json(text: &str, cmos_stat: Option<&str>) -> Result<YosysCost, String> {
-    let v: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| format!("stat -json output is not JSON: {e}"))?;
+pub fn parse_stat_json(text: &str, cmos_stat: Option<&str>) -> Result<YosysCost, Error> {
+    let unreadable = |message: String| Error::Tool {
+        tool: "yosys",
+        message,
+    };
+    let v: serde_json::Value = serde_json::from_str(text)
+        .map_err(|e| unreadable(format!("stat -json output is not JSON: {e}")))?;
     let design = &v["design"];
-    let by_type = design["num_cells_by_type"]
-        .as_object()
-        .ok_or("stat -json output has no design.num_cells_by_type")?;
+    let by_type = design["num_cells_by_type"].as_object().ok_or_else(|| {
+        unreadable("stat -json output has no design.num_cells_by_type".to_string())
+    })?;
     let mut cells_by_type = BTreeMap::new();
     let (mut luts, mut carries, mut dsps, mut ffs) = (0, 0, 0, 0);
     for (name, count) in by_type {

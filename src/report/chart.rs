@@ -1,6 +1,7 @@
 //! Charts: scatter and line series on linear or logarithmic axes, rendered to SVG text or PNG
 //! bytes with an embedded font (DejaVu Sans), so output is identical on every machine.
 
+use crate::error::Error;
 use std::sync::Once;
 
 use plotters::coord::Shift;
@@ -204,32 +205,37 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, chart: &Chart) -> Resu
     root.present().map_err(err)
 }
 
+/// A drawing library's complaint as the library's error.
+pub fn render_error(message: String) -> Error {
+    Error::Render { message }
+}
+
 /// Renders a chart as SVG text.
-pub fn render_svg(chart: &Chart) -> Result<String, String> {
+pub fn render_svg(chart: &Chart) -> Result<String, Error> {
     register_font();
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-        draw(root, chart)?;
+        draw(root, chart).map_err(render_error)?;
     }
     text.push('\n');
     Ok(text)
 }
 
 /// Renders a chart as PNG bytes.
-pub fn render_png(chart: &Chart) -> Result<Vec<u8>, String> {
+pub fn render_png(chart: &Chart) -> Result<Vec<u8>, Error> {
     register_font();
     let (w, h) = SIZE;
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-        draw(root, chart)?;
+        draw(root, chart).map_err(render_error)?;
     }
     encode_png(&rgb, SIZE)
 }
 
 /// Encodes an RGB buffer of `size` pixels as PNG bytes (best compression, deterministic).
-pub fn encode_png(rgb: &[u8], size: (u32, u32)) -> Result<Vec<u8>, String> {
+pub fn encode_png(rgb: &[u8], size: (u32, u32)) -> Result<Vec<u8>, Error> {
     let (w, h) = size;
     let mut png_bytes = Vec::new();
     {
@@ -237,8 +243,12 @@ pub fn encode_png(rgb: &[u8], size: (u32, u32)) -> Result<Vec<u8>, String> {
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
         enc.set_compression(png::Compression::Best);
-        let mut writer = enc.write_header().map_err(|e| e.to_string())?;
-        writer.write_image_data(rgb).map_err(|e| e.to_string())?;
+        let mut writer = enc
+            .write_header()
+            .map_err(|e| render_error(e.to_string()))?;
+        writer
+            .write_image_data(rgb)
+            .map_err(|e| render_error(e.to_string()))?;
     }
     Ok(png_bytes)
 }

@@ -1,6 +1,8 @@
 //! The stability report: heat maps of where each path fails (SVG and PNG), the overview of
 //! every path, the overshoot chart, the region and special-input tables, and the document.
 
+use crate::error::Error;
+use crate::report::chart::render_error;
 use std::io::{self, Write};
 
 use plotters::coord::Shift;
@@ -341,12 +343,12 @@ fn draw_overview<DB: DrawingBackend>(
 fn svg_with(
     size: (u32, u32),
     draw: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
-) -> Result<String, String> {
+) -> Result<String, Error> {
     register_font();
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
-        draw(root)?;
+        draw(root).map_err(render_error)?;
     }
     text.push('\n');
     Ok(text)
@@ -356,24 +358,24 @@ fn svg_with(
 fn png_with(
     size: (u32, u32),
     draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
-) -> Result<Vec<u8>, String> {
+) -> Result<Vec<u8>, Error> {
     register_font();
     let (w, h) = size;
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-        draw(root)?;
+        draw(root).map_err(render_error)?;
     }
     crate::report::chart::encode_png(&rgb, size)
 }
 
 /// The heat map of one path as SVG text.
-pub fn heatmap_svg(m: &PathMap, tol: f64) -> Result<String, String> {
+pub fn heatmap_svg(m: &PathMap, tol: f64) -> Result<String, Error> {
     svg_with(HEAT_SIZE, |root| draw_heatmap(root, m, tol))
 }
 
 /// The heat map of one path as PNG bytes.
-pub fn heatmap_png(m: &PathMap, tol: f64) -> Result<Vec<u8>, String> {
+pub fn heatmap_png(m: &PathMap, tol: f64) -> Result<Vec<u8>, Error> {
     png_with(HEAT_SIZE, |root| draw_heatmap(root, m, tol))
 }
 
@@ -383,14 +385,14 @@ fn overview_size(n_maps: usize) -> (u32, u32) {
 }
 
 /// The pass/fail overview of every path as SVG text.
-pub fn overview_svg(maps: &[PathMap], tol: f64) -> Result<String, String> {
+pub fn overview_svg(maps: &[PathMap], tol: f64) -> Result<String, Error> {
     svg_with(overview_size(maps.len()), |root| {
         draw_overview(root, maps, tol)
     })
 }
 
 /// The pass/fail overview of every path as PNG bytes.
-pub fn overview_png(maps: &[PathMap], tol: f64) -> Result<Vec<u8>, String> {
+pub fn overview_png(maps: &[PathMap], tol: f64) -> Result<Vec<u8>, Error> {
     png_with(overview_size(maps.len()), |root| {
         draw_overview(root, maps, tol)
     })
