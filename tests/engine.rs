@@ -96,3 +96,16 @@ fn the_throughput_command_prints_the_checksum_of_the_outputs() {
     assert_eq!(bad.status.code(), Some(2));
     assert_eq!(String::from_utf8_lossy(&bad.stderr).lines().count(), 1);
 }
+
+#[test]
+fn check_and_budget_are_the_same_with_one_and_two_threads() {
+    let mut cfg = Config::from_toml("cutoff = \"paper\"\n").unwrap();
+    cfg.n = "16,17,100,555,1024".parse().unwrap();
+    let dp = Datapath::new(cfg).unwrap();
+    let one = in_pool(1, || specfx::analysis::check::check(&dp).unwrap());
+    let two = in_pool(2, || specfx::analysis::check::check(&dp).unwrap());
+    assert_eq!(one, two);
+    let one = in_pool(1, || specfx::analysis::budget::analyse(&dp, None).unwrap());
+    let two = in_pool(2, || specfx::analysis::budget::analyse(&dp, None).unwrap());
+    assert_eq!(one, two);
+}

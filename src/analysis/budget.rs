@@ -10,11 +10,11 @@
 //!
 //! Work is split by n across threads and merged in n order, so every figure is deterministic.
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::analysis::check::{check, CheckReport, Input};
 use crate::analysis::optimize::{metric_value, Budget, Metric};
+use crate::engine::map_n;
 use crate::error::Error;
 use crate::fixed::{quantize_f64, Format};
 use crate::pipeline::walk::{walk, Arithmetic, Stage};
@@ -832,11 +832,7 @@ pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, E
     );
     let ln_c: Vec<f64> = codes.iter().map(|&k| (k as f64 * c_lsb).ln()).collect();
     let srcs = sources(dp);
-    let per_n_acc: Vec<Acc> = dp
-        .constants()
-        .par_iter()
-        .map(|nc| analyse_one_n(dp, nc, &codes, &ln_c, &srcs, ranges))
-        .collect();
+    let per_n_acc: Vec<Acc> = map_n(dp, |nc| analyse_one_n(dp, nc, &codes, &ln_c, &srcs, ranges));
     let mut acc = Acc::new(srcs.len(), ranges.0, ranges.1);
     let mut per_n = Vec::with_capacity(per_n_acc.len());
     for (nc, a) in dp.constants().iter().zip(&per_n_acc) {

@@ -6,10 +6,10 @@
 //! approximation. Work is split by n across threads and merged in n order, so every figure is
 //! deterministic.
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::analysis::budget::F64Walk;
+use crate::engine::map_n;
 use crate::error::Error;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
 use crate::pipeline::fast::EventCounts;
@@ -690,11 +690,7 @@ pub fn check(dp: &Datapath) -> Result<CheckReport, Error> {
             .collect(),
         codes,
     };
-    let per_n: Vec<PerN> = dp
-        .constants()
-        .par_iter()
-        .map(|nc| check_one_n(dp, nc, &shared))
-        .collect();
+    let per_n: Vec<PerN> = map_n(dp, |nc| check_one_n(dp, nc, &shared));
 
     let stages = dp.stages();
     let mut acc = vec![Acc::new(); stages.len()];

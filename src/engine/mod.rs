@@ -74,6 +74,23 @@ pub fn map_items<T: Send>(
         .collect()
 }
 
+/// Runs `work` once per exponent of the datapath, in parallel, and returns the results in the
+/// order of the n set: the engine's coarse items, for analyses whose figures are folded over
+/// the codes of one n in code order (their sums then do not depend on how codes are split).
+///
+/// # Examples
+/// ```
+/// use specfx::engine::map_n;
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let ns = map_n(&dp, |nc| nc.n);
+/// assert_eq!(ns.len(), 1009);
+/// assert_eq!((ns[0], ns[1008]), (16, 1024));
+/// ```
+pub fn map_n<T: Send>(dp: &Datapath, work: impl Fn(&NConstants) -> T + Sync) -> Vec<T> {
+    dp.constants().par_iter().map(&work).collect()
+}
+
 /// The output codes of a datapath over a range of input codes for every n: the checksum and
 /// count of its evaluations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

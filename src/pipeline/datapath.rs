@@ -545,16 +545,15 @@ impl Datapath {
     /// This is the plain transcription of the arithmetic (exact intermediates in `i128`,
     /// quantized by [`quantize`]); [`Datapath::eval_batch`] is its fast twin.
     pub fn eval(&self, c_raw: i64, nc: &NConstants) -> Probes {
+        let mut p = Probes::default();
         let mut fixed = FixedWalk {
             dp: self,
             nc,
             c_raw,
             c: c_raw,
-            probes: Probes::default(),
+            probes: &mut p,
         };
-        let walked = walk(&mut fixed, self.config.cutoff, self.config.k as usize);
-        let mut p = fixed.probes;
-        p.cut = walked.cut;
+        p.cut = walk(&mut fixed, self.config.cutoff, self.config.k as usize).cut;
         p
     }
 
@@ -919,10 +918,11 @@ struct FixedWalk<'a> {
     c_raw: i64,
     /// The input clamped to 1.0 (set by `sub`).
     c: i64,
-    probes: Probes,
+    probes: &'a mut Probes,
 }
 
 impl FixedWalk<'_> {
+    #[inline]
     fn record(&mut self, stage_idx: usize, q: Quantized) -> i128 {
         self.probes.values[stage_idx] = q.raw;
         self.probes.events[stage_idx] = q.event;
@@ -933,6 +933,7 @@ impl FixedWalk<'_> {
 impl Arithmetic for FixedWalk<'_> {
     type Value = i128;
 
+    #[inline]
     fn sub(&mut self) -> i128 {
         let (c, d) = self.dp.op_sub(self.c_raw);
         self.c = c;
@@ -941,37 +942,45 @@ impl Arithmetic for FixedWalk<'_> {
         i128::from(d)
     }
 
+    #[inline]
     fn below_threshold(&self) -> bool {
         self.nc.below_threshold(self.c)
     }
 
+    #[inline]
     fn mul_t(&mut self, d: i128) -> i128 {
         let q = self.dp.op_mul_t(d as i64, self.nc);
         self.record(STAGE_T, q)
     }
 
+    #[inline]
     fn add_offset(&mut self, t: i128) -> i128 {
         self.dp.exact_sum(t as i64, self.nc)
     }
 
+    #[inline]
     fn is_negative(&self, sum: i128) -> bool {
         sum < 0
     }
 
+    #[inline]
     fn zero(&self) -> i128 {
         0
     }
 
+    #[inline]
     fn quant_b(&mut self, base: i128) -> i128 {
         let q = quantize_to(base, self.dp.b_frac(self.nc), &self.dp.config.b);
         self.record(STAGE_B, q)
     }
 
+    #[inline]
     fn square(&mut self, i: usize, x: i128) -> i128 {
         let q = self.dp.op_square(i, x as i64);
         self.record(STAGE_SQ0 + i, q)
     }
 
+    #[inline]
     fn mul_out(&mut self, s: i128) -> i128 {
         self.probes.values[self.dp.stage_coef()] = self.nc.coef_raw;
         let q = self.dp.op_mul_out(s as i64, self.nc);

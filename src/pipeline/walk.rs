@@ -127,6 +127,7 @@ pub struct Walked<V> {
 }
 
 /// Walks the stages of a datapath with `k` squarings and cutoff `cutoff` in an arithmetic.
+#[inline]
 pub fn walk<A: Arithmetic>(a: &mut A, cutoff: Cutoff, k: usize) -> Walked<A::Value> {
     let d = a.sub();
     let t = a.mul_t(d);
