@@ -558,6 +558,7 @@ impl Datapath {
     }
 
     /// The exact sum `t + offset` on the larger of their fraction bits (`b_frac`).
+    #[inline]
     fn exact_sum(&self, t: i64, nc: &NConstants) -> i128 {
         let ft = self.config.t.format.frac_bits();
         let fb = self.b_frac(nc);
@@ -566,12 +567,14 @@ impl Datapath {
     }
 
     /// Fraction bits of the exact sum `t + offset`.
+    #[inline]
     fn b_frac(&self, nc: &NConstants) -> i32 {
         self.config.t.format.frac_bits().max(nc.offset_frac)
     }
 
     /// Operation `sub`: clamps the input code to 1.0 and returns it with d = c - 1, exact in
     /// d's format.
+    #[inline]
     pub fn op_sub(&self, c_raw: i64) -> (i64, i64) {
         let c = c_raw.min(self.one_raw);
         (c, (c - self.one_raw) << self.d_shift)
@@ -579,6 +582,7 @@ impl Datapath {
 
     /// Operation `mul_t`: t = d * slope, exact (`d.frac + slope_frac` fraction bits), then
     /// quantized by t's stage.
+    #[inline]
     pub fn op_mul_t(&self, d: i64, nc: &NConstants) -> Quantized {
         quantize_to(
             i128::from(d) * i128::from(nc.slope_raw),
@@ -589,6 +593,7 @@ impl Datapath {
 
     /// Operation `add_b`: b = t + offset, exact on the larger fraction, then the cutoff (which
     /// needs the clamped input code `c`), then b's stage. Returns b and whether it was cut.
+    #[inline]
     pub fn op_add_b(&self, t: i64, c: i64, nc: &NConstants) -> (Quantized, bool) {
         let sum = self.exact_sum(t, nc);
         let cut = self.config.cutoff.cuts(sum < 0, nc.below_threshold(c));
@@ -598,6 +603,7 @@ impl Datapath {
 
     /// Operation `square` number `i` (0-based): the exact square of the previous stage's raw
     /// value (doubled fraction bits), quantized by squaring stage `i`.
+    #[inline]
     pub fn op_square(&self, i: usize, x: i64) -> Quantized {
         let cfg = &self.config;
         let f_in = if i == 0 {
@@ -609,6 +615,7 @@ impl Datapath {
     }
 
     /// Operation `mul_out`: out = sq_k * coef, exact, then quantized by the output stage.
+    #[inline]
     pub fn op_mul_out(&self, s: i64, nc: &NConstants) -> Quantized {
         let cfg = &self.config;
         let fs = cfg.square[cfg.square.len() - 1].format.frac_bits();
