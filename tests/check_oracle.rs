@@ -3,7 +3,7 @@
 //! the same algorithm written out here, no shortcut. The check's fast paths (the dead prefix
 //! found by bisection, d's exact figures, the live compaction) must give the same figures.
 
-use specfx::analysis::check::check;
+use specfx::analysis::check::{check, check_outputs};
 use specfx::fixed::Event;
 use specfx::pipeline::{Config, Datapath};
 use specfx::reference::lobe::Cutoff;
@@ -114,6 +114,8 @@ fn compare(toml: &str) {
     cfg.n = "16,17,40,100,333,1000,1024".parse().unwrap();
     let dp = Datapath::new(cfg).unwrap();
     let fast = check(&dp).unwrap();
+    // The output-only check gives the full check's output figures, bit for bit.
+    assert_eq!(check_outputs(&dp).unwrap(), fast.output_figures(), "{toml}");
     let slow = slow_check(&dp);
     assert_eq!(fast.n_evaluations, slow.count, "{toml}");
     for (i, st) in fast.stages.iter().enumerate() {

@@ -245,6 +245,14 @@ fn corners_equal_brute_force(dp: &Datapath) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// The output-only check against the full check's output figures (they must be the same bits).
+fn output_check_equals_full_check(dp: &Datapath) -> Result<(), TestCaseError> {
+    let full = specfx::analysis::check::check(dp).unwrap().output_figures();
+    let fast = specfx::analysis::check::check_outputs(dp).unwrap();
+    prop_assert_eq!(fast, full);
+    Ok(())
+}
+
 /// `eval` against the independent big-integer oracle (`tests/common/oracle.rs`, written from
 /// `docs/arithmetic.md`) on about 100 codes per n, ends and 1.0 included.
 fn scalar_equals_oracle(dp: &Datapath) -> Result<(), TestCaseError> {
@@ -290,6 +298,7 @@ proptest! {
         batch_equals_scalar(&dp)?;
         outputs_equal_scalar(&dp)?;
         corners_equal_brute_force(&dp)?;
+        output_check_equals_full_check(&dp)?;
     }
 }
 
@@ -304,6 +313,7 @@ proptest! {
         batch_equals_scalar(&dp)?;
         outputs_equal_scalar(&dp)?;
         corners_equal_brute_force(&dp)?;
+        output_check_equals_full_check(&dp)?;
         scalar_equals_oracle(&dp)?;
     }
 }

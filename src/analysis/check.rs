@@ -119,6 +119,169 @@ pub struct CheckReport {
     pub notes: Vec<String>,
 }
 
+/// The output-side figures of an exhaustive check: what sweeps and the optimiser compare.
+/// [`check_outputs`] computes them without the per-stage statistics, and gives the same values
+/// as [`CheckReport::output_figures`] of the full [`check`], bit for bit (tested).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OutputFigures {
+    /// Evaluations in all.
+    pub n_evaluations: u64,
+    /// max |fixed lobe - f64 lobe of the same algorithm|.
+    pub shape_quant_max_abs: f64,
+    /// max |f64 lobe - cos^n|.
+    pub shape_approx_max_abs: f64,
+    /// max |fixed lobe - cos^n|.
+    pub shape_total_max_abs: f64,
+    /// max output error in output LSBs.
+    pub out_max_ulp: f64,
+    /// Share of outputs within 1/2 LSB of the f64 output.
+    pub out_correctly_rounded: f64,
+    /// Whether the output never decreases as c increases, for every n.
+    pub monotonic: bool,
+}
+
+impl CheckReport {
+    /// The output-side figures of this check.
+    pub fn output_figures(&self) -> OutputFigures {
+        OutputFigures {
+            n_evaluations: self.n_evaluations,
+            shape_quant_max_abs: self.shape_quant_max_abs,
+            shape_approx_max_abs: self.shape_approx_max_abs,
+            shape_total_max_abs: self.shape_total_max_abs,
+            out_max_ulp: self.out_max_ulp,
+            out_correctly_rounded: self.stages.last().map_or(0.0, |s| s.correctly_rounded),
+            monotonic: self.monotonic,
+        }
+    }
+}
+
+/// What one exponent contributes to [`OutputFigures`].
+struct OutputsOfN {
+    quant: f64,
+    approx: f64,
+    total: f64,
+    out_max_abs: f64,
+    n_correct: u64,
+    n_violations: u64,
+}
+
+/// The output figures of one exponent: the dead prefix (cut in both models, see
+/// [`dead_prefix_end`]) counts as exact, without evaluation; every later code is evaluated and
+/// compared with the f64 walk, exactly as [`check_one_n`] compares them.
+fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> OutputsOfN {
+    let cfg = dp.config();
+    let codes = &shared.codes[..];
+    let (lo, last) = (codes[0], codes[codes.len() - 1]);
+    let lobe_lsb = dp.stages()[dp.stage_last_square()].format.lsb();
+    let out_lsb = cfg.out.format.lsb();
+    let half = 0.5 * out_lsb * (1.0 + 1e-9);
+    let c_lsb = cfg.c.format.lsb();
+    let nf = f64::from(nc.n);
+    let threshold = nc.threshold.unwrap_or(i64::MIN);
+    let one = dp.one_code();
+    let cos_n = |i: usize| {
+        if codes[i] as f64 * c_lsb <= 0.0 {
+            0.0
+        } else {
+            (nf * shared.ln_c[i]).exp()
+        }
+    };
+    let dead_end = dead_prefix_end(dp, nc, codes);
+    let n_dead = (dead_end - lo) as usize;
+    let mut r = OutputsOfN {
+        quant: -1.0,
+        approx: -1.0,
+        total: -1.0,
+        out_max_abs: -1.0,
+        n_correct: n_dead as u64,
+        n_violations: 0,
+    };
+    if n_dead > 0 {
+        // Every dead output and lobe is 0 in both models; cos^n grows with c, so the largest
+        // dead code bounds the others' shape errors.
+        let cn = cos_n(n_dead - 1);
+        r.quant = 0.0;
+        r.approx = cn;
+        r.total = cn;
+        r.out_max_abs = 0.0;
+    }
+    let mut prev_out = (n_dead > 0).then_some(0);
+    let mut cols = ProbeColumns::default();
+    let (last_sq, out) = (dp.stage_last_square(), dp.stage_out());
+    for start in (n_dead..codes.len()).step_by(CHUNK) {
+        let end = (start + CHUNK).min(codes.len());
+        let chunk = &codes[start..end];
+        dp.eval_batch(nc, chunk, &mut cols);
+        for (j, &k) in chunk.iter().enumerate() {
+            let i = start + j;
+            let t = nc.slope * shared.ref_d[i];
+            let mut s = reference_base(cfg.cutoff, t, nc.offset, k.min(one) < threshold);
+            for _ in 0..cfg.k {
+                s *= s;
+            }
+            let fixed_lobe = cols.values[last_sq][j] as f64 * lobe_lsb;
+            let o = cols.values[out][j];
+            let err = o as f64 * out_lsb - s * nc.coef;
+            r.out_max_abs = r.out_max_abs.max(err.abs());
+            r.n_correct += u64::from(err.abs() <= half);
+            let cn = cos_n(i);
+            r.quant = r.quant.max((fixed_lobe - s).abs());
+            r.approx = r.approx.max((s - cn).abs());
+            r.total = r.total.max((fixed_lobe - cn).abs());
+            if prev_out.is_some_and(|p| o < p) {
+                r.n_violations += 1;
+            }
+            prev_out = Some(o);
+        }
+    }
+    debug_assert!(last >= lo);
+    r
+}
+
+/// The output figures of an exhaustive check ([`OutputFigures`]) without the per-stage
+/// statistics: the dead prefix of each n is not evaluated at all.
+///
+/// # Errors
+/// As [`check`]: [`Error::TooManyCodes`].
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::check::{check, check_outputs};
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// assert_eq!(check_outputs(&dp).unwrap(), check(&dp).unwrap().output_figures());
+/// ```
+pub fn check_outputs(dp: &Datapath) -> Result<OutputFigures, Error> {
+    let shared = code_columns(dp)?;
+    let per_n = map_n(dp, |nc| outputs_one_n(dp, nc, &shared));
+    let mut f = OutputsOfN {
+        quant: -1.0,
+        approx: -1.0,
+        total: -1.0,
+        out_max_abs: -1.0,
+        n_correct: 0,
+        n_violations: 0,
+    };
+    for p in &per_n {
+        f.quant = f.quant.max(p.quant);
+        f.approx = f.approx.max(p.approx);
+        f.total = f.total.max(p.total);
+        f.out_max_abs = f.out_max_abs.max(p.out_max_abs);
+        f.n_correct += p.n_correct;
+        f.n_violations += p.n_violations;
+    }
+    let n_eval = shared.codes.len() as u64 * per_n.len() as u64;
+    Ok(OutputFigures {
+        n_evaluations: n_eval,
+        shape_quant_max_abs: f.quant,
+        shape_approx_max_abs: f.approx,
+        shape_total_max_abs: f.total,
+        out_max_ulp: f.out_max_abs / dp.config().out.format.lsb(),
+        out_correctly_rounded: f.n_correct as f64 / n_eval as f64,
+        monotonic: f.n_violations == 0,
+    })
+}
+
 /// How many violations are listed in full.
 const MAX_LISTED_VIOLATIONS: usize = 100;
 
@@ -653,6 +816,31 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
 /// The largest number of input codes an exhaustive check evaluates per exponent.
 pub const MAX_CHECK_CODES: u64 = 1 << 24;
 
+/// Every input code up to 1.0 with its ln c and d's f64 reference, or [`Error::TooManyCodes`].
+fn code_columns(dp: &Datapath) -> Result<CodeColumns, Error> {
+    let codes_all = dp.input_codes();
+    let last = (*codes_all.end()).min(dp.one_code());
+    let n_codes = (last - codes_all.start() + 1) as u64;
+    if n_codes > MAX_CHECK_CODES {
+        return Err(Error::TooManyCodes {
+            format: dp.config().c.format.to_string(),
+            n_codes,
+            limit: MAX_CHECK_CODES,
+        });
+    }
+    let codes: Vec<i64> = (*codes_all.start()..=last).collect();
+    let c_lsb = dp.config().c.format.lsb();
+    let one = dp.one_code();
+    Ok(CodeColumns {
+        ln_c: codes.iter().map(|&k| (k as f64 * c_lsb).ln()).collect(),
+        ref_d: codes
+            .iter()
+            .map(|&k| (k.min(one) as f64 * c_lsb) - 1.0)
+            .collect(),
+        codes,
+    })
+}
+
 /// Checks a datapath exhaustively: every input code up to 1.0, every n of its set.
 ///
 /// Returns [`Error::TooManyCodes`] when the input format has more than [`MAX_CHECK_CODES`]
@@ -669,27 +857,11 @@ pub const MAX_CHECK_CODES: u64 = 1 << 24;
 /// assert!(r.monotonic);
 /// ```
 pub fn check(dp: &Datapath) -> Result<CheckReport, Error> {
+    let shared = code_columns(dp)?;
     let codes_all = dp.input_codes();
     let last = (*codes_all.end()).min(dp.one_code());
-    let n_codes = (last - codes_all.start() + 1) as u64;
-    if n_codes > MAX_CHECK_CODES {
-        return Err(Error::TooManyCodes {
-            format: dp.config().c.format.to_string(),
-            n_codes,
-            limit: MAX_CHECK_CODES,
-        });
-    }
-    let codes: Vec<i64> = (*codes_all.start()..=last).collect();
+    let n_codes = shared.codes.len() as u64;
     let c_lsb = dp.config().c.format.lsb();
-    let one = dp.one_code();
-    let shared = CodeColumns {
-        ln_c: codes.iter().map(|&k| (k as f64 * c_lsb).ln()).collect(),
-        ref_d: codes
-            .iter()
-            .map(|&k| (k.min(one) as f64 * c_lsb) - 1.0)
-            .collect(),
-        codes,
-    };
     let per_n: Vec<PerN> = map_n(dp, |nc| check_one_n(dp, nc, &shared));
 
     let stages = dp.stages();

@@ -18,7 +18,7 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
-use crate::analysis::check::{check, CheckReport};
+use crate::analysis::check::{check_outputs, OutputFigures};
 use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
 use crate::pipeline::walk::Stage;
@@ -136,19 +136,19 @@ impl fmt::Display for Budget {
     }
 }
 
-/// The value of a metric in a check.
-pub fn metric_value(r: &CheckReport, metric: Metric) -> f64 {
+/// The value of a metric in a check's output figures.
+pub fn metric_value(r: &OutputFigures, metric: Metric) -> f64 {
     match metric {
         Metric::ShapeTotal => r.shape_total_max_abs,
         Metric::ShapeQuant => r.shape_quant_max_abs,
         Metric::Out => r.out_max_ulp,
-        Metric::Correct => r.stages.last().map_or(0.0, |s| s.correctly_rounded),
+        Metric::Correct => r.out_correctly_rounded,
     }
 }
 
 impl Budget {
     /// Whether a check meets every bound.
-    pub fn met_by(&self, r: &CheckReport) -> bool {
+    pub fn met_by(&self, r: &OutputFigures) -> bool {
         self.bounds.iter().all(|b| {
             let v = metric_value(r, b.metric);
             match b.metric {
@@ -160,7 +160,7 @@ impl Budget {
 
     /// How far a check is from the budget: the largest ratio value/limit (limit/value for
     /// `correct`); at most 1 when met.
-    pub fn excess(&self, r: &CheckReport) -> f64 {
+    pub fn excess(&self, r: &OutputFigures) -> f64 {
         self.bounds
             .iter()
             .map(|b| {
@@ -262,7 +262,7 @@ pub fn optimize(
             Err(_) => None,
             Ok(dp) => {
                 *n_eval += 1;
-                let r = check(&dp)?;
+                let r = check_outputs(&dp)?;
                 Some(Candidate {
                     config: cfg.clone(),
                     cost: cost(&dp)?,

@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::check::check;
+use crate::analysis::check::check_outputs;
 use crate::cycle::Arch;
 use crate::error::Error;
 use crate::fixed::Format;
@@ -359,7 +359,7 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
         Ok(dp) => dp,
         Err(e) => return empty(e.to_string()),
     };
-    let r = match check(&dp) {
+    let r = match check_outputs(&dp) {
         Ok(r) => r,
         Err(e) => return empty(e.to_string()),
     };
@@ -371,7 +371,7 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
         shape_total_max_abs: Some(r.shape_total_max_abs),
         shape_quant_max_abs: Some(r.shape_quant_max_abs),
         out_max_ulp: Some(r.out_max_ulp),
-        out_correctly_rounded: Some(r.stages[dp.stage_out()].correctly_rounded),
+        out_correctly_rounded: Some(r.out_correctly_rounded),
         monotonic: Some(r.monotonic),
         luts: Some(cost.luts),
         register_bits: Some(cost.register_bits),

@@ -120,7 +120,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     config.name = "optimized".into();
     let dp = Datapath::new(config.clone())?;
     let proof = check(&dp).map_err(anyhow::Error::msg)?;
-    if !r.budget.met_by(&proof) {
+    if !r.budget.met_by(&proof.output_figures()) {
         bail!("the configuration found does not meet the budget on re-check: this is a bug");
     }
     let header = format!(
