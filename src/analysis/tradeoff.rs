@@ -1,8 +1,6 @@
 //! Speed against accuracy: every method of computing the specular lobe, its error against
 //! cos^n, its software speed measured in the same run, and its hardware cost.
 
-use std::time::Instant;
-
 use serde::Serialize;
 
 use crate::cycle::Arch;
@@ -11,7 +9,10 @@ use crate::pipeline::{Config, Datapath, ProbeColumns};
 use crate::reference::lobe::Cutoff;
 use crate::reference::method::Method;
 use crate::reference::minimax::sup_abs_error;
-use crate::report::chart::{Chart, Series};
+
+/// Measures how long a piece of work takes, in seconds: the caller's clock (the library has
+/// none, so that everything it computes is deterministic).
+pub type Timer<'a> = &'a mut dyn FnMut(&mut dyn FnMut()) -> f64;
 
 /// One method's figures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -84,8 +85,8 @@ fn cos_n(c: f64, n: u32) -> f64 {
     }
 }
 
-/// Figures of an f64 method over the exponents `ns`.
-pub fn f64_figures(name: &str, method: Method, ns: &[u32]) -> MethodFigures {
+/// Figures of an f64 method over the exponents `ns`; `time` measures its speed.
+pub fn f64_figures(name: &str, method: Method, ns: &[u32], time: Timer) -> MethodFigures {
     let cs = grid();
     let mut sum = 0.0;
     let mut per_n = Vec::with_capacity(ns.len());
@@ -97,15 +98,16 @@ pub fn f64_figures(name: &str, method: Method, ns: &[u32]) -> MethodFigures {
     }
     // Speed: one pass over the grid for every n, timed; "powi" is measured as repeated
     // squaring on integer n.
-    let start = Instant::now();
-    let mut sink = 0.0;
-    for &n in ns {
-        for &c in &cs {
-            sink += method.eval(std::hint::black_box(c), n);
+    let secs = time(&mut || {
+        let mut sink = 0.0;
+        for &n in ns {
+            for &c in &cs {
+                sink += method.eval(std::hint::black_box(c), n);
+            }
         }
-    }
-    std::hint::black_box(sink);
-    let secs = start.elapsed().as_secs_f64().max(1e-9);
+        std::hint::black_box(sink);
+    })
+    .max(1e-9);
     let (multipliers, latency) = match method {
         Method::CsM { k, .. } | Method::Minimax { k } => (Some(k + 2), Some(u64::from(k) + 4)),
         _ => (None, None),
@@ -124,8 +126,9 @@ pub fn f64_figures(name: &str, method: Method, ns: &[u32]) -> MethodFigures {
     }
 }
 
-/// Figures of `c.powi(n)` (repeated squaring in f64), which [`Method`] does not name.
-pub fn powi_figures(ns: &[u32]) -> MethodFigures {
+/// Figures of `c.powi(n)` (repeated squaring in f64), which [`Method`] does not name; `time`
+/// measures its speed.
+pub fn powi_figures(ns: &[u32], time: Timer) -> MethodFigures {
     let cs = grid();
     let eval = |c: f64, n: u32| c.powi(n as i32);
     let mut sum = 0.0;
@@ -136,15 +139,16 @@ pub fn powi_figures(ns: &[u32]) -> MethodFigures {
         }
         per_n.push(sup_abs_error(n, 0.0, |c| eval(c, n)).0);
     }
-    let start = Instant::now();
-    let mut sink = 0.0;
-    for &n in ns {
-        for &c in &cs {
-            sink += eval(std::hint::black_box(c), n);
+    let secs = time(&mut || {
+        let mut sink = 0.0;
+        for &n in ns {
+            for &c in &cs {
+                sink += eval(std::hint::black_box(c), n);
+            }
         }
-    }
-    std::hint::black_box(sink);
-    let secs = start.elapsed().as_secs_f64().max(1e-9);
+        std::hint::black_box(sink);
+    })
+    .max(1e-9);
     MethodFigures {
         method: "powi".into(),
         kind: "f64",
@@ -172,8 +176,9 @@ pub fn fixed_config(frac: i32) -> Config {
 }
 
 /// Figures of a fixed-point datapath: its lobe (before the coefficient) against cos^n on the
-/// input codes of the grid, the batch evaluation speed, and its analytic cost.
-pub fn fixed_figures(dp: &Datapath) -> MethodFigures {
+/// input codes of the grid, the batch evaluation speed (measured by `time`), and its analytic
+/// cost.
+pub fn fixed_figures(dp: &Datapath, time: Timer) -> MethodFigures {
     let one = dp.one_code();
     let step = (one / 4096).max(1);
     let codes: Vec<i64> = (0..=one).step_by(step as usize).collect();
@@ -200,11 +205,12 @@ pub fn fixed_figures(dp: &Datapath) -> MethodFigures {
             .fold(0.0, f64::max);
         per_n.push(max);
     }
-    let start = Instant::now();
-    for nc in dp.constants() {
-        dp.eval_batch(nc, std::hint::black_box(&codes), &mut cols);
-    }
-    let secs = start.elapsed().as_secs_f64().max(1e-9);
+    let secs = time(&mut || {
+        for nc in dp.constants() {
+            dp.eval_batch(nc, std::hint::black_box(&codes), &mut cols);
+        }
+    })
+    .max(1e-9);
     let cost = analytic_cost(dp, Arch::Pipelined, Target::Generic);
     MethodFigures {
         method: dp.config().name.clone(),
@@ -217,64 +223,5 @@ pub fn fixed_figures(dp: &Datapath) -> MethodFigures {
         yosys: None,
         latency: Some(cost.latency),
         per_n_max_abs_err: per_n,
-    }
-}
-
-/// Chart of accuracy against speed: one point per method.
-pub fn speed_chart(figures: &[MethodFigures]) -> Chart {
-    let shown: Vec<&MethodFigures> = figures
-        .iter()
-        .filter(|f| !f.method.ends_with("_none") && !f.method.ends_with("_paper"))
-        .collect();
-    Chart {
-        title: "Speed against accuracy, n = 16..1024".into(),
-        x_label: "software speed (million evaluations per second, one core)".into(),
-        y_label: "max |method - cos^n| (absolute, log scale)".into(),
-        log_x: false,
-        log_y: true,
-        series: shown
-            .iter()
-            .enumerate()
-            .map(|(i, f)| Series {
-                label: f.method.clone(),
-                points: vec![(f.evals_per_s / 1e6, f.max_abs_err.max(1e-17))],
-                line: false,
-                color: crate::report::chart::hue(i, shown.len()),
-            })
-            .collect(),
-    }
-}
-
-/// Chart of the error against n for a few methods.
-pub fn per_n_chart(figures: &[MethodFigures], ns: &[u32], names: &[&str]) -> Chart {
-    let colors = [
-        (31, 119, 180),
-        (214, 39, 40),
-        (44, 160, 44),
-        (255, 127, 14),
-        (148, 103, 189),
-        (0, 0, 0),
-    ];
-    Chart {
-        title: "Error against n".into(),
-        x_label: "specular exponent n".into(),
-        y_label: "max over c of |method - cos^n| (absolute, log scale)".into(),
-        log_x: false,
-        log_y: true,
-        series: names
-            .iter()
-            .filter_map(|name| figures.iter().find(|f| f.method == *name))
-            .enumerate()
-            .map(|(i, f)| Series {
-                label: f.method.clone(),
-                points: ns
-                    .iter()
-                    .zip(&f.per_n_max_abs_err)
-                    .map(|(&n, &e)| (f64::from(n), e.max(1e-17)))
-                    .collect(),
-                line: true,
-                color: colors[i % colors.len()],
-            })
-            .collect(),
     }
 }

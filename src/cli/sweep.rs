@@ -243,7 +243,7 @@ fn write_results(dir: &Path, points: &mut [PointResult]) -> Result<()> {
     let mut json = serde_json::to_vec_pretty(&points)?;
     json.push(b'\n');
     write_atomic(&dir.join("sweep.json"), &json)?;
-    let chart = specfx::analysis::sweep::chart(points);
+    let chart = specfx::report::sweep::chart(points);
     let svg = specfx::report::chart::render_svg(&chart).map_err(anyhow::Error::msg)?;
     write_atomic(&dir.join("sweep.svg"), svg.as_bytes())?;
     let png = specfx::report::chart::render_png(&chart).map_err(anyhow::Error::msg)?;

@@ -10,11 +10,12 @@ use clap::Args;
 use super::output::{print_json, write_atomic, write_chart};
 use super::Outcome;
 use specfx::analysis::tradeoff::{
-    f64_figures, f64_methods, fixed_config, fixed_figures, per_n_chart, powi_figures, speed_chart,
-    MethodFigures, YosysFigures,
+    f64_figures, f64_methods, fixed_config, fixed_figures, powi_figures, MethodFigures,
+    YosysFigures,
 };
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
+use specfx::report::tradeoff::{per_n_chart, speed_chart};
 
 /// Arguments of `specfx tradeoff`.
 #[derive(Debug, Args)]
@@ -43,19 +44,25 @@ pub fn tradeoff(
 ) -> Result<Vec<MethodFigures>> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let ns_v = ns.values();
+    // The wall clock the library leaves to its callers.
+    let mut time_it = |work: &mut dyn FnMut()| {
+        let start = std::time::Instant::now();
+        work();
+        start.elapsed().as_secs_f64()
+    };
     let mut figures = Vec::new();
     for (name, method) in f64_methods() {
         eprintln!("tradeoff: {name}");
-        figures.push(f64_figures(&name, method, ns_v));
+        figures.push(f64_figures(&name, method, ns_v, &mut time_it));
     }
     eprintln!("tradeoff: powi");
-    figures.insert(1, powi_figures(ns_v));
+    figures.insert(1, powi_figures(ns_v, &mut time_it));
     for frac in [8, 12, 16] {
         let mut cfg = fixed_config(frac);
         cfg.n = ns.clone();
         let dp = Datapath::new(cfg)?;
         eprintln!("tradeoff: {}", dp.config().name);
-        let mut f = fixed_figures(&dp);
+        let mut f = fixed_figures(&dp, &mut time_it);
         if let Some(target) = yosys {
             eprintln!(
                 "tradeoff: synthesising {} with yosys ({target})",

@@ -6,3 +6,5 @@ pub mod csv;
 pub mod doc;
 pub mod paper;
 pub mod stability;
+pub mod sweep;
+pub mod tradeoff;
