@@ -19,6 +19,7 @@ use std::fmt::Write as _;
 use crate::analysis::budget::mixed_eval;
 use crate::error::Error;
 use crate::fixed::{Event, Exact, Rounding};
+use crate::pipeline::walk::{walk, Arithmetic};
 use crate::pipeline::{Datapath, NConstants, StageSpec};
 use crate::reference::lobe::Cutoff;
 
@@ -86,6 +87,84 @@ fn first_code(one: i64, holds: impl Fn(i64) -> bool) -> i64 {
         }
     }
     lo
+}
+
+/// The walk's interpreter that writes gappa's definitions: each step appends its line and
+/// returns the name (or, for the exact sum `t + offset`, the expression) it defined. The
+/// quantized chain rounds with `r_<stage>` and the quantized constants (`SQ`, `OQ`, `CQ`); the
+/// exact chain (`exact`) names its values `M<stage>` and uses the exact constants (`SE`, `OE`,
+/// `CE`). The script covers only the upper region, where neither model cuts, so no step cuts.
+struct Script<'a> {
+    text: &'a mut String,
+    exact: bool,
+}
+
+impl<'a> Script<'a> {
+    fn new(text: &'a mut String, exact: bool) -> Self {
+        Script { text, exact }
+    }
+
+    /// Defines `name` (with the exact chain's `M` prefix) as `value`, rounded by the stage's
+    /// operator in the quantized chain.
+    fn define(&mut self, name: &str, value: &str) -> String {
+        if self.exact {
+            let _ = writeln!(self.text, "M{name} = {value};");
+            format!("M{name}")
+        } else {
+            let _ = writeln!(self.text, "{name} = r_{name}({value});");
+            name.to_string()
+        }
+    }
+
+    fn constant(&self, name: &str) -> String {
+        format!("{name}{}", if self.exact { 'E' } else { 'Q' })
+    }
+}
+
+impl Arithmetic for Script<'_> {
+    type Value = String;
+
+    fn sub(&mut self) -> String {
+        // d = c - 1 is exact and shared by both chains: the quantized chain defines it.
+        if !self.exact {
+            self.text.push_str("d = c - 1;\n");
+        }
+        "d".into()
+    }
+
+    fn below_threshold(&self) -> bool {
+        false
+    }
+
+    fn mul_t(&mut self, d: String) -> String {
+        let value = format!("{} * {d}", self.constant("S"));
+        self.define("t", &value)
+    }
+
+    fn add_offset(&mut self, t: String) -> String {
+        format!("{t} + {}", self.constant("O"))
+    }
+
+    fn is_negative(&self, _sum: String) -> bool {
+        false
+    }
+
+    fn zero(&self) -> String {
+        "0".into()
+    }
+
+    fn quant_b(&mut self, base: String) -> String {
+        self.define("b", &base)
+    }
+
+    fn square(&mut self, i: usize, x: String) -> String {
+        self.define(&format!("s{}", i + 1), &format!("{x} * {x}"))
+    }
+
+    fn mul_out(&mut self, s: String) -> String {
+        let value = format!("{s} * {}", self.constant("C"));
+        self.define("out", &value)
+    }
 }
 
 /// Builds the gappa job of one exponent, or says why its bound cannot be proved this way.
@@ -177,20 +256,8 @@ pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, Error> {
         raw_value(nc.coef_raw, cfg.coef.format.frac_bits())
     );
     let _ = writeln!(s, "CE = {};", dyadic(nc.coef));
-    s.push_str("d = c - 1;\nt = r_t(SQ * d);\nb = r_b(t + OQ);\n");
-    let mut prev = "b".to_string();
-    for i in 1..=k {
-        let _ = writeln!(s, "s{i} = r_s{i}({prev} * {prev});");
-        prev = format!("s{i}");
-    }
-    let _ = writeln!(s, "out = r_out({prev} * CQ);");
-    s.push_str("Mt = SE * d;\nMb = Mt + OE;\n");
-    let mut mprev = "Mb".to_string();
-    for i in 1..=k {
-        let _ = writeln!(s, "Ms{i} = {mprev} * {mprev};");
-        mprev = format!("Ms{i}");
-    }
-    let _ = writeln!(s, "Mout = {mprev} * CE;");
+    let quantized = walk(&mut Script::new(&mut s, false), cfg.cutoff, k);
+    let exact = walk(&mut Script::new(&mut s, true), cfg.cutoff, k);
     let fc = cfg.c.format.frac_bits();
     let mut goal = format!(
         "{{ @FIX(c, {}) /\\ c in [{}, {}] -> out - Mout in ?",
@@ -208,6 +275,10 @@ pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, Error> {
     s.push_str("t - Mt -> (t - SQ * d) + (SQ - SE) * d;\n");
     s.push_str("b - Mb -> (b - (t + OQ)) + (t - Mt) + (OQ - OE);\n");
     let mut prev = ("b".to_string(), "Mb".to_string());
+    debug_assert_eq!(
+        (quantized.out.as_str(), exact.out.as_str()),
+        ("out", "Mout")
+    );
     for i in 1..=k {
         let (p, mp) = &prev;
         let _ = writeln!(
@@ -216,6 +287,7 @@ pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, Error> {
         );
         prev = (format!("s{i}"), format!("Ms{i}"));
     }
+    debug_assert_eq!((&prev.0, &prev.1), (&quantized.lobe, &exact.lobe));
     let (p, mp) = &prev;
     let _ = writeln!(
         s,

@@ -92,8 +92,8 @@ impl NConstants {
 /// One arithmetic the walk can run in. Each method is one step of the walk; the interpreter
 /// holds the input and whatever it records (probes, events, text).
 pub trait Arithmetic {
-    /// A value between two steps.
-    type Value: Copy;
+    /// A value between two steps (a number, or for a script generator the name of one).
+    type Value: Clone;
     /// `d = c - 1` of the input clamped to 1.0.
     fn sub(&mut self) -> Self::Value;
     /// Whether the input is below the paper cutoff's threshold.
@@ -132,12 +132,12 @@ pub fn walk<A: Arithmetic>(a: &mut A, cutoff: Cutoff, k: usize) -> Walked<A::Val
     let d = a.sub();
     let t = a.mul_t(d);
     let sum = a.add_offset(t);
-    let cut = cutoff.cuts(a.is_negative(sum), a.below_threshold());
+    let cut = cutoff.cuts(a.is_negative(sum.clone()), a.below_threshold());
     let base = if cut { a.zero() } else { sum };
     let mut s = a.quant_b(base);
     for i in 0..k {
         s = a.square(i, s);
     }
-    let out = a.mul_out(s);
+    let out = a.mul_out(s.clone());
     Walked { lobe: s, out, cut }
 }
