@@ -19,7 +19,6 @@ use crate::error::Error;
 use crate::fixed::{quantize_f64, Format};
 use crate::pipeline::walk::{walk, Arithmetic, Stage};
 use crate::pipeline::{Datapath, NConstants, ProbeColumns, StageSpec, Variant, MAX_STAGES};
-use crate::reference::lobe::Cutoff;
 
 /// An error source: a quantization the datapath performs that the f64 model does not.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -708,11 +707,10 @@ fn analyse_one_n(
             let t_exact = nc.slope * (c - 1.0);
             let dead = fixed_out == 0.0
                 && fixed_lobe == 0.0
-                && match cfg.cutoff {
-                    Cutoff::Clamp => t_exact.max(t_min) + nc.offset + margin < 0.0,
-                    Cutoff::Paper => nc.threshold.is_some_and(|thr| code.min(one) < thr),
-                    Cutoff::None => false,
-                };
+                && cfg.cutoff.cuts(
+                    t_exact.max(t_min) + nc.offset + margin < 0.0,
+                    nc.below_threshold(code.min(one)),
+                );
             let (ref_lobe, ref_out) = if dead {
                 (0.0, 0.0)
             } else {

@@ -369,11 +369,9 @@ impl Prepared {
             } => {
                 // As `cs_base`: (n/m)(c - 1) + 1.
                 let base = slope * (c - 1.0) + 1.0;
-                let (value, cut) = match cutoff {
-                    Cutoff::Clamp => (pow_2k(base.max(0.0), k), base <= 0.0 || base.is_nan()),
-                    Cutoff::Paper if c < threshold => (0.0, true),
-                    Cutoff::Paper | Cutoff::None => (pow_2k(base, k), false),
-                };
+                // A clamped base of 0 (or NaN) counts as cut: its value is 0 either way.
+                let cut = cutoff.cuts(base <= 0.0 || base.is_nan(), c < threshold);
+                let value = if cut { 0.0 } else { pow_2k(base, k) };
                 FloatSample {
                     value,
                     base: Some(base),

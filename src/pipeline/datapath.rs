@@ -720,11 +720,7 @@ impl Datapath {
                 .zip(cut.iter_mut())
                 .map(|((&t, &code), cut)| {
                     let sum = (t << t_align) + offset;
-                    *cut = match cutoff {
-                        Cutoff::Clamp => sum < 0,
-                        Cutoff::Paper => code.min(one) < threshold,
-                        Cutoff::None => false,
-                    };
+                    *cut = cutoff.cuts(sum < 0, code.min(one) < threshold);
                     if *cut {
                         0
                     } else {

@@ -160,16 +160,13 @@ pub fn paper_cutoff_cosine(n: f64) -> f64 {
 #[inline]
 pub fn cs_m(c: f64, n: f64, k: u32, cutoff: Cutoff) -> f64 {
     let base = cs_base(c, n, k);
-    match cutoff {
-        Cutoff::Clamp => pow_2k(base.max(0.0), k),
-        Cutoff::Paper => {
-            if c < paper_cutoff_cosine(n) {
-                0.0
-            } else {
-                pow_2k(base, k)
-            }
-        }
-        Cutoff::None => pow_2k(base, k),
+    // The clamp's max(0, base) also maps a NaN base to 0; the threshold is computed only for
+    // the paper cutoff, the one rule that reads it.
+    let below = cutoff == Cutoff::Paper && c < paper_cutoff_cosine(n);
+    if cutoff.cuts(base.is_nan() || base < 0.0, below) {
+        0.0
+    } else {
+        pow_2k(base, k)
     }
 }
 
