@@ -4,7 +4,9 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use specfx::analysis::check::check;
 use specfx::analysis::sweep::{evaluate, Space};
-use specfx::cycle::sim::{random_inputs, simulate, Stimulus, Stop};
+use specfx::cycle::sim::{
+    random_inputs, simulate, simulate_with, sweep_inputs, Record, Stimulus, Stop,
+};
 use specfx::cycle::Arch;
 use specfx::engine::output_sum;
 use specfx::pipeline::{Config, Datapath, ProbeColumns};
@@ -76,27 +78,43 @@ fn sweep_point(c: &mut Criterion) {
     g.finish();
 }
 
+/// The cycle model, in cycles/s: both architectures on the sweep stream (every code for each
+/// n in turn, as `scripts/bench-peers`' Verilator harness streams them) without bubbles or
+/// stalls, keeping statistics only; and the pipelined one on the random stream under 10%
+/// bubbles and stalls, keeping every transfer as the co-simulation's stimulus does.
 fn cycle_model(c: &mut Criterion) {
     let dp = Datapath::new(Config::baseline()).unwrap();
-    const CYCLES: u64 = 100_000;
+    const CYCLES: u64 = 1_000_000;
     let mut g = c.benchmark_group("cycle");
     g.sample_size(10);
     g.throughput(Throughput::Elements(CYCLES));
+    let lean = Record {
+        transfers: false,
+        trace_cycles: 0,
+    };
     for arch in [Arch::Pipelined, Arch::Folded] {
         g.bench_function(format!("{arch}/baseline"), |b| {
             b.iter(|| {
                 let mut stimulus = Stimulus::new(1, 0.0, 0.0);
-                simulate(
-                    &dp,
-                    arch,
-                    random_inputs(&dp, 1),
-                    &mut stimulus,
-                    Stop::Cycles(CYCLES),
-                    0,
-                )
+                let stop = Stop::Cycles(CYCLES);
+                simulate_with(&dp, arch, sweep_inputs(&dp), &mut stimulus, stop, lean)
             })
         });
     }
+    g.bench_function("pipelined/baseline/random-stalls-recorded", |b| {
+        b.iter(|| {
+            let mut stimulus = Stimulus::new(1, 0.1, 0.1);
+            let stop = Stop::Cycles(CYCLES);
+            simulate(
+                &dp,
+                Arch::Pipelined,
+                random_inputs(&dp, 1),
+                &mut stimulus,
+                stop,
+                0,
+            )
+        })
+    });
     g.finish();
 }
 

@@ -2,9 +2,119 @@
 //! the latencies and intervals that docs/cycle.md derives.
 
 use proptest::prelude::*;
-use specfx::cycle::sim::{simulate, Stimulus, Stop};
-use specfx::cycle::Arch;
+use specfx::cycle::sim::{run, simulate, Record, Stimulus, Stop};
+use specfx::cycle::{Arch, Item, Machine, Op, Pipelined, RegisterView, Token};
 use specfx::pipeline::{Config, Datapath};
+
+/// The pipelined architecture written as the RTL is: every register a token, every clock edge
+/// moving each token one register on and applying the register's operation to it, values
+/// computed stage by stage with the datapath's stage operations. The oracle of [`Pipelined`],
+/// which carries tokens without computing and shows the functional model's values.
+#[derive(Clone)]
+struct Literal {
+    /// The operation computed on entry to each register (`None`: a delay register).
+    ops: Vec<Option<Op>>,
+    owner: Vec<Op>,
+    regs: Vec<Option<Token>>,
+}
+
+impl Literal {
+    fn new(dp: &Datapath) -> Literal {
+        let cfg = dp.config();
+        let lat = &cfg.latency;
+        let mut plan = vec![(Op::Sub, lat.sub), (Op::MulT, lat.mul), (Op::AddB, lat.add)];
+        plan.extend((0..cfg.k as usize).map(|i| (Op::Square(i), lat.mul)));
+        plan.push((Op::MulOut, lat.mul));
+        let (mut ops, mut owner) = (Vec::new(), Vec::new());
+        for (op, l) in plan {
+            for r in 0..l {
+                ops.push((r == 0).then_some(op));
+                owner.push(op);
+            }
+        }
+        let regs = vec![None; ops.len()];
+        Literal { ops, owner, regs }
+    }
+
+    fn units(&self) -> Vec<Op> {
+        let mut v: Vec<Op> = self.owner.clone();
+        v.dedup();
+        v
+    }
+}
+
+impl Machine for Literal {
+    fn in_ready(&self, out_ready: bool) -> bool {
+        self.output().is_none() || out_ready
+    }
+
+    fn output(&self) -> Option<(u64, i64)> {
+        self.regs
+            .last()
+            .copied()
+            .flatten()
+            .map(|t| (t.tag, t.value))
+    }
+
+    fn step(&mut self, dp: &Datapath, input: Option<Item>, out_ready: bool) {
+        if !self.in_ready(out_ready) {
+            return;
+        }
+        let old = self.regs.clone();
+        for r in 0..old.len() {
+            let incoming = if r == 0 {
+                input.map(|it| Token {
+                    tag: it.tag,
+                    n_idx: it.n_idx,
+                    c: it.c_raw,
+                    value: it.c_raw,
+                })
+            } else {
+                old[r - 1]
+            };
+            self.regs[r] = match self.ops[r] {
+                Some(op) => incoming.map(|t| op.apply(dp, t)),
+                None => incoming,
+            };
+        }
+    }
+
+    fn unit_names(&self) -> Vec<String> {
+        self.units().iter().map(|o| o.name()).collect()
+    }
+
+    fn occupancy(&self) -> Vec<bool> {
+        self.units()
+            .iter()
+            .map(|&op| {
+                self.owner
+                    .iter()
+                    .zip(&self.regs)
+                    .any(|(&o, r)| o == op && r.is_some())
+            })
+            .collect()
+    }
+
+    fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
+        let k = dp.config().k as usize;
+        let mut index_in_op = 0;
+        (0..self.regs.len())
+            .map(|r| {
+                let op = self.owner[r];
+                index_in_op = if r > 0 && self.owner[r - 1] == op {
+                    index_in_op + 1
+                } else {
+                    0
+                };
+                RegisterView {
+                    name: format!("{}_q{}", op.name(), index_in_op),
+                    width: dp.stages()[op.stage().index(k)].format.width(),
+                    value: self.regs[r].map(|t| t.value),
+                }
+            })
+            .collect()
+    }
+}
 
 fn datapath(k: u32, lat: (u32, u32, u32), n: &str) -> Datapath {
     let mut cfg = Config::baseline();
@@ -48,6 +158,43 @@ proptest! {
         let r = simulate(&dp, arch, inputs.iter().copied(), &mut free, Stop::Drained(1_000_000), 0);
         prop_assert_eq!(r.stats.latency_min, arch.latency(dp.config()));
         prop_assert_eq!(r.stats.latency_max, arch.latency(dp.config()));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// The ring of tokens is the register-by-register pipeline: the same outputs on the same
+    /// cycles, the same statistics and occupancy, and the same value in every register of the
+    /// trace on every cycle, for any latencies, k, cutoff, stream and stall pattern (the
+    /// stream's inputs reach past 1.0 and into the cut region).
+    #[test]
+    fn the_pipeline_ring_equals_the_literal_pipeline(
+        k in 1u32..=7,
+        lat in (1u32..=3, 1u32..=4, 1u32..=3),
+        cutoff in 0usize..3,
+        seed in any::<u64>(),
+        bubble in 0.0f64..0.9,
+        stall in 0.0f64..0.9,
+        inputs in prop::collection::vec((0usize..3, 0i64..=65535), 1..200),
+    ) {
+        let mut cfg = datapath(k, lat, "16,300,1024").config().clone();
+        cfg.cutoff = specfx::reference::lobe::Cutoff::ALL[cutoff];
+        let dp = Datapath::new(cfg).unwrap();
+        let cycles = Stop::Cycles(2 * inputs.len() as u64 + 40);
+        let trace = Record { transfers: true, trace_cycles: u64::MAX };
+        let ring = run(&dp, Arch::Pipelined, Pipelined::new(&dp), inputs.iter().copied(),
+            &mut Stimulus::new(seed, bubble, stall), cycles, trace);
+        let literal = run(&dp, Arch::Pipelined, Literal::new(&dp), inputs.iter().copied(),
+            &mut Stimulus::new(seed, bubble, stall), cycles, trace);
+        prop_assert!(ring.trace.iter().any(|c| c.registers.iter().any(|r| r.value.is_some())));
+        // Statistics do not depend on what is recorded.
+        let lean = Record { transfers: false, trace_cycles: 0 };
+        let stats = run(&dp, Arch::Pipelined, Pipelined::new(&dp), inputs.iter().copied(),
+            &mut Stimulus::new(seed, bubble, stall), cycles, lean);
+        prop_assert!(stats.outputs.is_empty() && stats.trace.is_empty());
+        prop_assert_eq!(&stats.stats, &ring.stats);
+        prop_assert_eq!(ring, literal);
     }
 }
 
@@ -117,11 +264,7 @@ fn simulate_with_ready(dp: &Datapath, inputs: &[(usize, i64)], stall: u64) -> Ve
         let item = (next < inputs.len() && in_ready).then(|| {
             let (n_idx, c_raw) = inputs[next];
             next += 1;
-            Item {
-                tag: next as u64 - 1,
-                n_idx,
-                c_raw,
-            }
+            Item::new(dp, next as u64 - 1, n_idx, c_raw)
         });
         if m.output().is_some() && ready {
             out.push(cycle);
@@ -154,4 +297,60 @@ fn vcd_trace_parses_back() {
         .is_some());
     let n_commands = parser.count();
     assert!(n_commands > 100 * 8);
+}
+
+/// A folded unit whose output is off by one for input 17: the simulator's mismatch count
+/// compares every output with the functional model and finds exactly that one.
+#[derive(Clone)]
+struct OffByOne(specfx::cycle::Folded);
+
+impl Machine for OffByOne {
+    fn in_ready(&self, out_ready: bool) -> bool {
+        self.0.in_ready(out_ready)
+    }
+    fn output(&self) -> Option<(u64, i64)> {
+        self.0
+            .output()
+            .map(|(tag, v)| (tag, if tag == 17 { v + 1 } else { v }))
+    }
+    fn step(&mut self, dp: &Datapath, input: Option<Item>, out_ready: bool) {
+        self.0.step(dp, input, out_ready)
+    }
+    fn unit_names(&self) -> Vec<String> {
+        self.0.unit_names()
+    }
+    fn occupancy(&self) -> Vec<bool> {
+        self.0.occupancy()
+    }
+    fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
+        self.0.registers(dp)
+    }
+}
+
+#[test]
+fn a_wrong_output_is_counted_as_a_mismatch() {
+    let dp = datapath(4, (1, 2, 1), "16,64,1000");
+    let inputs: Vec<(usize, i64)> = (0..300).map(|i| (i % 3, 32768 - 5 * i as i64)).collect();
+    let go = |m| {
+        let mut stim = Stimulus::new(3, 0.2, 0.2);
+        let stop = Stop::Drained(100_000);
+        let record = Record {
+            transfers: false,
+            trace_cycles: 0,
+        };
+        run(
+            &dp,
+            Arch::Folded,
+            m,
+            inputs.iter().copied(),
+            &mut stim,
+            stop,
+            record,
+        )
+        .stats
+    };
+    let honest = go(OffByOne(specfx::cycle::Folded::new(&dp)));
+    assert_eq!(honest.n_outputs, 300);
+    assert_eq!(honest.mismatches, 1);
+    assert_eq!(honest.order_errors, 0);
 }

@@ -8,7 +8,7 @@ use clap::Args;
 
 use super::output::{print_json, print_with};
 use super::Outcome;
-use specfx::cycle::sim::{random_inputs, simulate, SimStats, Stimulus, Stop};
+use specfx::cycle::sim::{simulate_with, Record, SimStats, Stimulus, Stop, Stream};
 use specfx::cycle::vcd::write_vcd;
 use specfx::cycle::Arch;
 use specfx::nset::NSet;
@@ -42,6 +42,10 @@ pub struct SimArgs {
     /// Probability that the sink is not ready in a cycle.
     #[arg(long, default_value = "0.1", value_parser = parse_probability)]
     stall: f64,
+    /// Input stream: random (n and c uniform, seeded) or sweep (every code up to 1.0 for each
+    /// n in turn, as the co-simulation's sorted order streams them).
+    #[arg(long, default_value = "random")]
+    stream: Stream,
     /// Exponents, replacing the configuration's set.
     #[arg(long)]
     n: Option<NSet>,
@@ -68,13 +72,18 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
     } else {
         0
     };
-    let result = simulate(
+    // Statistics (and a trace) only: no per-cycle records, which a long run cannot afford.
+    let record = Record {
+        transfers: false,
+        trace_cycles,
+    };
+    let result = simulate_with(
         &dp,
         args.arch,
-        random_inputs(&dp, args.seed),
+        args.stream.inputs(&dp, args.seed),
         &mut stim,
         Stop::Cycles(args.cycles),
-        trace_cycles,
+        record,
     );
     if let Some(path) = &args.vcd {
         let mut buf = Vec::new();

@@ -1,11 +1,13 @@
 //! Cycle-level model: the `pipelined` and `folded` microarchitectures with valid/ready
 //! handshakes, as `docs/cycle.md` specifies them.
 //!
-//! A clocked step is a pure function: [`Machine::next`] takes the registers and the inputs of
-//! one cycle and returns the registers after the clock edge; the simulator ([`sim`]) commits
-//! them. Each operation computes with the bit-accurate stage operations of
-//! [`crate::pipeline::Datapath`] (`op_sub`, `op_mul_t`, `op_add_b`, `op_square`,
-//! `op_mul_out`), so values are computed stage by stage as they move, as in the RTL.
+//! A clock edge is [`Machine::step`]: the registers and the inputs of one cycle give the
+//! registers after the edge ([`Machine::next`] returns them without changing the machine); the
+//! simulator ([`sim`]) drives it. The `folded` unit computes with the bit-accurate stage
+//! operations of [`crate::pipeline::Datapath`] (`op_sub`, `op_mul_t`, `op_add_b`,
+//! `op_square`, `op_mul_out`) as its FSM steps, as in the RTL. The `pipelined` one carries
+//! tokens whose values are the functional model's (`docs/cycle.md`), checked register by
+//! register against a literal pipeline in `tests/cycle_model.rs`.
 //!
 //! Valid/ready rules (both ports; see `docs/cycle.md`):
 //!
@@ -82,7 +84,13 @@ impl Arch {
 crate::names::named_enum!(Arch, "architecture", "pipelined or folded");
 
 /// One input of a stream: its sequence number, the index of its n in the datapath's n set,
-/// and its raw input code.
+/// its raw input code, and its output under the functional model.
+///
+/// The output rides along because the `pipelined` machine needs no other value: each of its
+/// registers applies its operation once to the token it takes in and holds the result, so the
+/// value in any register is the functional model's value of its input at that register's
+/// stage, and the simulator computes those in batches ([`Datapath::eval_outputs`]) ahead of
+/// the stream. The `folded` machine computes its values itself, operation by operation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Item {
     /// Sequence number (0, 1, 2, ... in stream order).
@@ -91,6 +99,28 @@ pub struct Item {
     pub n_idx: usize,
     /// Raw input code.
     pub c_raw: i64,
+    /// The raw output [`Datapath::eval`] gives for this input.
+    pub out: i64,
+}
+
+impl Item {
+    /// The item of input `(n_idx, c_raw)` with sequence number `tag`, its output computed
+    /// alone (the simulator computes many at once).
+    pub fn new(dp: &Datapath, tag: u64, n_idx: usize, c_raw: i64) -> Item {
+        let out = dp.eval(c_raw, &dp.constants()[n_idx]).values[dp.stage_out()];
+        Item {
+            tag,
+            n_idx,
+            c_raw,
+            out,
+        }
+    }
+
+    /// The value this input has at `stage` (d, t, b, a square or out).
+    pub fn value_at(&self, dp: &Datapath, stage: Stage) -> i64 {
+        let probes = dp.eval(self.c_raw, &dp.constants()[self.n_idx]);
+        probes.values[stage.index(dp.config().k as usize)]
+    }
 }
 
 /// A value in a register, with the input it belongs to.
@@ -175,13 +205,14 @@ pub trait Machine: Clone {
     fn in_ready(&self, out_ready: bool) -> bool;
     /// The output register: `Some((tag, raw))` when `out_valid` is high.
     fn output(&self) -> Option<(u64, i64)>;
-    /// The registers after the clock edge, given this cycle's transferred input (if any) and
-    /// `out_ready`.
-    fn next(&self, dp: &Datapath, input: Option<Item>, out_ready: bool) -> Self;
-    /// [`Machine::next`] written into `next` (whose old registers are overwritten), so that a
-    /// simulator can keep two register sets and swap them without allocating.
-    fn next_into(&self, dp: &Datapath, input: Option<Item>, out_ready: bool, next: &mut Self) {
-        *next = self.next(dp, input, out_ready);
+    /// The clock edge: the registers become those after the edge, given this cycle's
+    /// transferred input (if any) and `out_ready`.
+    fn step(&mut self, dp: &Datapath, input: Option<Item>, out_ready: bool);
+    /// The registers after the clock edge, leaving these as they are.
+    fn next(&self, dp: &Datapath, input: Option<Item>, out_ready: bool) -> Self {
+        let mut next = self.clone();
+        next.step(dp, input, out_ready);
+        next
     }
     /// Adds 1 to `counts[unit]` for every unit that holds valid data now (the units of
     /// [`Machine::unit_names`], in order).
@@ -198,17 +229,25 @@ pub trait Machine: Clone {
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView>;
 }
 
-/// The `pipelined` architecture: one delay line of `latency` registers per operation.
+/// The `pipelined` architecture: one delay line of `latency` registers per operation, the
+/// first computing the operation on the token it takes in.
+///
+/// Nothing in the pipeline depends on the values it carries (a stall holds every register,
+/// otherwise every register takes its predecessor's token), so the registers hold their
+/// input's [`Item`] and show the value of its stage on demand; they sit in a ring, so a clock
+/// edge costs the same whatever the latency.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Pipelined {
-    /// The operation computed on entry to each register (`None`: a plain delay register).
-    ops: Vec<Option<Op>>,
-    /// The operation each register belongs to (for occupancy and names).
+    /// The operation each register belongs to (for names and stage values), input side first.
     owner: Vec<Op>,
-    /// The registers, input side first.
-    regs: Vec<Option<Token>>,
-    /// The registers of each unit (of `op_units(owner)`), a contiguous range each.
-    unit_regs: Vec<std::ops::Range<usize>>,
+    /// The registers, as a ring: register `r` (input side first) is `ring[(head + r) % len]`.
+    ring: Vec<Option<Item>>,
+    /// Where register 0 sits in the ring.
+    head: usize,
+    /// Bit `r`: register `r` holds a token.
+    valid: u128,
+    /// The registers of each unit (of `op_units(owner)`) as a mask of `valid`'s bits.
+    unit_masks: Vec<u128>,
 }
 
 impl Pipelined {
@@ -219,28 +258,35 @@ impl Pipelined {
         let mut plan = vec![(Op::Sub, lat.sub), (Op::MulT, lat.mul), (Op::AddB, lat.add)];
         plan.extend((0..cfg.k as usize).map(|i| (Op::Square(i), lat.mul)));
         plan.push((Op::MulOut, lat.mul));
-        let mut ops = Vec::new();
-        let mut owner = Vec::new();
-        for (op, l) in plan {
-            for r in 0..l {
-                ops.push((r == 0).then_some(op));
-                owner.push(op);
-            }
-        }
-        let regs = vec![None; ops.len()];
-        let mut unit_regs: Vec<std::ops::Range<usize>> = Vec::new();
-        for (r, &op) in owner.iter().enumerate() {
-            match unit_regs.last_mut() {
-                Some(range) if owner[range.start] == op => range.end = r + 1,
-                _ => unit_regs.push(r..r + 1),
-            }
-        }
+        let owner: Vec<Op> = plan
+            .iter()
+            .flat_map(|&(op, l)| std::iter::repeat_n(op, l as usize))
+            .collect();
+        // At most 8 registers per operation and k + 4 <= 11 operations.
+        assert!(owner.len() <= 128, "a pipeline of at most 128 registers");
+        let unit_masks = op_units(&owner)
+            .iter()
+            .map(|&op| {
+                (0..owner.len())
+                    .filter(|&r| owner[r] == op)
+                    .fold(0u128, |m, r| m | 1 << r)
+            })
+            .collect();
         Pipelined {
-            ops,
+            ring: vec![None; owner.len()],
+            head: 0,
+            valid: 0,
+            unit_masks,
             owner,
-            regs,
-            unit_regs,
         }
+    }
+
+    /// Register `r`, input side first.
+    #[inline]
+    fn reg(&self, r: usize) -> Option<Item> {
+        let i = self.head + r;
+        let len = self.ring.len();
+        self.ring[if i >= len { i - len } else { i }]
     }
 }
 
@@ -259,47 +305,34 @@ impl Machine for Pipelined {
         self.output().is_none() || out_ready
     }
 
+    #[inline]
     fn output(&self) -> Option<(u64, i64)> {
-        self.regs
-            .last()
-            .copied()
-            .flatten()
-            .map(|t| (t.tag, t.value))
+        if self.valid >> (self.ring.len() - 1) & 1 == 0 {
+            return None;
+        }
+        self.reg(self.ring.len() - 1).map(|it| (it.tag, it.out))
     }
 
-    fn next(&self, dp: &Datapath, input: Option<Item>, out_ready: bool) -> Pipelined {
-        let mut next = self.clone();
-        self.next_into(dp, input, out_ready, &mut next);
-        next
-    }
-
-    fn next_into(&self, dp: &Datapath, input: Option<Item>, out_ready: bool, next: &mut Self) {
+    fn step(&mut self, _dp: &Datapath, input: Option<Item>, out_ready: bool) {
         if !self.in_ready(out_ready) {
             // Rule 5: a stalled pipeline holds everything (and accepts nothing).
-            next.regs.copy_from_slice(&self.regs);
             return;
         }
-        for r in 0..self.regs.len() {
-            let incoming = if r == 0 {
-                input.map(|it| Token {
-                    tag: it.tag,
-                    n_idx: it.n_idx,
-                    c: it.c_raw,
-                    value: it.c_raw,
-                })
-            } else {
-                self.regs[r - 1]
-            };
-            next.regs[r] = match self.ops[r] {
-                Some(op) => incoming.map(|t| op.apply(dp, t)),
-                None => incoming,
-            };
-        }
+        let len = self.ring.len();
+        self.valid = ((self.valid << 1) | u128::from(input.is_some())) & (u128::MAX >> (128 - len));
+        // Register r takes register r - 1's token: the ring turns by one, and the slot of the
+        // token leaving the last register becomes register 0.
+        self.head = if self.head == 0 {
+            self.ring.len() - 1
+        } else {
+            self.head - 1
+        };
+        self.ring[self.head] = input;
     }
 
     fn count_occupancy(&self, counts: &mut [u64]) {
-        for (count, range) in counts.iter_mut().zip(&self.unit_regs) {
-            *count += u64::from(self.regs[range.clone()].iter().any(Option::is_some));
+        for (count, &mask) in counts.iter_mut().zip(&self.unit_masks) {
+            *count += u64::from(self.valid & mask != 0);
         }
     }
 
@@ -308,14 +341,9 @@ impl Machine for Pipelined {
     }
 
     fn occupancy(&self) -> Vec<bool> {
-        op_units(&self.owner)
+        self.unit_masks
             .iter()
-            .map(|&op| {
-                self.owner
-                    .iter()
-                    .zip(&self.regs)
-                    .any(|(&o, r)| o == op && r.is_some())
-            })
+            .map(|&m| self.valid & m != 0)
             .collect()
     }
 
@@ -324,11 +352,9 @@ impl Machine for Pipelined {
         let k = dp.config().k as usize;
         let width_of = |op: Op| -> u32 { stages[op.stage().index(k)].format.width() };
         let mut index_in_op = 0;
-        self.owner
-            .iter()
-            .zip(&self.regs)
-            .enumerate()
-            .map(|(r, (&op, reg))| {
+        (0..self.owner.len())
+            .map(|r| {
+                let op = self.owner[r];
                 if r > 0 && self.owner[r - 1] == op {
                     index_in_op += 1;
                 } else {
@@ -337,7 +363,7 @@ impl Machine for Pipelined {
                 RegisterView {
                     name: format!("{}_q{}", op.name(), index_in_op),
                     width: width_of(op),
-                    value: reg.map(|t| t.value),
+                    value: self.reg(r).map(|it| it.value_at(dp, op.stage())),
                 }
             })
             .collect()
@@ -387,7 +413,53 @@ impl Machine for Folded {
         self.out
     }
 
-    fn next(&self, dp: &Datapath, input: Option<Item>, out_ready: bool) -> Folded {
+    fn step(&mut self, dp: &Datapath, input: Option<Item>, out_ready: bool) {
+        *self = self.after(dp, input, out_ready);
+    }
+
+    fn unit_names(&self) -> Vec<String> {
+        vec!["multiplier".into(), "out_reg".into()]
+    }
+
+    fn occupancy(&self) -> Vec<bool> {
+        vec![self.busy, self.out.is_some()]
+    }
+
+    fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
+        let widest = dp
+            .stages()
+            .iter()
+            .map(|s| s.format.width())
+            .max()
+            .unwrap_or(1);
+        vec![
+            RegisterView {
+                name: "x".into(),
+                width: widest,
+                value: self.x.map(|t| t.value),
+            },
+            RegisterView {
+                name: "step".into(),
+                width: 8,
+                value: self.busy.then_some(self.step as i64),
+            },
+            RegisterView {
+                name: "count".into(),
+                width: 8,
+                value: self.busy.then_some(i64::from(self.count)),
+            },
+            RegisterView {
+                name: "out_q".into(),
+                width: dp.stages()[dp.stage_out()].format.width(),
+                value: self.out.map(|o| o.1),
+            },
+        ]
+    }
+}
+
+impl Folded {
+    /// The registers after the clock edge.
+    fn after(&self, dp: &Datapath, input: Option<Item>, out_ready: bool) -> Folded {
         let out_free = self.out.is_none() || out_ready;
         let mut next = self.clone();
         if self.out.is_some() && out_ready {
@@ -428,44 +500,5 @@ impl Machine for Folded {
             next.count = 0;
         }
         next
-    }
-
-    fn unit_names(&self) -> Vec<String> {
-        vec!["multiplier".into(), "out_reg".into()]
-    }
-
-    fn occupancy(&self) -> Vec<bool> {
-        vec![self.busy, self.out.is_some()]
-    }
-
-    fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
-        let widest = dp
-            .stages()
-            .iter()
-            .map(|s| s.format.width())
-            .max()
-            .unwrap_or(1);
-        vec![
-            RegisterView {
-                name: "x".into(),
-                width: widest,
-                value: self.x.map(|t| t.value),
-            },
-            RegisterView {
-                name: "step".into(),
-                width: 8,
-                value: self.busy.then_some(self.step as i64),
-            },
-            RegisterView {
-                name: "count".into(),
-                width: 8,
-                value: self.busy.then_some(i64::from(self.count)),
-            },
-            RegisterView {
-                name: "out_q".into(),
-                width: dp.stages()[dp.stage_out()].format.width(),
-                value: self.out.map(|o| o.1),
-            },
-        ]
     }
 }

@@ -28,7 +28,13 @@ impl Stimulus {
     }
 
     /// The next cycle's (valid offer, out_ready).
+    #[inline]
     pub fn next_cycle(&mut self) -> (bool, bool) {
+        if self.bubble == 0.0 && self.stall == 0.0 {
+            // Both draws would be >= 0: skipping them changes no cycle, since nothing else
+            // reads this generator.
+            return (true, true);
+        }
         let valid = self.rng.gen::<f64>() >= self.bubble;
         let ready = self.rng.gen::<f64>() >= self.stall;
         (valid, ready)
@@ -109,11 +115,11 @@ pub struct SimStats {
 pub struct SimResult {
     /// Statistics.
     pub stats: SimStats,
-    /// Every output transfer, in order.
+    /// Every output transfer, in order (empty unless [`Record::transfers`]).
     pub outputs: Vec<OutputEvent>,
-    /// The `valid` offer bit of every simulated cycle.
+    /// The `valid` offer bit of every simulated cycle (empty unless [`Record::transfers`]).
     pub valid_bits: Vec<bool>,
-    /// The `out_ready` bit of every simulated cycle.
+    /// The `out_ready` bit of every simulated cycle (empty unless [`Record::transfers`]).
     pub ready_bits: Vec<bool>,
     /// Port and register traces of the first `trace_cycles` cycles.
     pub trace: Vec<CycleTrace>,
@@ -139,72 +145,200 @@ pub fn simulate(
     stop: Stop,
     trace_cycles: u64,
 ) -> SimResult {
+    let record = Record {
+        transfers: true,
+        trace_cycles,
+    };
+    simulate_with(dp, arch, items, stimulus, stop, record)
+}
+
+/// [`simulate`], keeping only what `record` asks for besides the statistics.
+pub fn simulate_with(
+    dp: &Datapath,
+    arch: Arch,
+    items: impl Iterator<Item = (usize, i64)>,
+    stimulus: &mut Stimulus,
+    stop: Stop,
+    record: Record,
+) -> SimResult {
     match arch {
-        Arch::Pipelined => run(
-            dp,
-            arch,
-            Pipelined::new(dp),
-            items,
-            stimulus,
-            stop,
-            trace_cycles,
-        ),
-        Arch::Folded => run(
-            dp,
-            arch,
-            Folded::new(dp),
-            items,
-            stimulus,
-            stop,
-            trace_cycles,
-        ),
+        Arch::Pipelined => run(dp, arch, Pipelined::new(dp), items, stimulus, stop, record),
+        Arch::Folded => run(dp, arch, Folded::new(dp), items, stimulus, stop, record),
     }
 }
 
-fn run<M: Machine>(
+/// The input stream with each input's functional output, computed ahead in blocks: a block's
+/// inputs are grouped by n and evaluated with [`Datapath::eval_outputs`]. Blocks grow from
+/// [`Source::FIRST_BLOCK`] to [`Source::MAX_BLOCK`] inputs, so a short simulation reads little
+/// ahead of what it accepts.
+struct Source<'a, I> {
+    dp: &'a Datapath,
+    items: I,
+    /// Inputs read and evaluated, `(n_idx, c_raw, out)`; those before `next` are accepted.
+    ahead: Vec<(usize, i64, i64)>,
+    next: usize,
+    block: usize,
+    exhausted: bool,
+    scratch: crate::pipeline::OutputScratch,
+    /// Reused buffers of [`Source::refill`].
+    order: Vec<usize>,
+    starts: Vec<usize>,
+    codes: Vec<i64>,
+    values: Vec<i64>,
+}
+
+impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
+    const FIRST_BLOCK: usize = 256;
+    const MAX_BLOCK: usize = 1 << 16;
+
+    fn new(dp: &'a Datapath, items: I) -> Self {
+        Source {
+            dp,
+            items,
+            ahead: Vec::new(),
+            next: 0,
+            block: Self::FIRST_BLOCK,
+            exhausted: false,
+            scratch: crate::pipeline::OutputScratch::default(),
+            order: Vec::new(),
+            starts: Vec::new(),
+            codes: Vec::new(),
+            values: Vec::new(),
+        }
+    }
+
+    /// The next input, if the stream has one.
+    #[inline]
+    fn peek(&mut self) -> Option<(usize, i64, i64)> {
+        if self.next == self.ahead.len() && !self.exhausted {
+            self.refill();
+        }
+        self.ahead.get(self.next).copied()
+    }
+
+    #[inline]
+    fn next(&mut self) -> Option<(usize, i64, i64)> {
+        let item = self.peek();
+        self.next += usize::from(item.is_some());
+        item
+    }
+
+    fn refill(&mut self) {
+        self.ahead.clear();
+        self.next = 0;
+        self.ahead
+            .extend(self.items.by_ref().take(self.block).map(|(n, c)| (n, c, 0)));
+        self.exhausted = self.ahead.len() < self.block;
+        self.block = (self.block * 2).min(Self::MAX_BLOCK);
+        // Group by n (a counting sort, so each group keeps stream order), evaluate, scatter
+        // back.
+        let constants = self.dp.constants();
+        let starts = &mut self.starts;
+        starts.clear();
+        starts.resize(constants.len() + 1, 0);
+        for &(n_idx, _, _) in &self.ahead {
+            starts[n_idx + 1] += 1;
+        }
+        for i in 1..starts.len() {
+            starts[i] += starts[i - 1];
+        }
+        self.order.clear();
+        self.order.resize(self.ahead.len(), 0);
+        for (i, &(n_idx, _, _)) in self.ahead.iter().enumerate() {
+            // starts[n_idx] is the next free place of group n_idx; it ends at the group's end.
+            self.order[starts[n_idx]] = i;
+            starts[n_idx] += 1;
+        }
+        let mut group_start = 0;
+        for (n_idx, nc) in constants.iter().enumerate() {
+            let group = &self.order[group_start..starts[n_idx]];
+            group_start = starts[n_idx];
+            if group.is_empty() {
+                continue;
+            }
+            self.codes.clear();
+            self.codes.extend(group.iter().map(|&i| self.ahead[i].1));
+            self.values.clear();
+            self.values.resize(group.len(), 0);
+            self.dp
+                .eval_outputs(nc, &self.codes, &mut self.values, &mut self.scratch);
+            for (&i, &v) in group.iter().zip(&self.values) {
+                self.ahead[i].2 = v;
+            }
+        }
+    }
+}
+
+/// What a simulation keeps besides its statistics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Record {
+    /// Keep every output transfer and the valid/ready bits of every cycle (the co-simulation's
+    /// stimulus files need them; statistics do not).
+    pub transfers: bool,
+    /// Keep the ports and registers of the first this many cycles, for traces.
+    pub trace_cycles: u64,
+}
+
+/// Runs `machine` on a stream of inputs (`items[i]` gets tag `i`) under `stimulus`'s bubbles
+/// and stalls, keeping what `record` asks for; `arch` names the architecture in the
+/// statistics. [`simulate`] is this with the machine of an architecture; tests run other
+/// machines (a literal register-by-register pipeline) through it.
+pub fn run<M: Machine>(
     dp: &Datapath,
     arch: Arch,
     mut machine: M,
     items: impl Iterator<Item = (usize, i64)>,
     stimulus: &mut Stimulus,
     stop: Stop,
-    trace_cycles: u64,
+    record: Record,
 ) -> SimResult {
-    let mut items = items.peekable();
-    let mut accepted_at: Vec<u64> = Vec::new();
-    let mut inputs: Vec<(usize, i64)> = Vec::new();
-    let mut outputs: Vec<OutputEvent> = Vec::new();
-    let mut valid_bits = Vec::new();
-    let mut ready_bits = Vec::new();
+    let mut items = Source::new(dp, items);
+    // Room for a run that stops after a number of cycles (up to 2^22 of them; longer runs
+    // grow), so that the per-cycle records do not move as they grow.
+    let room = match stop {
+        Stop::Cycles(c) if record.transfers => c.min(1 << 22) as usize,
+        _ => 0,
+    };
+    let mut outputs: Vec<OutputEvent> = Vec::with_capacity(room);
+    let mut valid_bits = Vec::with_capacity(room);
+    let mut ready_bits = Vec::with_capacity(room);
     let mut trace = Vec::new();
+    // The inputs in flight from tag `first_in_flight` on: the cycle each transferred and the
+    // functional model's output for it. Outputs leave in order, so the front leaves first.
+    let mut in_flight: std::collections::VecDeque<(u64, i64)> = Default::default();
+    let mut first_in_flight = 0u64;
+    let (mut n_inputs, mut n_outputs) = (0u64, 0u64);
+    let (mut latency_min, mut latency_max) = (u64::MAX, 0);
+    let mut mismatches = 0;
     let units = machine.unit_names();
     let mut occupied = vec![0u64; units.len()];
     let (mut bubbles, mut stalls, mut backpressure) = (0, 0, 0);
     let mut order_errors = 0;
-    let mut spare = machine.clone();
     let max_cycles = match stop {
         Stop::Cycles(c) | Stop::Drained(c) => c,
     };
     let mut cycle = 0u64;
     while cycle < max_cycles {
         if let Stop::Drained(_) = stop {
-            if items.peek().is_none() && outputs.len() == inputs.len() {
+            if items.peek().is_none() && n_outputs == n_inputs {
                 break;
             }
         }
         let (offer, out_ready) = stimulus.next_cycle();
-        valid_bits.push(offer);
-        ready_bits.push(out_ready);
-        let next_item = items.peek().copied();
+        if record.transfers {
+            valid_bits.push(offer);
+            ready_bits.push(out_ready);
+        }
+        let next_item = items.peek();
         let in_valid = offer && next_item.is_some();
         let in_ready = machine.in_ready(out_ready);
         let output = machine.output();
-        if cycle < trace_cycles {
+        if cycle < record.trace_cycles {
             trace.push(CycleTrace {
                 cycle,
                 in_valid,
                 in_ready,
-                in_c: next_item.filter(|_| in_valid).map(|(_, c)| c),
+                in_c: next_item.filter(|_| in_valid).map(|(_, c, _)| c),
                 out_valid: output.is_some(),
                 out_ready,
                 out_data: output.map(|o| o.1),
@@ -220,42 +354,63 @@ fn run<M: Machine>(
         }
         let transfer_in = in_valid && in_ready;
         let item = if transfer_in {
-            let (n_idx, c_raw) = items.next().expect("peeked");
-            let tag = inputs.len() as u64;
-            inputs.push((n_idx, c_raw));
-            accepted_at.push(cycle);
-            Some(Item { tag, n_idx, c_raw })
+            let (n_idx, c_raw, out) = items.next().expect("peeked");
+            let tag = n_inputs;
+            n_inputs += 1;
+            in_flight.push_back((cycle, out));
+            Some(Item {
+                tag,
+                n_idx,
+                c_raw,
+                out,
+            })
         } else {
             None
         };
         if let Some((tag, value)) = output {
             if out_ready {
-                if tag != outputs.len() as u64 {
+                if tag != n_outputs {
                     order_errors += 1;
                 }
-                outputs.push(OutputEvent {
-                    tag,
-                    value,
-                    cycle,
-                    latency: cycle - accepted_at[tag as usize],
-                });
+                n_outputs += 1;
+                // An output whose tag names no input in flight is an order error only.
+                let at = tag
+                    .checked_sub(first_in_flight)
+                    .and_then(|i| in_flight.get(i as usize).copied());
+                let latency = at.map_or(0, |(accepted, _)| cycle - accepted);
+                if at.is_some_and(|(_, want)| want != value) {
+                    mismatches += 1;
+                }
+                if at.is_some() && tag == first_in_flight {
+                    in_flight.pop_front();
+                    first_in_flight += 1;
+                }
+                latency_min = latency_min.min(latency);
+                latency_max = latency_max.max(latency);
+                if record.transfers {
+                    outputs.push(OutputEvent {
+                        tag,
+                        value,
+                        cycle,
+                        latency,
+                    });
+                }
             } else {
                 stalls += 1;
             }
         }
-        machine.next_into(dp, item, out_ready, &mut spare);
-        std::mem::swap(&mut machine, &mut spare);
+        machine.step(dp, item, out_ready);
         cycle += 1;
     }
-    let mismatches = count_mismatches(dp, &inputs, &outputs);
-    let latency_min = outputs.iter().map(|o| o.latency).min().unwrap_or(0);
-    let latency_max = outputs.iter().map(|o| o.latency).max().unwrap_or(0);
+    if n_outputs == 0 {
+        latency_min = 0;
+    }
     let cfg = dp.config();
     let stats = SimStats {
         arch,
         n_cycles: cycle,
-        n_inputs: inputs.len() as u64,
-        n_outputs: outputs.len() as u64,
+        n_inputs,
+        n_outputs,
         latency_min,
         latency_max,
         latency_nominal: arch.latency(cfg),
@@ -263,7 +418,7 @@ fn run<M: Machine>(
         throughput: if cycle == 0 {
             0.0
         } else {
-            outputs.len() as f64 / cycle as f64
+            n_outputs as f64 / cycle as f64
         },
         bubble_cycles: bubbles,
         stall_cycles: stalls,
@@ -294,35 +449,55 @@ fn run<M: Machine>(
     }
 }
 
-/// How many outputs differ from the functional model's output for their input (outputs whose
-/// tag names no input are not counted here; they are order errors). The expected outputs are
-/// computed in batches per n with [`Datapath::eval_outputs`].
-fn count_mismatches(dp: &Datapath, inputs: &[(usize, i64)], outputs: &[OutputEvent]) -> u64 {
-    let mut by_n: Vec<Vec<usize>> = vec![Vec::new(); dp.constants().len()];
-    for (i, o) in outputs.iter().enumerate() {
-        if let Some(&(n_idx, _)) = inputs.get(o.tag as usize) {
-            by_n[n_idx].push(i);
+/// An input stream a simulation can be driven with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stream {
+    /// [`random_inputs`]: n and c uniform, seeded.
+    Random,
+    /// [`sweep_inputs`]: every code up to 1.0 for every n in turn, as the co-simulation's
+    /// sorted order and `scripts/bench-peers`' Verilator harness stream them.
+    Sweep,
+}
+
+impl Stream {
+    /// Both streams.
+    pub const ALL: [Stream; 2] = [Stream::Random, Stream::Sweep];
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stream::Random => "random",
+            Stream::Sweep => "sweep",
         }
     }
-    let mut scratch = crate::pipeline::OutputScratch::default();
-    let mut mismatches = 0;
-    for (n_idx, which) in by_n.iter().enumerate() {
-        let nc = &dp.constants()[n_idx];
-        for part in which.chunks(4096) {
-            let codes: Vec<i64> = part
-                .iter()
-                .map(|&i| inputs[outputs[i].tag as usize].1)
-                .collect();
-            let mut expected = vec![0; codes.len()];
-            dp.eval_outputs(nc, &codes, &mut expected, &mut scratch);
-            mismatches += part
-                .iter()
-                .zip(&expected)
-                .filter(|(&i, &e)| outputs[i].value != e)
-                .count() as u64;
+
+    /// The endless stream of inputs for a datapath (`seed` seeds the random one).
+    pub fn inputs(self, dp: &Datapath, seed: u64) -> Box<dyn Iterator<Item = (usize, i64)> + '_> {
+        match self {
+            Stream::Random => Box::new(random_inputs(dp, seed)),
+            Stream::Sweep => Box::new(sweep_inputs(dp)),
         }
     }
-    mismatches
+}
+
+crate::names::named_enum!(Stream, "input stream", "random or sweep");
+
+/// The endless stream of every input code from the format's first up to 1.0, for the first n
+/// of the set, then the second, and so on, starting again after the last.
+///
+/// # Examples
+/// ```
+/// use specfx::cycle::sim::sweep_inputs;
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let first: Vec<(usize, i64)> = sweep_inputs(&dp).skip(32768).take(2).collect();
+/// assert_eq!(first, [(0, 32768), (1, 0)]);
+/// ```
+pub fn sweep_inputs(dp: &Datapath) -> impl Iterator<Item = (usize, i64)> + '_ {
+    let codes = *dp.input_codes().start()..=dp.one_code();
+    (0..dp.constants().len())
+        .flat_map(move |n_idx| codes.clone().map(move |c| (n_idx, c)))
+        .cycle()
 }
 
 /// An endless seeded stream of random inputs: n uniform over the set, c uniform over the
@@ -333,40 +508,4 @@ pub fn random_inputs(dp: &Datapath, seed: u64) -> impl Iterator<Item = (usize, i
     let codes = dp.input_codes();
     let n_count = dp.constants().len();
     std::iter::repeat_with(move || (rng.gen_range(0..n_count), rng.gen_range(codes.clone())))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::pipeline::Config;
-
-    /// Outputs equal to `eval`'s count nothing; each changed value counts once, whatever n it
-    /// belongs to; an output whose tag names no input is left to the order check.
-    #[test]
-    fn mismatches_are_counted_against_eval() {
-        let dp = Datapath::new(Config::baseline()).unwrap();
-        let inputs: Vec<(usize, i64)> = (0..5000)
-            .map(|i| (i % dp.constants().len(), 32768 - (i as i64 * 7) % 900))
-            .collect();
-        let mut outputs: Vec<OutputEvent> = inputs
-            .iter()
-            .enumerate()
-            .map(|(tag, &(n_idx, c))| OutputEvent {
-                tag: tag as u64,
-                value: dp.eval(c, &dp.constants()[n_idx]).values[dp.stage_out()],
-                cycle: tag as u64,
-                latency: 0,
-            })
-            .collect();
-        assert_eq!(count_mismatches(&dp, &inputs, &outputs), 0);
-        outputs[17].value += 1;
-        outputs[4321].value -= 1;
-        outputs.push(OutputEvent {
-            tag: 99_999,
-            value: 0,
-            cycle: 0,
-            latency: 0,
-        });
-        assert_eq!(count_mismatches(&dp, &inputs, &outputs), 2);
-    }
 }
