@@ -14,11 +14,11 @@ use serde::Serialize;
 
 use crate::analysis::check::{check, CheckReport, Input};
 use crate::analysis::optimize::{metric_value, Budget, Metric};
-use crate::engine::map_n;
+use crate::engine::{fold_n, Chunk, Codes};
 use crate::error::Error;
 use crate::fixed::{quantize_f64, Format};
 use crate::pipeline::walk::{walk, Arithmetic, Stage};
-use crate::pipeline::{Datapath, NConstants, ProbeColumns, StageSpec, Variant, MAX_STAGES};
+use crate::pipeline::{Datapath, NConstants, StageSpec, Variant, MAX_STAGES};
 
 /// An error source: a quantization the datapath performs that the f64 model does not.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -652,8 +652,6 @@ impl Acc {
     }
 }
 
-const CHUNK: usize = 4096;
-
 /// How far above its exact value the base of a one-source model can be: one LSB of t (or t's
 /// saturation at its minimum), plus one LSB of each minimax constant.
 fn base_margin(dp: &Datapath) -> (f64, f64) {
@@ -665,95 +663,95 @@ fn base_margin(dp: &Datapath) -> (f64, f64) {
     (cfg.t.format.lsb() + constants, cfg.t.format.min_value())
 }
 
-fn analyse_one_n(
-    dp: &Datapath,
-    nc: &NConstants,
-    codes: &[i64],
-    ln_c: &[f64],
-    srcs: &[Source],
-    ranges: (f64, f64),
-) -> Acc {
+/// What every chunk of the budget's stream needs besides the chunk: the sources and the
+/// cumulative masks of the incremental attribution (sources 0..=i quantized).
+struct Sources {
+    srcs: Vec<Source>,
+    cumulative: Vec<u32>,
+}
+
+impl Sources {
+    fn new(srcs: Vec<Source>) -> Sources {
+        let cumulative = srcs
+            .iter()
+            .scan(0, |m, s| {
+                *m |= s.mask();
+                Some(*m)
+            })
+            .collect();
+        Sources { srcs, cumulative }
+    }
+}
+
+/// Folds one chunk of the engine's stream into the budget's accumulator of its n.
+fn add_chunk(dp: &Datapath, sources: &Sources, acc: &mut Acc, chunk: &Chunk<'_>) {
     let cfg = dp.config();
-    let out_idx = dp.stage_out();
+    let nc = chunk.nc;
     let out_lsb = cfg.out.format.lsb();
     let lobe_lsb = dp.stages()[dp.stage_last_square()].format.lsb();
     let c_lsb = cfg.c.format.lsb();
     let one = dp.one_code();
-    let nf = f64::from(nc.n);
     let (margin, t_min) = base_margin(dp);
-    // Cumulative masks: sources 0..=i quantized.
-    let cumulative: Vec<u32> = srcs
-        .iter()
-        .scan(0, |m, s| {
-            *m |= s.mask();
-            Some(*m)
-        })
-        .collect();
-    let mut acc = Acc::new(srcs.len(), ranges.0, ranges.1);
-    let mut cols = ProbeColumns::default();
-    for (chunk, ln_chunk) in codes.chunks(CHUNK).zip(ln_c.chunks(CHUNK)) {
-        dp.eval_batch(nc, chunk, &mut cols);
-        let lobes = &cols.values[dp.stage_last_square()];
-        let outs = &cols.values[out_idx];
-        for (i, &code) in chunk.iter().enumerate() {
-            let at = (nc.n, code);
-            let c = code.min(one) as f64 * c_lsb;
-            let target = (nf * ln_chunk[i]).exp();
-            let fixed_lobe = lobes[i] as f64 * lobe_lsb;
-            let fixed_out = outs[i] as f64 * out_lsb;
-            // Dead inputs: every model cuts the base (the one-source models too, whose base
-            // is at most `margin` above the exact one) and the datapath outputs 0, so every
-            // quantization error is exactly 0.
-            let t_exact = nc.slope * (c - 1.0);
-            let dead = fixed_out == 0.0
-                && fixed_lobe == 0.0
-                && cfg.cutoff.cuts(
-                    t_exact.max(t_min) + nc.offset + margin < 0.0,
-                    nc.below_threshold(code.min(one)),
-                );
-            let (ref_lobe, ref_out) = if dead {
-                (0.0, 0.0)
-            } else {
-                mixed_eval(dp, nc, code, 0)
-            };
-            if !dead {
-                let e_total = fixed_out - ref_out;
-                acc.total.add(e_total, at);
-                let mut sum = 0.0;
-                for (src, m) in srcs.iter().zip(&mut acc.sources) {
-                    let e = mixed_eval(dp, nc, code, src.mask()).1 - ref_out;
-                    m.add(e, at);
-                    sum += e;
-                }
-                acc.residual.add(e_total - sum, at);
-                let mut before = ref_out;
-                for (j, m) in acc.incremental.iter_mut().enumerate() {
-                    let after = if j + 1 == cumulative.len() {
-                        fixed_out
-                    } else {
-                        mixed_eval(dp, nc, code, cumulative[j]).1
-                    };
-                    m.add(after - before, at);
-                    before = after;
-                }
-                let bin = ((c * C_BINS as f64) as usize).min(C_BINS - 1);
-                acc.per_c_out[bin] = acc.per_c_out[bin].max(e_total.abs() / out_lsb);
-                acc.hist_out.add(e_total / out_lsb);
-                acc.shape_quant = acc.shape_quant.max((fixed_lobe - ref_lobe).abs());
-            } else {
-                acc.hist_out.add(0.0);
+    let Sources { srcs, cumulative } = sources;
+    let lobes = &chunk.probes.values[dp.stage_last_square()];
+    let outs = &chunk.probes.values[dp.stage_out()];
+    for (i, &code) in chunk.codes.iter().enumerate() {
+        let at = (nc.n, code);
+        let c = code.min(one) as f64 * c_lsb;
+        let target = chunk.cos_n(i);
+        let fixed_lobe = lobes[i] as f64 * lobe_lsb;
+        let fixed_out = outs[i] as f64 * out_lsb;
+        // Dead inputs: every model cuts the base (the one-source models too, whose base
+        // is at most `margin` above the exact one) and the datapath outputs 0, so every
+        // quantization error is exactly 0.
+        let t_exact = nc.slope * (c - 1.0);
+        let dead = fixed_out == 0.0
+            && fixed_lobe == 0.0
+            && cfg.cutoff.cuts(
+                t_exact.max(t_min) + nc.offset + margin < 0.0,
+                nc.below_threshold(code.min(one)),
+            );
+        let (ref_lobe, ref_out) = if dead {
+            (0.0, 0.0)
+        } else {
+            mixed_eval(dp, nc, code, 0)
+        };
+        if !dead {
+            let e_total = fixed_out - ref_out;
+            acc.total.add(e_total, at);
+            let mut sum = 0.0;
+            for (src, m) in srcs.iter().zip(&mut acc.sources) {
+                let e = mixed_eval(dp, nc, code, src.mask()).1 - ref_out;
+                m.add(e, at);
+                sum += e;
             }
-            acc.approx.add(ref_out - nc.coef * target, at);
-            acc.total_vs_target.add(fixed_out - nc.coef * target, at);
-            let shape_total = fixed_lobe - target;
-            acc.shape_total = acc.shape_total.max(shape_total.abs());
-            acc.shape_approx = acc.shape_approx.max((ref_lobe - target).abs());
-            acc.hist_shape.add(shape_total * 256.0);
+            acc.residual.add(e_total - sum, at);
+            let mut before = ref_out;
+            for (j, m) in acc.incremental.iter_mut().enumerate() {
+                let after = if j + 1 == cumulative.len() {
+                    fixed_out
+                } else {
+                    mixed_eval(dp, nc, code, cumulative[j]).1
+                };
+                m.add(after - before, at);
+                before = after;
+            }
             let bin = ((c * C_BINS as f64) as usize).min(C_BINS - 1);
-            acc.per_c_shape[bin] = acc.per_c_shape[bin].max(shape_total.abs());
+            acc.per_c_out[bin] = acc.per_c_out[bin].max(e_total.abs() / out_lsb);
+            acc.hist_out.add(e_total / out_lsb);
+            acc.shape_quant = acc.shape_quant.max((fixed_lobe - ref_lobe).abs());
+        } else {
+            acc.hist_out.add(0.0);
         }
+        acc.approx.add(ref_out - nc.coef * target, at);
+        acc.total_vs_target.add(fixed_out - nc.coef * target, at);
+        let shape_total = fixed_lobe - target;
+        acc.shape_total = acc.shape_total.max(shape_total.abs());
+        acc.shape_approx = acc.shape_approx.max((ref_lobe - target).abs());
+        acc.hist_shape.add(shape_total * 256.0);
+        let bin = ((c * C_BINS as f64) as usize).min(C_BINS - 1);
+        acc.per_c_shape[bin] = acc.per_c_shape[bin].max(shape_total.abs());
     }
-    acc
 }
 
 fn stats(
@@ -821,16 +819,21 @@ pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, E
     let cfg = dp.config();
     let c_lsb = cfg.c.format.lsb();
     let out_lsb = cfg.out.format.lsb();
-    let last = (*dp.input_codes().end()).min(dp.one_code());
-    let codes: Vec<i64> = (*dp.input_codes().start()..=last).collect();
+    let codes = Codes::up_to_one(dp);
     // The check's maxima size the histograms (with a hair of slack for the f64 reference).
     let ranges = (
         report.out_max_ulp * (1.0 + 1e-9),
         report.shape_total_max_abs * (1.0 + 1e-9),
     );
-    let ln_c: Vec<f64> = codes.iter().map(|&k| (k as f64 * c_lsb).ln()).collect();
-    let srcs = sources(dp);
-    let per_n_acc: Vec<Acc> = map_n(dp, |nc| analyse_one_n(dp, nc, &codes, &ln_c, &srcs, ranges));
+    let sources = Sources::new(sources(dp));
+    let srcs = &sources.srcs;
+    let per_n_acc: Vec<Acc> = fold_n(
+        dp,
+        &codes,
+        |_| Acc::new(srcs.len(), ranges.0, ranges.1),
+        |acc, chunk| add_chunk(dp, &sources, acc, chunk),
+        &|| {},
+    );
     let mut acc = Acc::new(srcs.len(), ranges.0, ranges.1);
     let mut per_n = Vec::with_capacity(per_n_acc.len());
     for (nc, a) in dp.constants().iter().zip(&per_n_acc) {
@@ -844,7 +847,7 @@ pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, E
             shape_approx_max_abs: a.shape_approx,
         });
     }
-    let count = (codes.len() * per_n.len()).max(1) as f64;
+    let count = (codes.codes.len() * per_n.len()).max(1) as f64;
     let sources_stats: Vec<SourceStats> = srcs
         .iter()
         .zip(&acc.sources)

@@ -9,11 +9,11 @@
 use serde::Serialize;
 
 use crate::analysis::budget::F64Walk;
-use crate::engine::map_n;
+use crate::engine::{each_chunk, map_n, Codes, Span};
 use crate::error::Error;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
 use crate::pipeline::fast::EventCounts;
-use crate::pipeline::{Datapath, NConstants, ProbeColumns, MAX_STAGES};
+use crate::pipeline::{Datapath, NConstants, MAX_STAGES};
 use crate::reference::lobe::Cutoff;
 
 /// An input where a figure is reached.
@@ -170,7 +170,7 @@ struct OutputsOfN {
 /// compared with the f64 walk, exactly as [`check_one_n`] compares them.
 fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> OutputsOfN {
     let cfg = dp.config();
-    let codes = &shared.codes[..];
+    let codes = &shared.codes.codes[..];
     let (lo, last) = (codes[0], codes[codes.len() - 1]);
     let lobe_lsb = dp.stages()[dp.stage_last_square()].format.lsb();
     let out_lsb = cfg.out.format.lsb();
@@ -183,7 +183,7 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
         if codes[i] as f64 * c_lsb <= 0.0 {
             0.0
         } else {
-            (nf * shared.ln_c[i]).exp()
+            (nf * shared.codes.ln_c[i]).exp()
         }
     };
     let dead_end = dead_prefix_end(dp, nc, codes);
@@ -206,14 +206,16 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
         r.out_max_abs = 0.0;
     }
     let mut prev_out = (n_dead > 0).then_some(0);
-    let mut cols = ProbeColumns::default();
     let (last_sq, out) = (dp.stage_last_square(), dp.stage_out());
-    for start in (n_dead..codes.len()).step_by(CHUNK) {
-        let end = (start + CHUNK).min(codes.len());
-        let chunk = &codes[start..end];
-        dp.eval_batch(nc, chunk, &mut cols);
-        for (j, &k) in chunk.iter().enumerate() {
-            let i = start + j;
+    let span = Span {
+        from: n_dead,
+        dead_end: i64::MIN,
+        chunk_codes: CHUNK,
+    };
+    each_chunk(dp, nc, &shared.codes, span, |c| {
+        let cols = c.probes;
+        for (j, &k) in c.codes.iter().enumerate() {
+            let i = c.start + j;
             let t = nc.slope * shared.ref_d[i];
             let mut s = reference_base(cfg.cutoff, t, nc.offset, k.min(one) < threshold);
             for _ in 0..cfg.k {
@@ -233,7 +235,7 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
             }
             prev_out = Some(o);
         }
-    }
+    });
     debug_assert!(last >= lo);
     r
 }
@@ -270,7 +272,7 @@ pub fn check_outputs(dp: &Datapath) -> Result<OutputFigures, Error> {
         f.n_correct += p.n_correct;
         f.n_violations += p.n_violations;
     }
-    let n_eval = shared.codes.len() as u64 * per_n.len() as u64;
+    let n_eval = shared.codes.codes.len() as u64 * per_n.len() as u64;
     Ok(OutputFigures {
         n_evaluations: n_eval,
         shape_quant_max_abs: f.quant,
@@ -593,15 +595,14 @@ fn dead_prefix_end(dp: &Datapath, nc: &NConstants, codes: &[i64]) -> i64 {
     a
 }
 
-/// Per-code inputs shared by every n: the codes, ln c and d's f64 reference.
+/// Per-code inputs shared by every n: the codes with ln c, and d's f64 reference.
 struct CodeColumns {
-    codes: Vec<i64>,
-    ln_c: Vec<f64>,
+    codes: Codes,
     ref_d: Vec<f64>,
 }
 
 fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
-    let codes = &shared.codes[..];
+    let codes = &shared.codes.codes[..];
     let cfg = dp.config();
     let stages = dp.stages();
     let n_stages = stages.len();
@@ -624,7 +625,6 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
     // The largest code whose fixed and f64 lobes are both 0: cos^n is increasing in c, so
     // its error there is the largest of all such codes and needs one evaluation at the end.
     let mut zero_lobe_code: Option<(i64, f64)> = None;
-    let mut cols = ProbeColumns::default();
     let mut refs: Vec<Vec<f64>> = vec![Vec::new(); n_stages];
     let mut errs: Vec<f64> = Vec::with_capacity(CHUNK);
     // Compacted columns of the inputs whose base is not 0 in both models ("live").
@@ -637,18 +637,16 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
     // reference and its fixed-point value are the same f64 for every code, so every error is
     // +0.0 and d's figures follow without computing them (the same bits as computing them).
     let d_is_exact = cfg.c.format.width() <= 52 && cfg.d.format.width() <= 53;
-    for ((chunk, ln_chunk), ref_d_chunk) in codes
-        .chunks(CHUNK)
-        .zip(shared.ln_c.chunks(CHUNK))
-        .zip(shared.ref_d.chunks(CHUNK))
-    {
+    let span = Span {
+        from: 0,
+        dead_end,
+        chunk_codes: CHUNK,
+    };
+    each_chunk(dp, nc, &shared.codes, span, |c| {
+        let (chunk, ln_chunk, cols) = (c.codes, c.ln_c, c.probes);
+        let ref_d_chunk = &shared.ref_d[c.start..c.start + chunk.len()];
         // A chunk below the dead prefix's end: every base is cut, and 0 in the f64 model too.
-        let dead_chunk = chunk[chunk.len() - 1] < dead_end;
-        if dead_chunk {
-            dp.eval_batch_cut(nc, chunk, &mut cols);
-        } else {
-            dp.eval_batch(nc, chunk, &mut cols);
-        }
+        let dead_chunk = c.dead;
         for (a, counts) in acc.iter_mut().zip(&cols.event_counts) {
             a.add_events(counts);
         }
@@ -794,7 +792,7 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
             }
             prev_out = Some(o);
         }
-    }
+    });
     if let Some((code, lnc)) = zero_lobe_code {
         let at = (nc.n, code);
         let cos_n = if code <= 0 { 0.0 } else { (nf * lnc).exp() };
@@ -832,12 +830,11 @@ fn code_columns(dp: &Datapath) -> Result<CodeColumns, Error> {
     let c_lsb = dp.config().c.format.lsb();
     let one = dp.one_code();
     Ok(CodeColumns {
-        ln_c: codes.iter().map(|&k| (k as f64 * c_lsb).ln()).collect(),
         ref_d: codes
             .iter()
             .map(|&k| (k.min(one) as f64 * c_lsb) - 1.0)
             .collect(),
-        codes,
+        codes: Codes::new(dp, codes),
     })
 }
 
@@ -860,7 +857,7 @@ pub fn check(dp: &Datapath) -> Result<CheckReport, Error> {
     let shared = code_columns(dp)?;
     let codes_all = dp.input_codes();
     let last = (*codes_all.end()).min(dp.one_code());
-    let n_codes = shared.codes.len() as u64;
+    let n_codes = shared.codes.codes.len() as u64;
     let c_lsb = dp.config().c.format.lsb();
     let per_n: Vec<PerN> = map_n(dp, |nc| check_one_n(dp, nc, &shared));
 

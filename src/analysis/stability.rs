@@ -15,11 +15,12 @@ use std::str::FromStr;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::engine::{fold_n, Chunk, Codes};
 use crate::error::Error;
 use crate::fixed::{quantize_f64, Event, Overflow, Rounding};
 use crate::nset::NSet;
 use crate::pipeline::datapath::STAGE_B;
-use crate::pipeline::{Config, Datapath, ProbeColumns, Variant};
+use crate::pipeline::{Config, Datapath, Variant};
 use crate::reference::lobe::{
     affine_lobe, cos_pow, exp_limit, m_of_k, paper_cutoff_cosine, pow_2k, schlick, Cutoff,
 };
@@ -839,7 +840,8 @@ struct FixedPlan {
     reason: Option<String>,
     lobe_scale: f64,
     out_scale: f64,
-    codes: Vec<i64>,
+    /// Every code from 0 up to 1.0.
+    codes: Codes,
     cs: Vec<f64>,
     rows: Vec<usize>,
 }
@@ -878,15 +880,23 @@ fn fixed_plan(config: &Config, ns: &[u32]) -> Result<FixedPlan, Error> {
             let scale =
                 |stage_idx: usize| (-f64::from(dp.stages()[stage_idx].format.frac_bits())).exp2();
             (
-                (0..=dp.one_code()).collect::<Vec<i64>>(),
+                Codes::new(dp, (0..=dp.one_code()).collect()),
                 scale(dp.stage_last_square()),
                 scale(dp.stage_out()),
                 (-f64::from(dp.config().c.format.frac_bits())).exp2(),
             )
         }
-        None => (Vec::new(), 1.0, 1.0, 1.0),
+        None => (
+            Codes {
+                codes: Vec::new(),
+                ln_c: Vec::new(),
+            },
+            1.0,
+            1.0,
+            1.0,
+        ),
     };
-    let cs: Vec<f64> = codes.iter().map(|&c| c as f64 * c_scale).collect();
+    let cs: Vec<f64> = codes.codes.iter().map(|&c| c as f64 * c_scale).collect();
     let rows = cs.iter().map(|&c| heat_row(c)).collect();
     Ok(FixedPlan {
         dp,
@@ -899,30 +909,31 @@ fn fixed_plan(config: &Config, ns: &[u32]) -> Result<FixedPlan, Error> {
     })
 }
 
-fn fixed_column(plan: &FixedPlan, n: u32, tol: f64, cols: &mut ProbeColumns) -> NAcc {
-    let mut acc = NAcc::new();
-    let Some(dp) = &plan.dp else {
-        acc.unrepresentable = true;
-        return acc;
-    };
-    let Some(nc) = dp.constants_for(n) else {
-        acc.unrepresentable = true;
-        return acc;
-    };
+/// A fixed path's accumulator of one n: the map's figures and the previous element's lobe and
+/// output (monotonicity runs across chunks).
+struct FixedAcc {
+    acc: NAcc,
+    prev_lobe: i64,
+    prev_out: i64,
+}
+
+/// Folds one chunk of the engine's stream into a fixed path's accumulator.
+fn fixed_chunk(plan: &FixedPlan, dp: &Datapath, tol: f64, fa: &mut FixedAcc, chunk: &Chunk<'_>) {
+    let nc = chunk.nc;
+    let n = nc.n;
     let cfg = dp.config();
     let n_below_m = cfg.variant == Variant::Plain && n < m_of_k(cfg.k);
     let nf = f64::from(n);
-    dp.eval_batch(nc, &plan.codes, cols);
-    let any_event = cols.event_counts.iter().flatten().any(|&x| x > 0);
+    let cols = chunk.probes;
     let last = dp.stage_last_square();
     let out = dp.stage_out();
-    let mut prev_lobe = i64::MIN;
-    let mut prev_out = i64::MIN;
-    for (j, &code) in plan.codes.iter().enumerate() {
+    // The stream visits plan.codes, which start at code 0: a code is its own index.
+    for (i, &code) in chunk.codes.iter().enumerate() {
+        let j = code as usize;
         let c = plan.cs[j];
-        let lobe_raw = cols.values[last][j];
-        let out_raw = cols.values[out][j];
-        let b_raw = cols.values[STAGE_B][j];
+        let lobe_raw = cols.values[last][i];
+        let out_raw = cols.values[out][i];
+        let b_raw = cols.values[STAGE_B][i];
         let lobe = lobe_raw as f64 * plan.lobe_scale;
         let err = lobe - cos_pow(c, nf);
         let mut flags = error_flags(err, tol);
@@ -937,17 +948,16 @@ fn fixed_column(plan: &FixedPlan, n: u32, tol: f64, cols: &mut ProbeColumns) -> 
         }
         // The fall in lobe units (an output fall is divided by the coefficient).
         let mut drop = 0.0;
-        if lobe_raw < prev_lobe || out_raw < prev_out {
+        if lobe_raw < fa.prev_lobe || out_raw < fa.prev_out {
             flags |= Kind::NonMonotonic.bit();
-            drop = ((prev_lobe - lobe_raw) as f64 * plan.lobe_scale)
-                .max((prev_out - out_raw) as f64 * plan.out_scale / nc.coef);
+            drop = ((fa.prev_lobe - lobe_raw) as f64 * plan.lobe_scale)
+                .max((fa.prev_out - out_raw) as f64 * plan.out_scale / nc.coef);
         }
-        prev_lobe = lobe_raw;
-        prev_out = out_raw;
+        fa.prev_lobe = lobe_raw;
+        fa.prev_out = out_raw;
         let mut stage_mask = 0u32;
-        if any_event {
-            let p = dp.eval(code, nc);
-            for (stage_idx, e) in p.events.iter().enumerate() {
+        if chunk.any_event() {
+            for (stage_idx, e) in chunk.events(i).iter().enumerate() {
                 match e {
                     Event::None => {}
                     Event::Wrapped => {
@@ -961,9 +971,42 @@ fn fixed_column(plan: &FixedPlan, n: u32, tol: f64, cols: &mut ProbeColumns) -> 
                 }
             }
         }
-        acc.add(c, plan.rows[j], err, flags, stage_mask, drop);
+        fa.acc.add(c, plan.rows[j], err, flags, stage_mask, drop);
     }
-    acc
+}
+
+/// The accumulators of a fixed path for every n of the grid, in grid order: the engine's
+/// stream over the n its datapath holds, an unrepresentable accumulator for the others.
+fn fixed_columns(plan: &FixedPlan, ns: &[u32], tol: f64, done: &(dyn Fn() + Sync)) -> Vec<NAcc> {
+    let unrepresentable = || NAcc {
+        unrepresentable: true,
+        ..NAcc::new()
+    };
+    let Some(dp) = &plan.dp else {
+        ns.iter().for_each(|_| done());
+        return ns.iter().map(|_| unrepresentable()).collect();
+    };
+    let per_n = fold_n(
+        dp,
+        &plan.codes,
+        |_| FixedAcc {
+            acc: NAcc::new(),
+            prev_lobe: i64::MIN,
+            prev_out: i64::MIN,
+        },
+        |fa, chunk| fixed_chunk(plan, dp, tol, fa, chunk),
+        done,
+    );
+    let mut held = dp.constants().iter().map(|nc| nc.n).zip(per_n).peekable();
+    ns.iter()
+        .map(|&n| match held.peek() {
+            Some(&(m, _)) if m == n => held.next().expect("peeked").1.acc,
+            _ => {
+                done();
+                unrepresentable()
+            }
+        })
+        .collect()
 }
 
 /// Folds the per-n accumulators of one path, in n order, into its map.
@@ -1214,18 +1257,13 @@ pub fn map(
 
     let mut fixed_maps = Vec::new();
     for (config, plan) in &plans {
-        let mut accs = Vec::with_capacity(ns.len());
-        for chunk in ns.chunks(CHUNK) {
-            let part: Vec<NAcc> = chunk
-                .par_iter()
-                .map_init(ProbeColumns::default, |cols, &n| {
-                    fixed_column(plan, n, tol, cols)
-                })
-                .collect();
-            accs.extend(part);
-            done += chunk.len();
-            progress(done, total);
-        }
+        let base = done;
+        let finished = std::sync::atomic::AtomicUsize::new(0);
+        let accs = fixed_columns(plan, ns, tol, &|| {
+            let now = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(base + now, total);
+        });
+        done += ns.len();
         let stage_names: Vec<String> = plan
             .dp
             .as_ref()

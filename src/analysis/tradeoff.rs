@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use crate::cycle::Arch;
+use crate::engine::{fold_n, Codes};
 use crate::hdl::cost::{analytic_cost, Target};
 use crate::pipeline::{Config, Datapath, ProbeColumns};
 use crate::reference::lobe::Cutoff;
@@ -185,26 +186,28 @@ pub fn fixed_figures(dp: &Datapath, time: Timer) -> MethodFigures {
     let lsb_c = dp.config().c.format.lsb();
     let last = dp.stage_last_square();
     let lsb_s = dp.stages()[last].format.lsb();
+    // One pass of the engine's stream over every code: the maximum error of each n, and the
+    // errors on the grid's codes (every step-th), summed afterwards in n and code order.
+    let all_codes = Codes::new(dp, (0..=one).collect());
+    let per_n_figures = fold_n(
+        dp,
+        &all_codes,
+        |_| (0.0f64, Vec::with_capacity(codes.len())),
+        |(max, grid), chunk| {
+            for (i, &k) in chunk.codes.iter().enumerate() {
+                let lobe = chunk.probes.values[last][i] as f64 * lsb_s;
+                let err = (lobe - cos_n(k as f64 * lsb_c, chunk.nc.n)).abs();
+                *max = max.max(err);
+                if k % step == 0 {
+                    grid.push(err);
+                }
+            }
+        },
+        &|| {},
+    );
+    let sum = per_n_figures.iter().flat_map(|(_, grid)| grid).sum::<f64>();
+    let per_n: Vec<f64> = per_n_figures.iter().map(|&(max, _)| max).collect();
     let mut cols = ProbeColumns::default();
-    let mut sum = 0.0;
-    let mut per_n = Vec::new();
-    let all_codes: Vec<i64> = (0..=one).collect();
-    for nc in dp.constants() {
-        dp.eval_batch(nc, &codes, &mut cols);
-        for (i, &k) in codes.iter().enumerate() {
-            sum += (cols.values[last][i] as f64 * lsb_s - cos_n(k as f64 * lsb_c, nc.n)).abs();
-        }
-        // The maximum over every input code of this n.
-        dp.eval_batch(nc, &all_codes, &mut cols);
-        let max = all_codes
-            .iter()
-            .enumerate()
-            .map(|(i, &k)| {
-                (cols.values[last][i] as f64 * lsb_s - cos_n(k as f64 * lsb_c, nc.n)).abs()
-            })
-            .fold(0.0, f64::max);
-        per_n.push(max);
-    }
     let secs = time(&mut || {
         for nc in dp.constants() {
             dp.eval_batch(nc, std::hint::black_box(&codes), &mut cols);

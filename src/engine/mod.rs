@@ -13,7 +13,8 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use crate::pipeline::{Datapath, NConstants};
+use crate::fixed::Event;
+use crate::pipeline::{Datapath, NConstants, ProbeColumns, MAX_STAGES};
 
 /// Codes per work item: large enough to amortise scheduling, small enough that a sweep of
 /// 1024 exponents splits across cores and each item's columns stay in cache.
@@ -89,6 +90,174 @@ pub fn map_items<T: Send>(
 /// ```
 pub fn map_n<T: Send>(dp: &Datapath, work: impl Fn(&NConstants) -> T + Sync) -> Vec<T> {
     dp.constants().par_iter().map(&work).collect()
+}
+
+/// The input codes a stream evaluates for every n, with `ln c` of each (c clamped to 1.0),
+/// computed once and shared by every n: `cos^n = exp(n ln c)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Codes {
+    /// Raw input codes, in the order the stream visits them.
+    pub codes: Vec<i64>,
+    /// `ln c` of each code clamped to 1.0.
+    pub ln_c: Vec<f64>,
+}
+
+impl Codes {
+    /// The given codes of a datapath's input.
+    pub fn new(dp: &Datapath, codes: Vec<i64>) -> Codes {
+        let (one, lsb) = (dp.one_code(), dp.config().c.format.lsb());
+        let ln_c = codes
+            .iter()
+            .map(|&k| (k.min(one) as f64 * lsb).ln())
+            .collect();
+        Codes { codes, ln_c }
+    }
+
+    /// Every code of the input format from its first up to 1.0.
+    pub fn up_to_one(dp: &Datapath) -> Codes {
+        let last = (*dp.input_codes().end()).min(dp.one_code());
+        Codes::new(dp, (*dp.input_codes().start()..=last).collect())
+    }
+}
+
+/// Codes per chunk of the stream.
+pub const CHUNK_CODES: usize = 4096;
+
+/// One chunk of the stream: an exponent, a run of codes, and what the datapath and the f64
+/// reference give for them.
+pub struct Chunk<'a> {
+    dp: &'a Datapath,
+    /// The exponent's constants.
+    pub nc: &'a NConstants,
+    /// The input codes.
+    pub codes: &'a [i64],
+    /// `ln c` of each code clamped to 1.0.
+    pub ln_c: &'a [f64],
+    /// The fixed-point probes: every stage's value, the cut flags and each stage's event
+    /// counts over the chunk.
+    pub probes: &'a ProbeColumns,
+    /// The index of the chunk's first code in the stream's [`Codes`] (for an analysis's own
+    /// per-code columns).
+    pub start: usize,
+    /// The chunk lies below the caller's dead-prefix end: every base is cut, so d and t are
+    /// evaluated and b..out hold 0 ([`Datapath::eval_batch_cut`]).
+    pub dead: bool,
+}
+
+impl Chunk<'_> {
+    /// `cos^n` of element `i`, from its `ln c`.
+    #[inline]
+    pub fn cos_n(&self, i: usize) -> f64 {
+        (f64::from(self.nc.n) * self.ln_c[i]).exp()
+    }
+
+    /// Whether any stage of any element of the chunk wrapped, saturated or was zeroed.
+    pub fn any_event(&self) -> bool {
+        self.probes.event_counts.iter().flatten().any(|&x| x > 0)
+    }
+
+    /// The overflow event of each stage for element `i` (the batch keeps counts only, so the
+    /// element is evaluated alone when the chunk had any event).
+    pub fn events(&self, i: usize) -> [Event; MAX_STAGES] {
+        if self.any_event() {
+            self.dp.eval(self.codes[i], self.nc).events
+        } else {
+            [Event::None; MAX_STAGES]
+        }
+    }
+}
+
+/// The engine's stream: for every n of the datapath, in parallel, an accumulator made by
+/// `init` is fed the chunks of `codes` in order by `step`; the accumulators come back in the
+/// order of the n set, so every figure folded from them is the same with any number of
+/// threads. `done` is called once per finished n (from any thread), for progress.
+///
+/// # Examples
+/// ```
+/// use specfx::engine::{fold_n, Codes};
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let codes = Codes::up_to_one(&dp);
+/// // The largest output of each n, and cos^n at c = 1.
+/// let per_n = fold_n(&dp, &codes, |_| (0, 0.0), |acc, chunk| {
+///     let out = &chunk.probes.values[dp.stage_out()];
+///     acc.0 = acc.0.max(*out.iter().max().unwrap());
+///     acc.1 = chunk.cos_n(chunk.codes.len() - 1);
+/// }, &|| {});
+/// assert_eq!(per_n.len(), 1009);
+/// assert_eq!(per_n[0].1, 1.0);
+/// ```
+pub fn fold_n<A: Send>(
+    dp: &Datapath,
+    codes: &Codes,
+    init: impl Fn(&NConstants) -> A + Sync,
+    step: impl Fn(&mut A, &Chunk<'_>) + Sync,
+    done: &(dyn Fn() + Sync),
+) -> Vec<A> {
+    map_n(dp, |nc| {
+        let mut acc = init(nc);
+        each_chunk(dp, nc, codes, Span::default(), |chunk| {
+            step(&mut acc, chunk)
+        });
+        done();
+        acc
+    })
+}
+
+/// Which part of the codes [`each_chunk`] streams, in chunks of what size, and where the
+/// caller has proven a dead prefix.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Span {
+    /// The index of the first code streamed.
+    pub from: usize,
+    /// Chunks whose codes are all below this code are dead (see [`Chunk::dead`]).
+    pub dead_end: i64,
+    /// Codes per chunk (figures summed per chunk depend on it).
+    pub chunk_codes: usize,
+}
+
+impl Default for Span {
+    /// Every code, no dead prefix, [`CHUNK_CODES`] codes per chunk.
+    fn default() -> Span {
+        Span {
+            from: 0,
+            dead_end: i64::MIN,
+            chunk_codes: CHUNK_CODES,
+        }
+    }
+}
+
+/// The stream of one n: the chunks of `codes[span.from..]` in order, each evaluated (a dead
+/// chunk with [`Datapath::eval_batch_cut`]) and handed to `f`.
+pub fn each_chunk(
+    dp: &Datapath,
+    nc: &NConstants,
+    codes: &Codes,
+    span: Span,
+    mut f: impl FnMut(&Chunk<'_>),
+) {
+    let mut probes = ProbeColumns::default();
+    let mut start = span.from;
+    while start < codes.codes.len() {
+        let end = (start + span.chunk_codes).min(codes.codes.len());
+        let chunk = &codes.codes[start..end];
+        let dead = chunk[chunk.len() - 1] < span.dead_end;
+        if dead {
+            dp.eval_batch_cut(nc, chunk, &mut probes);
+        } else {
+            dp.eval_batch(nc, chunk, &mut probes);
+        }
+        f(&Chunk {
+            dp,
+            nc,
+            codes: chunk,
+            ln_c: &codes.ln_c[start..end],
+            probes: &probes,
+            start,
+            dead,
+        });
+        start = end;
+    }
 }
 
 /// The output codes of a datapath over a range of input codes for every n: the checksum and
