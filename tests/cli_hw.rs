@@ -29,6 +29,16 @@ fn sim_json_reports_latency_throughput_and_no_mismatch() {
     ]));
     assert_eq!(v["n_outputs"], 992);
     assert_eq!(v["latency_max"], 8);
+    // The sweep stream: n = 16 and 20, every code 0..=32768 of each (65,538 inputs) and on
+    // into the second pass; every output checked against the functional model.
+    let v = json(&specfx(&[
+        "sim", "--n", "16,20", "--stream", "sweep", "--cycles", "70000", "--bubble", "0",
+        "--stall", "0", "--json",
+    ]));
+    assert_eq!(v["n_inputs"], 70000);
+    assert_eq!(v["n_outputs"], 70000 - 8);
+    assert_eq!(v["mismatches"], 0);
+    assert_eq!(v["order_errors"], 0);
 }
 
 #[test]
@@ -57,6 +67,7 @@ fn bad_sim_arguments_are_refused() {
         &["sim", "--arch", "systolic"][..],
         &["sim", "--bubble", "1.5"],
         &["sim", "--cycles", "0"],
+        &["sim", "--stream", "sorted"],
         &["cost", "--target", "asic"],
     ] {
         let o = specfx(args);

@@ -109,3 +109,35 @@ fn check_and_budget_are_the_same_with_one_and_two_threads() {
     let two = in_pool(2, || specfx::analysis::budget::analyse(&dp, None).unwrap());
     assert_eq!(one, two);
 }
+
+/// The stability map of a datapath (some exponents it cannot hold, a wrapping narrow one with
+/// per-element events) and the trade-off's accuracy figures are folded from the engine's
+/// stream in n order: the same with one and two threads.
+#[test]
+fn stability_and_tradeoff_accuracy_are_the_same_with_one_and_two_threads() {
+    use specfx::analysis::stability::{map, narrow_datapath, Grid, Path};
+    use specfx::fixed::Overflow;
+    let grid = Grid {
+        n: "1..=40,500,4000".parse().unwrap(),
+        ..Grid::default()
+    };
+    let paths = [
+        Path::Fixed(Box::new(Config::baseline())),
+        Path::Fixed(Box::new(narrow_datapath(Overflow::Wrap))),
+    ];
+    let one = in_pool(1, || map(&paths, &grid, &|_, _| {}).unwrap());
+    let two = in_pool(2, || map(&paths, &grid, &|_, _| {}).unwrap());
+    assert_eq!(one, two);
+    let dp = Datapath::new(specfx::analysis::tradeoff::fixed_config(10)).unwrap();
+    // A clock that reads 1 s, so the speed figure is the same too.
+    let figures = || {
+        let mut clock = |f: &mut dyn FnMut()| {
+            f();
+            1.0
+        };
+        specfx::analysis::tradeoff::fixed_figures(&dp, &mut clock)
+    };
+    let (one, two) = (in_pool(1, figures), in_pool(2, figures));
+    assert!(one.per_n_max_abs_err.iter().all(|&e| e > 0.0));
+    assert_eq!(one, two);
+}
