@@ -426,12 +426,7 @@ impl Machine for Folded {
     }
 
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
-        let widest = dp
-            .stages()
-            .iter()
-            .map(|s| s.format.width())
-            .max()
-            .unwrap_or(1);
+        let widest = dp.widest_stage_bits();
         vec![
             RegisterView {
                 name: "x".into(),

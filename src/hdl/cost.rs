@@ -184,12 +184,7 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
         Arch::Folded => {
             let a = products.iter().map(|m| m.a_bits).max().unwrap_or(1);
             let b = products.iter().map(|m| m.b_bits).max().unwrap_or(1);
-            let widest = dp
-                .stages()
-                .iter()
-                .map(|s| s.format.width())
-                .max()
-                .unwrap_or(1);
+            let widest = dp.widest_stage_bits();
             let bits = u64::from(widest)
                 + carried
                 + u64::from(w(slope))

@@ -499,6 +499,15 @@ impl Datapath {
         STAGE_SQ0 + self.config.k as usize
     }
 
+    /// The width in bits of the widest stage format (the shared register of the folded unit).
+    pub fn widest_stage_bits(&self) -> u32 {
+        self.stages
+            .iter()
+            .map(|s| s.format.width())
+            .max()
+            .unwrap_or(1)
+    }
+
     /// Index of the output probe.
     pub fn stage_out(&self) -> usize {
         STAGE_SQ0 + self.config.k as usize + 1

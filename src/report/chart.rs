@@ -121,8 +121,8 @@ fn ranges(chart: &Chart) -> ((f64, f64), (f64, f64)) {
     (xr, yr)
 }
 
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, chart: &Chart) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, chart: &Chart) -> Result<(), Error> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| render_error(e.to_string());
     root.fill(&WHITE).map_err(err)?;
     let ((x0, x1), (y0, y1)) = ranges(chart);
     let mut builder = ChartBuilder::on(&root);
@@ -216,7 +216,7 @@ pub fn render_svg(chart: &Chart) -> Result<String, Error> {
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-        draw(root, chart).map_err(render_error)?;
+        draw(root, chart)?;
     }
     text.push('\n');
     Ok(text)
@@ -229,7 +229,7 @@ pub fn render_png(chart: &Chart) -> Result<Vec<u8>, Error> {
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-        draw(root, chart).map_err(render_error)?;
+        draw(root, chart)?;
     }
     encode_png(&rgb, SIZE)
 }

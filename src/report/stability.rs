@@ -173,8 +173,8 @@ fn draw_heatmap<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     m: &PathMap,
     tol: f64,
-) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+) -> Result<(), Error> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| render_error(e.to_string());
     root.fill(&WHITE).map_err(err)?;
     let (w, _) = root.dim_in_pixel();
     let (plot, legend) = root.split_horizontally(w - 200);
@@ -295,8 +295,8 @@ fn draw_overview<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     maps: &[PathMap],
     tol: f64,
-) -> Result<(), String> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+) -> Result<(), Error> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| render_error(e.to_string());
     root.fill(&WHITE).map_err(err)?;
     let root = root
         .titled(
@@ -342,13 +342,13 @@ fn draw_overview<DB: DrawingBackend>(
 /// Renders into an SVG string with a drawing function.
 fn svg_with(
     size: (u32, u32),
-    draw: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+    draw: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), Error>,
 ) -> Result<String, Error> {
     register_font();
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
-        draw(root).map_err(render_error)?;
+        draw(root)?;
     }
     text.push('\n');
     Ok(text)
@@ -357,14 +357,14 @@ fn svg_with(
 /// Renders into PNG bytes with a drawing function.
 fn png_with(
     size: (u32, u32),
-    draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
+    draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), Error>,
 ) -> Result<Vec<u8>, Error> {
     register_font();
     let (w, h) = size;
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-        draw(root).map_err(render_error)?;
+        draw(root)?;
     }
     crate::report::chart::encode_png(&rgb, size)
 }
