@@ -141,3 +141,17 @@ fn stability_and_tradeoff_accuracy_are_the_same_with_one_and_two_threads() {
     assert!(one.per_n_max_abs_err.iter().all(|&e| e > 0.0));
     assert_eq!(one, two);
 }
+
+/// A sweep point (the check's output figures the sweep and the optimiser compare) is the same
+/// with one and two threads.
+#[test]
+fn a_sweep_point_is_the_same_with_one_and_two_threads() {
+    use specfx::analysis::sweep::{evaluate, Space};
+    let space = Space::from_toml("n = \"16..=300\"\n[vary]\nk = [3, 4]\n").unwrap();
+    for index in 0..2 {
+        let one = in_pool(1, || evaluate(&space, index));
+        let two = in_pool(2, || evaluate(&space, index));
+        assert!(one.shape_total_max_abs.is_some());
+        assert_eq!(one, two);
+    }
+}
