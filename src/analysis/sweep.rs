@@ -166,8 +166,10 @@ impl Space {
             for v in values {
                 let mut cfg = space.base.clone();
                 let mut arch = Arch::Pipelined;
-                apply(&mut cfg, &mut arch, key, v)
-                    .map_err(|p| space_error(&format!("vary.{key}"), p))?;
+                apply(&mut cfg, &mut arch, key, v).map_err(|e| match e {
+                    Error::Config { problem, .. } => space_error(&format!("vary.{key}"), problem),
+                    e => e,
+                })?;
             }
         }
         Ok(space)
@@ -196,84 +198,91 @@ impl Space {
         let mut cfg = self.base.clone();
         let mut arch = Arch::Pipelined;
         for (key, v) in self.point_values(index) {
-            apply(&mut cfg, &mut arch, &key, &v).map_err(|problem| space_error(&key, problem))?;
+            apply(&mut cfg, &mut arch, &key, &v)?;
         }
         cfg.name = format!("point{index}");
         Ok((cfg, arch))
     }
 }
 
-fn with_frac(f: Format, frac: i64) -> Result<Format, String> {
-    let frac = i32::try_from(frac).map_err(|_| format!("fraction bits out of range: {frac}"))?;
-    Format::new(f.is_signed(), f.int_bits(), frac).map_err(|e| e.to_string())
+fn with_frac(key: &str, f: Format, frac: i64) -> Result<Format, Error> {
+    let frac = i32::try_from(frac)
+        .map_err(|_| space_error(key, format!("fraction bits out of range: {frac}")))?;
+    Format::new(f.is_signed(), f.int_bits(), frac).map_err(|e| space_error(key, e.to_string()))
 }
 
-fn with_int(f: Format, int: i64) -> Result<Format, String> {
-    let int = i32::try_from(int).map_err(|_| format!("integer bits out of range: {int}"))?;
-    Format::new(f.is_signed(), int, f.frac_bits()).map_err(|e| e.to_string())
+fn with_int(key: &str, f: Format, int: i64) -> Result<Format, Error> {
+    let int = i32::try_from(int)
+        .map_err(|_| space_error(key, format!("integer bits out of range: {int}")))?;
+    Format::new(f.is_signed(), int, f.frac_bits()).map_err(|e| space_error(key, e.to_string()))
 }
 
-fn as_str(v: &toml::Value) -> Result<&str, String> {
+fn as_str<'a>(key: &str, v: &'a toml::Value) -> Result<&'a str, Error> {
     v.as_str()
-        .ok_or_else(|| format!("expected a string, got {v}"))
+        .ok_or_else(|| space_error(key, format!("expected a string, got {v}")))
 }
 
-fn as_int(v: &toml::Value) -> Result<i64, String> {
+fn as_int(key: &str, v: &toml::Value) -> Result<i64, Error> {
     v.as_integer()
-        .ok_or_else(|| format!("expected an integer, got {v}"))
+        .ok_or_else(|| space_error(key, format!("expected an integer, got {v}")))
 }
 
-fn parse<T: std::str::FromStr>(v: &toml::Value) -> Result<T, String>
+fn parse<T: std::str::FromStr>(key: &str, v: &toml::Value) -> Result<T, Error>
 where
     T::Err: std::fmt::Display,
 {
-    as_str(v)?.parse::<T>().map_err(|e| e.to_string())
+    as_str(key, v)?
+        .parse::<T>()
+        .map_err(|e| space_error(key, e.to_string()))
 }
 
-/// Applies one axis value to a configuration.
-fn apply(cfg: &mut Config, arch: &mut Arch, key: &str, v: &toml::Value) -> Result<(), String> {
+/// Applies one axis value to a configuration; an error names `key`.
+fn apply(cfg: &mut Config, arch: &mut Arch, key: &str, v: &toml::Value) -> Result<(), Error> {
+    let fail = |problem: String| space_error(key, problem);
     match key {
         "k" => {
-            let k = u32::try_from(as_int(v)?).map_err(|_| format!("bad k: {v}"))?;
+            let k = u32::try_from(as_int(key, v)?).map_err(|_| fail(format!("bad k: {v}")))?;
             if !crate::reference::lobe::K_RANGE.contains(&k) {
-                return Err(format!("expected k in 1..=7, got {k}"));
+                return Err(fail(format!("expected k in 1..=7, got {k}")));
             }
             let first = cfg.square[0];
             cfg.square = vec![first; k as usize];
             cfg.k = k;
         }
-        "cutoff" => cfg.cutoff = parse(v)?,
+        "cutoff" => cfg.cutoff = parse(key, v)?,
         "variant" => {
-            cfg.variant = match as_str(v)? {
+            cfg.variant = match as_str(key, v)? {
                 "plain" => crate::pipeline::Variant::Plain,
                 "minimax" => crate::pipeline::Variant::Minimax,
-                s => return Err(format!("expected plain or minimax, got '{s}'")),
+                s => return Err(fail(format!("expected plain or minimax, got '{s}'"))),
             }
         }
-        "arch" => *arch = parse(v)?,
-        "coef.form" => cfg.coef.form = parse(v)?,
-        "coef.source" => cfg.coef.source = parse(v)?,
-        "coef.frac" => cfg.coef.format = with_frac(cfg.coef.format, as_int(v)?)?,
-        "coef.rounding" => cfg.coef.rounding = parse(v)?,
+        "arch" => *arch = parse(key, v)?,
+        "coef.form" => cfg.coef.form = parse(key, v)?,
+        "coef.source" => cfg.coef.source = parse(key, v)?,
+        "coef.frac" => cfg.coef.format = with_frac(key, cfg.coef.format, as_int(key, v)?)?,
+        "coef.rounding" => cfg.coef.rounding = parse(key, v)?,
         "latency.mul" => {
-            cfg.latency.mul = u32::try_from(as_int(v)?).map_err(|_| format!("bad latency: {v}"))?
+            cfg.latency.mul =
+                u32::try_from(as_int(key, v)?).map_err(|_| fail(format!("bad latency: {v}")))?
         }
         _ => {
-            let (stage, field) = key.split_once('.').ok_or("unknown axis")?;
+            let unknown = || fail("unknown axis".into());
+            let (stage, field) = key.split_once('.').ok_or_else(unknown)?;
             let specs: Vec<&mut crate::pipeline::StageSpec> = match stage {
                 "t" => vec![&mut cfg.t],
                 "b" => vec![&mut cfg.b],
                 "out" => vec![&mut cfg.out],
                 "square" => cfg.square.iter_mut().collect(),
-                _ => return Err("unknown axis".into()),
+                _ => return Err(unknown()),
             };
             for spec in specs {
                 match field {
-                    "frac" => spec.format = with_frac(spec.format, as_int(v)?)?,
-                    "int" => spec.format = with_int(spec.format, as_int(v)?)?,
-                    "rounding" => spec.rounding = parse(v)?,
-                    "overflow" => spec.overflow = parse(v)?,
-                    _ => return Err("unknown axis".into()),
+                    "frac" => spec.format = with_frac(key, spec.format, as_int(key, v)?)?,
+                    "int" => spec.format = with_int(key, spec.format, as_int(key, v)?)?,
+                    "rounding" => spec.rounding = parse(key, v)?,
+                    "overflow" => spec.overflow = parse(key, v)?,
+                    _ => return Err(unknown()),
                 }
             }
         }

@@ -195,21 +195,28 @@ fn sum_bits(a: Format, b: Format) -> u32 {
     u32::try_from(i64::from(int) + i64::from(frac) + 1).unwrap_or(u32::MAX)
 }
 
-/// Rounds an f64 constant into a format; it must fit.
+/// Rounds an f64 constant into a format; it must fit, or the error names the configuration
+/// `key` and says which constant (`what`, e.g. `coef(n = 500)`) does not fit.
 fn constant_raw(
     value: Exact,
     format: Format,
     rounding: crate::fixed::Rounding,
-) -> Result<i64, String> {
+    key: &str,
+    what: impl FnOnce() -> String,
+) -> Result<i64, Error> {
     let q = quantize(value, format, rounding, Overflow::Sat);
     if q.event == Event::None {
         Ok(q.raw)
     } else {
-        Err(format!(
-            "{} does not fit {format} (range {}..={})",
-            value.to_f64(),
-            format.min_value(),
-            format.max_value()
+        Err(config_error(
+            key,
+            format!(
+                "{} = {} does not fit {format} (range {}..={})",
+                what(),
+                value.to_f64(),
+                format.min_value(),
+                format.max_value()
+            ),
         ))
     }
 }
@@ -434,14 +441,16 @@ impl Datapath {
                 let mm = &config.minimax;
                 let a = Exact::from_f64(fit.a).expect("finite table entry");
                 let b = Exact::from_f64(fit.b).expect("finite table entry");
-                let a_raw = constant_raw(a, mm.a_format, mm.rounding)
-                    .map_err(|p| config_error("minimax.a_format", format!("A(n = {n}) = {p}")))?;
-                let off_raw = constant_raw(a + b, mm.offset_format, mm.rounding).map_err(|p| {
-                    config_error(
-                        "minimax.offset_format",
-                        format!("A(n = {n}) + B(n = {n}) = {p}"),
-                    )
+                let a_raw = constant_raw(a, mm.a_format, mm.rounding, "minimax.a_format", || {
+                    format!("A(n = {n})")
                 })?;
+                let off_raw = constant_raw(
+                    a + b,
+                    mm.offset_format,
+                    mm.rounding,
+                    "minimax.offset_format",
+                    || format!("A(n = {n}) + B(n = {n})"),
+                )?;
                 (
                     a_raw,
                     mm.a_format.frac_bits(),
@@ -459,8 +468,13 @@ impl Datapath {
                 format!("coef(n = {n}) is not finite: {coef}"),
             )
         })?;
-        let coef_raw = constant_raw(coef_exact, config.coef.format, config.coef.rounding)
-            .map_err(|p| config_error("coef.format", format!("coef(n = {n}) = {p}")))?;
+        let coef_raw = constant_raw(
+            coef_exact,
+            config.coef.format,
+            config.coef.rounding,
+            "coef.format",
+            || format!("coef(n = {n})"),
+        )?;
         let threshold = match config.cutoff {
             Cutoff::Paper => Some(paper_threshold(n, config.c.format, one_raw)),
             Cutoff::Clamp | Cutoff::None => None,
