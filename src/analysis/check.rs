@@ -13,7 +13,7 @@ use crate::engine::{each_chunk, map_n, Codes, Span};
 use crate::error::Error;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
 use crate::pipeline::fast::EventCounts;
-use crate::pipeline::{Datapath, NConstants, MAX_STAGES};
+use crate::pipeline::{first_code_where, Datapath, NConstants, MAX_STAGES};
 use crate::reference::lobe::Cutoff;
 
 /// An input where a figure is reached.
@@ -583,16 +583,7 @@ fn dead_prefix_end(dp: &Datapath, nc: &NConstants, codes: &[i64]) -> i64 {
         let d = (k.min(one) as f64 * c_lsb) - 1.0;
         reference_base(cfg.cutoff, nc.slope * d, nc.offset, false) != 0.0
     };
-    let (mut a, mut b) = (lo, fixed);
-    while a < b {
-        let mid = a + (b - a) / 2;
-        if positive(mid) {
-            b = mid;
-        } else {
-            a = mid + 1;
-        }
-    }
-    a
+    first_code_where(lo..fixed, positive)
 }
 
 /// Per-code inputs shared by every n: the codes with ln c, and d's f64 reference.

@@ -20,7 +20,7 @@ use crate::analysis::budget::mixed_eval;
 use crate::error::Error;
 use crate::fixed::{Event, Exact, Rounding};
 use crate::pipeline::walk::{walk, Arithmetic};
-use crate::pipeline::{Datapath, NConstants, StageSpec};
+use crate::pipeline::{first_code_where, Datapath, NConstants, StageSpec};
 use crate::reference::lobe::Cutoff;
 
 /// Gappa's name for a rounding mode's direction.
@@ -77,16 +77,7 @@ pub struct Job {
 
 /// The smallest code from which a monotone predicate holds, over `0..=one`.
 fn first_code(one: i64, holds: impl Fn(i64) -> bool) -> i64 {
-    let (mut lo, mut hi) = (0, one + 1);
-    while lo < hi {
-        let mid = lo + (hi - lo) / 2;
-        if holds(mid) {
-            hi = mid;
-        } else {
-            lo = mid + 1;
-        }
-    }
-    lo
+    first_code_where(0..one + 1, holds)
 }
 
 /// The walk's interpreter that writes gappa's definitions: each step appends its line and

@@ -195,6 +195,28 @@ fn sum_bits(a: Format, b: Format) -> u32 {
     u32::try_from(i64::from(int) + i64::from(frac) + 1).unwrap_or(u32::MAX)
 }
 
+/// The first code of `codes` from which a monotone predicate holds (false on a prefix, true
+/// after it), by bisection; `codes.end` when it never holds.
+///
+/// # Examples
+/// ```
+/// use specfx::pipeline::first_code_where;
+/// assert_eq!(first_code_where(0..100, |c| c * c >= 50), 8);
+/// assert_eq!(first_code_where(0..5, |_| false), 5);
+/// ```
+pub fn first_code_where(codes: std::ops::Range<i64>, holds: impl Fn(i64) -> bool) -> i64 {
+    let (mut lo, mut hi) = (codes.start, codes.end);
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if holds(mid) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    lo
+}
+
 /// Rounds an f64 constant into a format; it must fit, or the error names the configuration
 /// `key` and says which constant (`what`, e.g. `coef(n = 500)`) does not fit.
 fn constant_raw(
@@ -872,16 +894,7 @@ impl Datapath {
         if !self.cut_is_prefix {
             return codes.start;
         }
-        let (mut lo, mut hi) = (codes.start, codes.end);
-        while lo < hi {
-            let mid = lo + (hi - lo) / 2;
-            if self.is_cut(mid, nc) {
-                lo = mid + 1;
-            } else {
-                hi = mid;
-            }
-        }
-        lo
+        first_code_where(codes, |code| !self.is_cut(code, nc))
     }
 
     /// [`Datapath::eval_batch`] for a batch of codes that are all cut (every code below

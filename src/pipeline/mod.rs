@@ -23,5 +23,6 @@ pub mod walk;
 
 pub use config::{CoefSpec, Config, FormatSpec, LatencySpec, MinimaxSpec, StageSpec, Variant};
 pub use datapath::{
-    Datapath, NConstants, OutputScratch, ProbeColumns, Probes, StageInfo, MAX_STAGES,
+    first_code_where, Datapath, NConstants, OutputScratch, ProbeColumns, Probes, StageInfo,
+    MAX_STAGES,
 };
