@@ -28,5 +28,6 @@ pub mod nset;
 pub mod pipeline;
 pub mod reference;
 pub mod report;
+pub mod scene;
 
 pub use error::Error;

@@ -12,6 +12,7 @@ mod optimize;
 mod output;
 mod paper;
 mod reference;
+pub mod render;
 mod report;
 mod sim;
 pub mod stability;
@@ -58,6 +59,8 @@ enum Command {
     Stability(stability::StabilityArgs),
     /// Charts speed against accuracy for every method (f64 models and fixed-point datapaths).
     Tradeoff(tradeoff::TradeoffArgs),
+    /// Renders a scene through the datapath beside f64 references: images, error maps, table.
+    Render(render::RenderArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -106,6 +109,7 @@ pub fn main() -> ExitCode {
         Command::Budget(args) => budget::run(&args),
         Command::Optimize(args) => optimize::run(&args),
         Command::Tradeoff(args) => tradeoff::run(&args),
+        Command::Render(args) => render::run(&args),
         Command::Stability(args) => stability::run(&args),
         Command::Hdl(args) => hdl::run(&args),
         Command::Throughput(args) => throughput::run(&args),

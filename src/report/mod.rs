@@ -5,6 +5,7 @@ pub mod check;
 pub mod csv;
 pub mod doc;
 pub mod paper;
+pub mod scene;
 pub mod stability;
 pub mod sweep;
 pub mod tradeoff;

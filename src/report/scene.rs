@@ -1,0 +1,173 @@
+//! The images of `specfx render`: each path's picture as PNG, difference heat maps in display
+//! LSBs with a colour bar, and the per-material error table.
+
+use plotters::prelude::*;
+
+use crate::error::Error;
+use crate::report::chart::{encode_png, register_font, render_error};
+use crate::scene::render::{ImageError, Rendered};
+
+/// One path's picture as PNG: 8 bits per channel, or for 10-bit images 16 bits per channel
+/// holding the 10-bit codes scaled to the full range (`code * 65535 / 1023`, rounded).
+pub fn path_png(r: &Rendered, path: usize) -> Result<Vec<u8>, Error> {
+    let codes = &r.codes[path];
+    if r.bits == 8 {
+        let rgb: Vec<u8> = codes.iter().flat_map(|c| c.map(|x| x as u8)).collect();
+        return encode_png(&rgb, (r.width, r.height));
+    }
+    let max = u32::from((1u16 << r.bits) - 1);
+    let bytes: Vec<u8> = codes
+        .iter()
+        .flat_map(|c| c.map(|x| ((u32::from(x) * 65535 + max / 2) / max) as u16))
+        .flat_map(u16::to_be_bytes)
+        .collect();
+    let mut png_bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut png_bytes, r.width, r.height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Sixteen);
+        enc.set_compression(png::Compression::Best);
+        let mut w = enc
+            .write_header()
+            .map_err(|e| render_error(e.to_string()))?;
+        w.write_image_data(&bytes)
+            .map_err(|e| render_error(e.to_string()))?;
+    }
+    Ok(png_bytes)
+}
+
+/// Width of the colour bar panel beside a heat map.
+const BAR: u32 = 110;
+
+/// A colour for `t` in [0, 1]: dark blue through red to yellow-white.
+fn heat(t: f64) -> [u8; 3] {
+    let t = t.clamp(0.0, 1.0);
+    let stops = [
+        (0.0, [40.0, 30.0, 110.0]),
+        (0.35, [170.0, 40.0, 120.0]),
+        (0.7, [245.0, 120.0, 40.0]),
+        (1.0, [255.0, 245.0, 160.0]),
+    ];
+    let i = stops.iter().rposition(|s| s.0 <= t).unwrap_or(0).min(2);
+    let (t0, c0) = stops[i];
+    let (t1, c1) = stops[i + 1];
+    let u = (t - t0) / (t1 - t0);
+    [0, 1, 2].map(|k| (c0[k] + u * (c1[k] - c0[k])).round() as u8)
+}
+
+/// The colour of a difference of `d` LSBs on a scale up to `max` (at least 1): a covered
+/// pixel without difference is mid grey, the background black.
+fn diff_colour(d: u32, max: u32, covered: bool) -> [u8; 3] {
+    match (covered, d) {
+        (false, _) => [0, 0, 0],
+        (true, 0) => [96, 96, 96],
+        (true, d) => heat(f64::from(d) / f64::from(max)),
+    }
+}
+
+/// A heat map of per-pixel differences in display LSBs, with a colour bar labelled from 1 to
+/// the largest difference (grey: no difference; black: background).
+pub fn heatmap_png(r: &Rendered, diff: &[u32], title: &str) -> Result<Vec<u8>, Error> {
+    register_font();
+    let (w, h) = (r.width, r.height.max(160));
+    let size = (w + BAR, h);
+    let max = diff.iter().copied().max().unwrap_or(0).max(1);
+    let mut rgb = vec![255u8; (size.0 * size.1 * 3) as usize];
+    for y in 0..r.height {
+        for x in 0..r.width {
+            let i = (y * r.width + x) as usize;
+            let c = diff_colour(diff[i], max, r.material[i].is_some());
+            let o = ((y * size.0 + x) * 3) as usize;
+            rgb[o..o + 3].copy_from_slice(&c);
+        }
+    }
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        let err = |e: DrawingAreaErrorKind<_>| render_error(e.to_string());
+        let font = ("sans-serif", 13).into_font().color(&BLACK);
+        let x0 = w as i32 + 14;
+        let (top, bottom) = (34, h as i32 - 24);
+        root.draw(&Text::new(title.to_string(), (x0 - 6, 4), font.clone()))
+            .map_err(err)?;
+        root.draw(&Text::new("display LSBs", (x0 - 6, 18), font.clone()))
+            .map_err(err)?;
+        let span = (bottom - top).max(1);
+        for yy in top..bottom {
+            let t = f64::from(bottom - 1 - yy) / f64::from(span - 1).max(1.0);
+            let c = heat(t);
+            root.draw(&Rectangle::new(
+                [(x0, yy), (x0 + 24, yy + 1)],
+                RGBColor(c[0], c[1], c[2]).filled(),
+            ))
+            .map_err(err)?;
+        }
+        root.draw(&Text::new(
+            format!("{max}"),
+            (x0 + 30, top - 2),
+            font.clone(),
+        ))
+        .map_err(err)?;
+        root.draw(&Text::new("1", (x0 + 30, bottom - 12), font.clone()))
+            .map_err(err)?;
+        root.draw(&Rectangle::new(
+            [(x0, bottom + 6), (x0 + 24, bottom + 18)],
+            RGBColor(96, 96, 96).filled(),
+        ))
+        .map_err(err)?;
+        root.draw(&Text::new("0", (x0 + 30, bottom + 5), font))
+            .map_err(err)?;
+        root.present().map_err(err)?;
+    }
+    encode_png(&rgb, size)
+}
+
+/// One row of the per-material table.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MaterialRow {
+    /// The material's name, or "all".
+    pub material: String,
+    /// Its exponent (0 for "all").
+    pub n: u32,
+    /// The datapath against f64 cos^n with its classic coefficient: the total error.
+    pub total: ImageError,
+    /// The datapath against the f64 model of its own algorithm: the quantization error.
+    pub quant: ImageError,
+}
+
+/// The table as Markdown (names are escaped for Markdown and HTML).
+pub fn table_markdown(rows: &[MaterialRow], bits: u32) -> String {
+    let mut s = "| material | n | pixels | max vs cos^n | mean vs cos^n | differing vs cos^n | max vs f64 model | mean vs f64 model | differing vs f64 model |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n".to_string();
+    for r in rows {
+        let name: String = r
+            .material
+            .chars()
+            .flat_map(|c| match c {
+                '<' => "&lt;".chars().collect::<Vec<_>>(),
+                '>' => "&gt;".chars().collect(),
+                '&' => "&amp;".chars().collect(),
+                '|' | '\\' | '*' | '_' | '`' | '[' | ']' => vec!['\\', c],
+                c if c.is_control() => vec![' '],
+                c => vec![c],
+            })
+            .collect();
+        s.push_str(&format!(
+            "| {name} | {} | {} | {} | {:.4} | {:.2}% | {} | {:.4} | {:.2}% |\n",
+            if r.n == 0 {
+                "-".to_string()
+            } else {
+                r.n.to_string()
+            },
+            r.total.pixels,
+            r.total.max_lsb,
+            r.total.mean_lsb,
+            100.0 * r.total.differing,
+            r.quant.max_lsb,
+            r.quant.mean_lsb,
+            100.0 * r.quant.differing,
+        ));
+    }
+    s.push_str(&format!(
+        "\nErrors are in display LSBs of the {bits}-bit sRGB image (the largest channel difference of a pixel); \"differing\" is the share of the material's pixels where any channel differs.\n"
+    ));
+    s
+}

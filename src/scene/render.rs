@@ -1,0 +1,401 @@
+//! The renderer: one ray per pixel through a [`Scene`], Lambert diffuse plus a normalised
+//! specular lobe evaluated three ways (f64 cos^n with its classic coefficient, the f64 model of
+//! the configuration's algorithm, the bit-accurate datapath), display codes and error figures.
+//!
+//! Radiance is `(k_d colour + pi k_s f_s) E` summed over the lights, with `E = intensity
+//! max(0, N.L)` and `f_s` the normalised lobe (so a white Lambert surface facing a light of
+//! intensity 1 shows 1); shadows are not traced. Display codes are the sRGB encoding of the
+//! radiance clamped to [0, 1], rounded to the image's bits.
+//!
+//! **Invariant:** no I/O; rows are rendered in parallel and the image is the same with any
+//! number of threads.
+
+use rayon::prelude::*;
+
+use crate::analysis::budget::F64Walk;
+use crate::pipeline::{Datapath, NConstants};
+use crate::reference::normalisation::classic_coefficient;
+use crate::scene::{add_scaled, cross, dot, norm, normalize, sub, LightKind, Model, Scene, Shape};
+
+/// The three specular paths, in the order of [`Rendered::codes`].
+pub const PATHS: [&str; 3] = ["f64_cos_n", "f64_model", "datapath"];
+
+/// A rendered scene: per pixel (row-major, top row first) the material hit and the display
+/// codes of each path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rendered {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Bits per channel.
+    pub bits: u32,
+    /// The material index of each pixel (`None`: background).
+    pub material: Vec<Option<u16>>,
+    /// `codes[path][pixel]`: RGB display codes.
+    pub codes: [Vec<[u16; 3]>; 3],
+}
+
+/// The background's linear radiance.
+const BACKGROUND: [f64; 3] = [0.02, 0.022, 0.03];
+
+/// A ray hit: distance, outward unit normal, object index.
+struct Hit {
+    t: f64,
+    normal: [f64; 3],
+    object: usize,
+}
+
+/// The nearest intersection of a ray (unit `dir`) with a sphere, beyond `t_min`.
+fn hit_sphere(o: [f64; 3], dir: [f64; 3], center: [f64; 3], radius: f64) -> Option<f64> {
+    let oc = sub(o, center);
+    let b = dot(oc, dir);
+    let c = dot(oc, oc) - radius * radius;
+    let disc = b * b - c;
+    if disc < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    [-b - s, -b + s].into_iter().find(|&t| t > 1e-9)
+}
+
+/// Signed distance to a shape (exact for the capsule and the torus).
+fn distance(shape: &Shape, p: [f64; 3]) -> f64 {
+    match *shape {
+        Shape::Sphere { center, radius } => norm(sub(p, center)) - radius,
+        Shape::Capsule { a, b, radius } => norm(sub(p, closest_on_segment(p, a, b))) - radius,
+        Shape::Torus {
+            center,
+            axis,
+            major,
+            minor,
+        } => {
+            let (h, radial) = torus_coords(p, center, axis);
+            ((radial - major).powi(2) + h * h).sqrt() - minor
+        }
+    }
+}
+
+fn closest_on_segment(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    let ab = sub(b, a);
+    let len2 = dot(ab, ab);
+    let s = if len2 == 0.0 {
+        0.0
+    } else {
+        (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0)
+    };
+    add_scaled(a, s, ab)
+}
+
+/// Height along the axis and distance from it.
+fn torus_coords(p: [f64; 3], center: [f64; 3], axis: [f64; 3]) -> (f64, f64) {
+    let q = sub(p, center);
+    let a = normalize(axis);
+    let h = dot(q, a);
+    let radial = add_scaled(q, -h, a);
+    (h, norm(radial))
+}
+
+/// The outward unit normal of a shape at a point on its surface.
+fn normal(shape: &Shape, p: [f64; 3]) -> [f64; 3] {
+    match *shape {
+        Shape::Sphere { center, .. } => normalize(sub(p, center)),
+        Shape::Capsule { a, b, .. } => normalize(sub(p, closest_on_segment(p, a, b))),
+        Shape::Torus {
+            center,
+            axis,
+            major,
+            ..
+        } => {
+            let q = sub(p, center);
+            let a = normalize(axis);
+            let radial = add_scaled(q, -dot(q, a), a);
+            let ring = add_scaled(center, major / norm(radial).max(1e-300), radial);
+            normalize(sub(p, ring))
+        }
+    }
+}
+
+/// A sphere enclosing a shape.
+fn bound(shape: &Shape) -> ([f64; 3], f64) {
+    match *shape {
+        Shape::Sphere { center, radius } => (center, radius),
+        Shape::Capsule { a, b, radius } => {
+            let mid = add_scaled(a, 0.5, sub(b, a));
+            (mid, 0.5 * norm(sub(b, a)) + radius)
+        }
+        Shape::Torus {
+            center,
+            major,
+            minor,
+            ..
+        } => (center, major + minor),
+    }
+}
+
+/// The nearest hit of a ray with one shape: analytic for the sphere, sphere tracing (on the
+/// exact distance) inside the bounding sphere for the others.
+fn hit_shape(shape: &Shape, o: [f64; 3], dir: [f64; 3]) -> Option<f64> {
+    if let Shape::Sphere { center, radius } = *shape {
+        return hit_sphere(o, dir, center, radius);
+    }
+    let (c, r) = bound(shape);
+    let oc = sub(o, c);
+    let b = dot(oc, dir);
+    let disc = b * b - (dot(oc, oc) - r * r);
+    if disc < 0.0 {
+        return None;
+    }
+    let (t0, t1) = (-b - disc.sqrt(), -b + disc.sqrt());
+    let mut t = t0.max(0.0);
+    let eps = 1e-7 * r;
+    for _ in 0..512 {
+        if t > t1 {
+            return None;
+        }
+        let d = distance(shape, add_scaled(o, t, dir));
+        if d < eps {
+            return Some(t);
+        }
+        t += d;
+    }
+    None
+}
+
+fn nearest(scene: &Scene, o: [f64; 3], dir: [f64; 3]) -> Option<Hit> {
+    let mut best: Option<(f64, usize)> = None;
+    for (i, obj) in scene.objects.iter().enumerate() {
+        if let Some(t) = hit_shape(&obj.shape, o, dir) {
+            if best.is_none_or(|(bt, _)| t < bt) {
+                best = Some((t, i));
+            }
+        }
+    }
+    best.map(|(t, object)| Hit {
+        t,
+        normal: normal(&scene.objects[object].shape, add_scaled(o, t, dir)),
+        object,
+    })
+}
+
+/// The specular lobe of one path for a cosine `c` (already clamped to [0, 1]) and exponent n:
+/// the normalised lobe `f_s`.
+struct Lobes<'a> {
+    dp: &'a Datapath,
+    /// Per material: its exponent's constants and its classic coefficient.
+    per_material: Vec<(&'a NConstants, f64)>,
+}
+
+impl Lobes<'_> {
+    fn eval(&self, material: usize, c: f64) -> [f64; 3] {
+        let (nc, classic) = self.per_material[material];
+        let dp = self.dp;
+        let cfg = dp.config();
+        let exact = classic * c.powf(f64::from(nc.n));
+        let one = dp.one_code() as f64;
+        let below = nc.threshold.is_some_and(|thr| c * one < thr as f64);
+        let model = F64Walk::new(dp, nc, c, below, 0).run().1;
+        let lsb = cfg.c.format.lsb();
+        let codes = dp.input_codes();
+        let code = ((c / lsb).round() as i64).clamp(*codes.start(), *codes.end());
+        let raw = dp.eval(code, nc).values[dp.stage_out()];
+        [exact, model, cfg.out.format.to_f64(raw)]
+    }
+}
+
+/// sRGB encoding of a linear value in [0, 1].
+fn srgb(x: f64) -> f64 {
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The display code of a linear radiance channel.
+pub fn display_code(x: f64, bits: u32) -> u16 {
+    let max = f64::from((1u32 << bits) - 1);
+    (srgb(x.clamp(0.0, 1.0)) * max).round() as u16
+}
+
+/// Renders a scene through a datapath whose n set holds every material's exponent (the
+/// caller builds it so); `progress(rows done, rows)` is called as rows finish.
+///
+/// # Panics
+/// If the datapath lacks a material's exponent.
+pub fn render(scene: &Scene, dp: &Datapath, progress: &(dyn Fn(usize, usize) + Sync)) -> Rendered {
+    let form = dp.config().coef.form;
+    let lobes = Lobes {
+        dp,
+        per_material: scene
+            .materials
+            .iter()
+            .map(|m| {
+                let nc = dp
+                    .constants_for(m.n)
+                    .expect("the datapath holds every material's exponent");
+                (nc, classic_coefficient(form, f64::from(m.n)))
+            })
+            .collect(),
+    };
+    let (w, h) = (scene.image.width as usize, scene.image.height as usize);
+    let cam = &scene.camera;
+    let forward = normalize(sub(cam.look_at, cam.position));
+    let right = normalize(cross(forward, cam.up));
+    let up = cross(right, forward);
+    let half = (cam.fov_deg.to_radians() / 2.0).tan();
+    let aspect = w as f64 / h as f64;
+    let material_of: Vec<usize> = scene
+        .objects
+        .iter()
+        .map(|o| scene.material_index(&o.material).expect("validated"))
+        .collect();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let rows: Vec<Vec<Pixel>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let row = (0..w)
+                .map(|x| {
+                    let sx = (2.0 * (x as f64 + 0.5) / w as f64 - 1.0) * half * aspect;
+                    let sy = (1.0 - 2.0 * (y as f64 + 0.5) / h as f64) * half;
+                    let dir = normalize(add_scaled(add_scaled(forward, sx, right), sy, up));
+                    shade(scene, &lobes, &material_of, cam.position, dir)
+                })
+                .collect();
+            let now = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(now, h);
+            row
+        })
+        .collect();
+    let mut out = Rendered {
+        width: scene.image.width,
+        height: scene.image.height,
+        bits: scene.image.bits,
+        material: Vec::with_capacity(w * h),
+        codes: [
+            Vec::with_capacity(w * h),
+            Vec::with_capacity(w * h),
+            Vec::with_capacity(w * h),
+        ],
+    };
+    for (m, codes) in rows.into_iter().flatten() {
+        out.material.push(m);
+        for (p, c) in out.codes.iter_mut().zip(codes) {
+            p.push(c);
+        }
+    }
+    out
+}
+
+/// A pixel: the material hit, and each path's display codes.
+type Pixel = (Option<u16>, [[u16; 3]; 3]);
+
+/// The display codes of each path for one primary ray, and the material it hit.
+fn shade(
+    scene: &Scene,
+    lobes: &Lobes<'_>,
+    material_of: &[usize],
+    eye: [f64; 3],
+    dir: [f64; 3],
+) -> Pixel {
+    let bits = scene.image.bits;
+    let encode = |rgb: [f64; 3]| rgb.map(|x| display_code(x, bits));
+    let Some(hit) = nearest(scene, eye, dir) else {
+        return (None, [encode(BACKGROUND); 3]);
+    };
+    let mi = material_of[hit.object];
+    let mat = &scene.materials[mi];
+    let p = add_scaled(eye, hit.t, dir);
+    let v = [-dir[0], -dir[1], -dir[2]];
+    let mut n = hit.normal;
+    if dot(n, v) < 0.0 {
+        n = n.map(|x| -x);
+    }
+    let amb = scene.shading.ambient;
+    let mut radiance = [mat.colour.map(|c| amb * c); 3];
+    for light in &scene.lights {
+        let l = match light.kind {
+            LightKind::Directional => normalize(light.direction.expect("validated")),
+            LightKind::Point => normalize(sub(light.position.expect("validated"), p)),
+        };
+        let ndotl = dot(n, l);
+        if ndotl <= 0.0 {
+            continue;
+        }
+        let c = match scene.shading.model {
+            Model::BlinnPhong => dot(n, normalize([l[0] + v[0], l[1] + v[1], l[2] + v[2]])),
+            Model::Phong => {
+                let r = add_scaled(l.map(|x| -x), 2.0 * ndotl, n);
+                dot(r, v)
+            }
+        }
+        .clamp(0.0, 1.0);
+        let spec = lobes.eval(mi, c);
+        for (rad, f_s) in radiance.iter_mut().zip(spec) {
+            for ((r, &lc), &mc) in rad.iter_mut().zip(&light.colour).zip(&mat.colour) {
+                let e = light.intensity * lc * ndotl;
+                *r += (mat.k_d * mc + std::f64::consts::PI * mat.k_s * f_s) * e;
+            }
+        }
+    }
+    (Some(mi as u16), radiance.map(encode))
+}
+
+/// The error figures of one material (or of the whole image): the datapath's display codes
+/// against a reference path's.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ImageError {
+    /// Pixels covered.
+    pub pixels: u64,
+    /// Largest difference of any channel, in display LSBs.
+    pub max_lsb: u32,
+    /// Mean over pixels of the largest channel difference, in display LSBs.
+    pub mean_lsb: f64,
+    /// Share of pixels with any channel different.
+    pub differing: f64,
+}
+
+/// The largest channel difference of each pixel between two paths, in display LSBs.
+pub fn difference(r: &Rendered, a: usize, b: usize) -> Vec<u32> {
+    r.codes[a]
+        .iter()
+        .zip(&r.codes[b])
+        .map(|(x, y)| {
+            (0..3)
+                .map(|ch| u32::from(x[ch].abs_diff(y[ch])))
+                .max()
+                .unwrap_or(0)
+        })
+        .collect()
+}
+
+/// Error figures of path `a` against path `b` over the pixels of material `m` (`None`: every
+/// covered pixel).
+pub fn image_error(r: &Rendered, a: usize, b: usize, m: Option<u16>) -> ImageError {
+    let diff = difference(r, a, b);
+    let mut e = ImageError {
+        pixels: 0,
+        max_lsb: 0,
+        mean_lsb: 0.0,
+        differing: 0.0,
+    };
+    let mut sum = 0u64;
+    let mut differing = 0u64;
+    for (d, mat) in diff.iter().zip(&r.material) {
+        let covered = match m {
+            Some(m) => *mat == Some(m),
+            None => mat.is_some(),
+        };
+        if covered {
+            e.pixels += 1;
+            e.max_lsb = e.max_lsb.max(*d);
+            sum += u64::from(*d);
+            differing += u64::from(*d > 0);
+        }
+    }
+    if e.pixels > 0 {
+        e.mean_lsb = sum as f64 / e.pixels as f64;
+        e.differing = differing as f64 / e.pixels as f64;
+    }
+    e
+}
