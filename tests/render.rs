@@ -139,7 +139,8 @@ fn the_default_scene_and_the_examples_are_valid() {
     for entry in std::fs::read_dir("examples/scenes").unwrap() {
         let path = entry.unwrap().path();
         let text = std::fs::read_to_string(&path).unwrap();
-        Scene::from_toml(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let load = |f: &str| std::fs::read(std::path::Path::new("examples/scenes").join(f));
+        Scene::from_toml_with(&text, &load).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     }
 }
 
@@ -247,4 +248,148 @@ fn render_writes_the_images_and_the_table() {
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(String::from_utf8_lossy(&o.stderr).lines().count(), 1);
     assert!(!out2.exists());
+}
+
+mod meshes {
+    use proptest::prelude::*;
+    use specfx::scene::mesh::{Mesh, MeshFormat};
+
+    fn obj(text: &str) -> Result<Mesh, String> {
+        Mesh::parse(text.as_bytes(), MeshFormat::Obj, 1.0, [0.0; 3], "m.obj")
+            .map_err(|e| e.to_string())
+    }
+
+    /// A binary STL of the given triangles, written from the format's definition (80-byte
+    /// header, u32 count, per triangle a normal, three vertices and a u16).
+    fn stl(tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
+        let mut b = vec![b' '; 80];
+        b.extend((tris.len() as u32).to_le_bytes());
+        for t in tris {
+            b.extend([0u8; 12]);
+            for v in t {
+                for x in v {
+                    b.extend(x.to_le_bytes());
+                }
+            }
+            b.extend([0u8; 2]);
+        }
+        b
+    }
+
+    #[test]
+    fn bad_meshes_get_clear_errors() {
+        let nan = obj("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap_err();
+        assert!(nan.contains("vertex 2 is not finite"), "{nan}");
+        let range = obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap_err();
+        assert!(range.contains("m.obj"), "{range}");
+        let none = obj("v 0 0 0\nv 1 0 0\n").unwrap_err();
+        assert!(none.contains("no triangles"), "{none}");
+        let good = stl(&[[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; 3]);
+        assert_eq!(
+            Mesh::parse(&good, MeshFormat::Stl, 1.0, [0.0; 3], "m.stl")
+                .unwrap()
+                .triangles
+                .len(),
+            3
+        );
+        let truncated = Mesh::parse(
+            &good[..good.len() - 20],
+            MeshFormat::Stl,
+            1.0,
+            [0.0; 3],
+            "m.stl",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(truncated.contains("m.stl"), "{truncated}");
+        let nan_stl = stl(&[[[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]]]);
+        let e = Mesh::parse(&nan_stl, MeshFormat::Stl, 1.0, [0.0; 3], "m.stl").unwrap_err();
+        assert!(e.to_string().contains("not finite"), "{e}");
+        let empty = stl(&[]);
+        let e = Mesh::parse(&empty, MeshFormat::Stl, 1.0, [0.0; 3], "m.stl").unwrap_err();
+        assert!(e.to_string().contains("no triangles"), "{e}");
+    }
+
+    /// The distance to a triangle along a ray, by the plane equation and barycentric
+    /// coordinates (an oracle independent of Moller-Trumbore).
+    fn brute(tris: &[[[f64; 3]; 3]], o: [f64; 3], d: [f64; 3]) -> Option<f64> {
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let mut best: Option<f64> = None;
+        for t in tris {
+            let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+            let denom = dot(n, d);
+            if denom.abs() < 1e-12 {
+                continue;
+            }
+            let s = dot(n, sub(t[0], o)) / denom;
+            if s <= 1e-9 {
+                continue;
+            }
+            let p = [o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]];
+            let inside =
+                (0..3).all(|k| dot(cross(sub(t[(k + 1) % 3], t[k]), sub(p, t[k])), n) >= 0.0);
+            if inside && best.is_none_or(|b| s < b) {
+                best = Some(s);
+            }
+        }
+        best
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// The hierarchy finds the nearest triangle a brute-force scan finds.
+        #[test]
+        fn the_bvh_hits_what_brute_force_hits(
+            tris in prop::collection::vec(prop::array::uniform3(prop::array::uniform3(-2.0f64..2.0)), 1..200),
+            o in prop::array::uniform3(-1.0f64..1.0),
+            dir in prop::array::uniform3(-1.0f64..1.0),
+        ) {
+            let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
+            prop_assume!(len > 0.1);
+            let d = dir.map(|x| x / len);
+            let o = [o[0], o[1], o[2] - 4.0];
+            let mesh = Mesh::new(tris.clone());
+            let got = mesh.hit(o, d).map(|h| h.0);
+            let want = brute(&tris, o, d);
+            match (got, want) {
+                (Some(g), Some(w)) => prop_assert!((g - w).abs() <= 1e-7 * w.max(1.0), "{} vs {}", g, w),
+                // A ray through an edge may be counted by one test and not the other.
+                (g, w) => prop_assert_eq!(g.is_some(), w.is_some()),
+            }
+        }
+    }
+}
+
+/// A square of two triangles facing the camera, lit head on: its pixels are the Lambert term
+/// in closed form, and the scene reads the mesh through the loader the command gives it.
+#[test]
+fn a_mesh_facing_the_camera_is_lambert() {
+    let text = sphere_scene(0.0, 16, 1.0, 0.0).replace(
+        "kind = \"sphere\"\nmaterial = \"m\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
+        "kind = \"mesh\"\nmaterial = \"m\"\nfile = \"sq.obj\"\nscale = 2.0",
+    );
+    let square = b"v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n".to_vec();
+    let scene = Scene::from_toml_with(&text, &|f| {
+        assert_eq!(f, "sq.obj");
+        Ok(square.clone())
+    })
+    .unwrap();
+    assert_eq!(scene.meshes[0].triangles.len(), 2);
+    let r = render(&scene, &datapath_for(&scene), &|_, _| {});
+    let want: Vec<u16> = [0.8, 0.3, 0.1].iter().map(|&c| code(0.5 * c)).collect();
+    for px in 0..9 {
+        assert_eq!(r.codes[2][px].to_vec(), want, "pixel {px}");
+    }
+    // Without a loader a mesh cannot be read, and the error says so.
+    let e = Scene::from_toml(&text).unwrap_err().to_string();
+    assert!(e.contains("object[0].file"), "{e}");
 }

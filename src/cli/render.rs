@@ -41,7 +41,11 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("scene {}: cannot read it", path.display()))?;
-            Scene::from_toml(&text).with_context(|| format!("scene {}", path.display()))?
+            // Mesh files are named relative to the scene file.
+            let dir = path.parent().map(|d| d.to_path_buf()).unwrap_or_default();
+            let load = |file: &str| std::fs::read(dir.join(file));
+            Scene::from_toml_with(&text, &load)
+                .with_context(|| format!("scene {}", path.display()))?
         }
     };
     let ns = NSet::from_values(&scene.exponents())?;

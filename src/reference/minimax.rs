@@ -270,21 +270,29 @@ pub fn table() -> &'static [MinimaxFit] {
     TABLE.get_or_init(|| parse_table(TABLE_CSV).expect("data/minimax.csv is well formed"))
 }
 
-/// Parses the CSV text of a table (header [`TABLE_HEADER`]).
-pub fn parse_table(text: &str) -> Result<Vec<MinimaxFit>, String> {
+/// Parses the CSV text of a table (header [`TABLE_HEADER`]); an error names the line.
+pub fn parse_table(text: &str) -> Result<Vec<MinimaxFit>, crate::error::Error> {
+    let fail = |problem: String| crate::error::Error::Config {
+        key: "minimax table".into(),
+        problem,
+    };
     let mut lines = text.lines();
     match lines.next() {
         Some(h) if h == TABLE_HEADER => {}
-        other => return Err(format!("expected header '{TABLE_HEADER}', got {other:?}")),
+        other => {
+            return Err(fail(format!(
+                "expected header '{TABLE_HEADER}', got {other:?}"
+            )))
+        }
     }
     lines
         .enumerate()
         .map(|(i, line)| {
             let bad = || {
-                format!(
+                fail(format!(
                     "line {}: expected 6 comma-separated numbers, got '{line}'",
                     i + 2
-                )
+                ))
             };
             let f: Vec<&str> = line.split(',').collect();
             if f.len() != 6 {

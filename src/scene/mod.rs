@@ -5,6 +5,7 @@
 //! `direction` points from the surface towards the light. Every value is checked when the scene
 //! is read, with an error naming its key (`object[2].radius`), so rendering cannot fail.
 
+pub mod mesh;
 pub mod render;
 
 use serde::Deserialize;
@@ -26,6 +27,8 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// The objects (at least one).
     pub objects: Vec<Object>,
+    /// The meshes that `Shape::Mesh` objects refer to.
+    pub meshes: Vec<mesh::Mesh>,
 }
 
 /// A scene file as written: objects keep every key any shape may have, so that a missing or
@@ -58,11 +61,20 @@ struct ObjectFile {
     axis: Option<[f64; 3]>,
     major: Option<f64>,
     minor: Option<f64>,
+    file: Option<String>,
+    scale: Option<f64>,
+    translate: Option<[f64; 3]>,
 }
 
 impl ObjectFile {
-    /// The object, or an error naming `object[i].<key>`.
-    fn build(&self, i: usize) -> Result<Object, Error> {
+    /// The object, or an error naming `object[i].<key>`; a mesh is read with `load` and
+    /// pushed onto `meshes`.
+    fn build(
+        &self,
+        i: usize,
+        load: Loader<'_>,
+        meshes: &mut Vec<mesh::Mesh>,
+    ) -> Result<Object, Error> {
         let key = |k: &str| format!("object[{i}].{k}");
         let present: Vec<&str> = [
             ("center", self.center.is_some()),
@@ -72,6 +84,9 @@ impl ObjectFile {
             ("axis", self.axis.is_some()),
             ("major", self.major.is_some()),
             ("minor", self.minor.is_some()),
+            ("file", self.file.is_some()),
+            ("scale", self.scale.is_some()),
+            ("translate", self.translate.is_some()),
         ]
         .into_iter()
         .filter_map(|(k, p)| p.then_some(k))
@@ -80,11 +95,12 @@ impl ObjectFile {
             "sphere" => &["center", "radius"],
             "capsule" => &["a", "b", "radius"],
             "torus" => &["center", "axis", "major", "minor"],
+            "mesh" => &["file", "scale", "translate"],
             other => {
                 return Err(Error::Config {
                     key: key("kind"),
                     problem: format!(
-                        "expected sphere, capsule or torus, got '{}'",
+                        "expected sphere, capsule, torus or mesh, got '{}'",
                         other.escape_debug()
                     ),
                 })
@@ -100,7 +116,12 @@ impl ObjectFile {
                 ),
             });
         }
-        if let Some(missing) = wants.iter().find(|k| !present.contains(k)) {
+        // A mesh's scale and translation are optional.
+        let optional = ["scale", "translate"];
+        if let Some(missing) = wants
+            .iter()
+            .find(|k| !present.contains(k) && !optional.contains(k))
+        {
             return Err(Error::Config {
                 key: key(missing),
                 problem: format!("a {} needs {}", self.kind, wants.join(", ")),
@@ -116,6 +137,29 @@ impl ObjectFile {
                 b: self.b.expect("checked"),
                 radius: self.radius.expect("checked"),
             },
+            "mesh" => {
+                let file = self.file.as_deref().expect("checked");
+                let scale = self.scale.unwrap_or(1.0);
+                positive(&key("scale"), scale)?;
+                let translate = self.translate.unwrap_or([0.0; 3]);
+                vector(&key("translate"), translate, false)?;
+                let format = mesh::MeshFormat::of(file).ok_or_else(|| Error::Config {
+                    key: key("file"),
+                    problem: format!(
+                        "expected a .obj or .stl file, got '{}'",
+                        file.escape_debug()
+                    ),
+                })?;
+                let bytes = load(file).map_err(|e| Error::Config {
+                    key: key("file"),
+                    problem: format!("cannot read '{}': {e}", file.escape_debug()),
+                })?;
+                let what = format!("{} ({})", key("file"), file.escape_debug());
+                meshes.push(mesh::Mesh::parse(&bytes, format, scale, translate, &what)?);
+                Shape::Mesh {
+                    mesh: meshes.len() - 1,
+                }
+            }
             _ => Shape::Torus {
                 center: self.center.expect("checked"),
                 axis: self.axis.expect("checked"),
@@ -264,6 +308,12 @@ pub enum Shape {
         /// Radius.
         radius: f64,
     },
+    /// A triangle mesh (`kind = "mesh"`, `file = "x.obj"` or `.stl`, optional `scale` and
+    /// `translate`): index into [`Scene::meshes`].
+    Mesh {
+        /// Which mesh.
+        mesh: usize,
+    },
     /// A torus around `axis` through `center`.
     Torus {
         /// Centre.
@@ -286,6 +336,9 @@ pub struct Object {
     pub shape: Shape,
 }
 
+/// Reads a mesh file named in a scene: its bytes.
+pub type Loader<'a> = &'a dyn Fn(&str) -> std::io::Result<Vec<u8>>;
+
 /// The built-in scene's text: a cluster of cells, a vessel segment and a bone-like ring, with
 /// shininess 16 to 1024.
 pub const DEFAULT_SCENE: &str = include_str!("default.toml");
@@ -302,12 +355,23 @@ impl Scene {
     /// assert!(Scene::from_toml(&bad).unwrap_err().to_string().contains(".radius"));
     /// ```
     pub fn from_toml(text: &str) -> Result<Scene, Error> {
+        Scene::from_toml_with(text, &|_| {
+            Err(std::io::Error::other(
+                "meshes are read by `specfx render` (Scene::from_toml_with)",
+            ))
+        })
+    }
+
+    /// [`Scene::from_toml`], reading each mesh file's bytes with `load` (the command reads
+    /// them relative to the scene file; the library does no I/O).
+    pub fn from_toml_with(text: &str, load: Loader<'_>) -> Result<Scene, Error> {
         let file: SceneFile = crate::error::parse_toml(text)?;
+        let mut meshes = Vec::new();
         let objects = file
             .objects
             .iter()
             .enumerate()
-            .map(|(i, o)| o.build(i))
+            .map(|(i, o)| o.build(i, load, &mut meshes))
             .collect::<Result<Vec<_>, _>>()?;
         let scene = Scene {
             image: file.image,
@@ -316,6 +380,7 @@ impl Scene {
             lights: file.lights,
             materials: file.materials,
             objects,
+            meshes,
         };
         scene.validate()?;
         Ok(scene)
@@ -449,6 +514,7 @@ impl Scene {
                     vector(&key("b"), b, false)?;
                     positive(&key("radius"), radius)?;
                 }
+                Shape::Mesh { .. } => {}
                 Shape::Torus {
                     center,
                     axis,

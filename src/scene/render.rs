@@ -73,6 +73,7 @@ fn distance(shape: &Shape, p: [f64; 3]) -> f64 {
             let (h, radial) = torus_coords(p, center, axis);
             ((radial - major).powi(2) + h * h).sqrt() - minor
         }
+        Shape::Mesh { .. } => unreachable!("meshes are ray cast, not traced"),
     }
 }
 
@@ -113,6 +114,7 @@ fn normal(shape: &Shape, p: [f64; 3]) -> [f64; 3] {
             let ring = add_scaled(center, major / norm(radial).max(1e-300), radial);
             normalize(sub(p, ring))
         }
+        Shape::Mesh { .. } => unreachable!("a mesh hit carries its face normal"),
     }
 }
 
@@ -130,6 +132,7 @@ fn bound(shape: &Shape) -> ([f64; 3], f64) {
             minor,
             ..
         } => (center, major + minor),
+        Shape::Mesh { .. } => unreachable!("a mesh has its own hierarchy"),
     }
 }
 
@@ -163,17 +166,21 @@ fn hit_shape(shape: &Shape, o: [f64; 3], dir: [f64; 3]) -> Option<f64> {
 }
 
 fn nearest(scene: &Scene, o: [f64; 3], dir: [f64; 3]) -> Option<Hit> {
-    let mut best: Option<(f64, usize)> = None;
+    let mut best: Option<(f64, usize, Option<[f64; 3]>)> = None;
     for (i, obj) in scene.objects.iter().enumerate() {
-        if let Some(t) = hit_shape(&obj.shape, o, dir) {
-            if best.is_none_or(|(bt, _)| t < bt) {
-                best = Some((t, i));
+        let hit = match obj.shape {
+            Shape::Mesh { mesh } => scene.meshes[mesh].hit(o, dir).map(|(t, n)| (t, Some(n))),
+            ref shape => hit_shape(shape, o, dir).map(|t| (t, None)),
+        };
+        if let Some((t, n)) = hit {
+            if best.is_none_or(|(bt, _, _)| t < bt) {
+                best = Some((t, i, n));
             }
         }
     }
-    best.map(|(t, object)| Hit {
+    best.map(|(t, object, n)| Hit {
         t,
-        normal: normal(&scene.objects[object].shape, add_scaled(o, t, dir)),
+        normal: n.unwrap_or_else(|| normal(&scene.objects[object].shape, add_scaled(o, t, dir))),
         object,
     })
 }

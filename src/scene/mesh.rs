@@ -1,0 +1,283 @@
+//! Triangle meshes for scenes: OBJ (tobj) and STL (stl_io, binary or ASCII) read from bytes
+//! the caller supplies, checked (finite vertices, indices in range, at least one triangle),
+//! and a bounding-volume hierarchy for ray casting.
+//!
+//! **Invariant:** no I/O: the command reads the files and hands their bytes over.
+
+use crate::error::Error;
+use crate::scene::{cross, dot, sub};
+
+/// A triangle mesh with its bounding-volume hierarchy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// The triangles, reordered so that every BVH leaf is a contiguous run.
+    pub triangles: Vec<[[f64; 3]; 3]>,
+    nodes: Vec<Node>,
+}
+
+/// A BVH node: a box, and either two children or a run of triangles.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Node {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    /// For a leaf, the first triangle; for an inner node, the right child (the left is next).
+    index: u32,
+    /// Triangles in a leaf (0 for an inner node).
+    count: u32,
+}
+
+/// Triangles per leaf at most.
+const LEAF: usize = 4;
+
+/// How a mesh file is written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ (polygons are triangulated).
+    Obj,
+    /// STL, binary or ASCII.
+    Stl,
+}
+
+impl MeshFormat {
+    /// The format of a file name's extension (`.obj`, `.stl`, any case).
+    pub fn of(name: &str) -> Option<MeshFormat> {
+        let lower = name.to_ascii_lowercase();
+        if lower.ends_with(".obj") {
+            Some(MeshFormat::Obj)
+        } else if lower.ends_with(".stl") {
+            Some(MeshFormat::Stl)
+        } else {
+            None
+        }
+    }
+}
+
+impl Mesh {
+    /// Reads a mesh from a file's bytes, scaled by `scale` and moved by `translate`; `what`
+    /// names it in errors.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::scene::mesh::{Mesh, MeshFormat};
+    /// let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n";
+    /// let m = Mesh::parse(obj, MeshFormat::Obj, 1.0, [0.0; 3], "t.obj").unwrap();
+    /// assert_eq!(m.triangles.len(), 2);
+    /// let bad = b"v 0 0 0\nv 1 0 0\nf 1 2 3\n";
+    /// assert!(Mesh::parse(bad, MeshFormat::Obj, 1.0, [0.0; 3], "t.obj").is_err());
+    /// ```
+    pub fn parse(
+        bytes: &[u8],
+        format: MeshFormat,
+        scale: f64,
+        translate: [f64; 3],
+        what: &str,
+    ) -> Result<Mesh, Error> {
+        let fail = |problem: String| Error::Config {
+            key: what.to_string(),
+            problem,
+        };
+        let (vertices, faces) = match format {
+            MeshFormat::Obj => read_obj(bytes, fail)?,
+            MeshFormat::Stl => read_stl(bytes, fail)?,
+        };
+        if let Some((i, v)) = vertices
+            .iter()
+            .enumerate()
+            .find(|(_, v)| v.iter().any(|x| !x.is_finite()))
+        {
+            return Err(fail(format!("vertex {} is not finite: {v:?}", i + 1)));
+        }
+        if let Some((i, f)) = faces
+            .iter()
+            .enumerate()
+            .find(|(_, f)| f.iter().any(|&k| k >= vertices.len()))
+        {
+            return Err(fail(format!(
+                "triangle {} refers to a vertex past the {} there are: {f:?} (0-based)",
+                i + 1,
+                vertices.len()
+            )));
+        }
+        if faces.is_empty() {
+            return Err(fail("the mesh has no triangles".into()));
+        }
+        let place = |v: [f64; 3]| [0, 1, 2].map(|k| v[k] * scale + translate[k]);
+        let triangles = faces
+            .iter()
+            .map(|f| f.map(|k| place(vertices[k])))
+            .collect();
+        Ok(Mesh::new(triangles))
+    }
+
+    /// A mesh of the given triangles, with its hierarchy built.
+    pub fn new(mut triangles: Vec<[[f64; 3]; 3]>) -> Mesh {
+        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF + 1);
+        let n = triangles.len();
+        build(&mut triangles, 0, n, &mut nodes);
+        Mesh { triangles, nodes }
+    }
+
+    /// A sphere enclosing the mesh: the centre and half-diagonal of its bounding box.
+    pub fn bound(&self) -> ([f64; 3], f64) {
+        let root = self.nodes[0];
+        let c = [0, 1, 2].map(|k| 0.5 * (root.lo[k] + root.hi[k]));
+        let r = 0.5 * crate::scene::norm(sub(root.hi, root.lo));
+        (c, r)
+    }
+
+    /// The nearest hit of a ray (origin `o`, unit direction `d`) beyond a small epsilon: the
+    /// distance and the unit face normal.
+    pub fn hit(&self, o: [f64; 3], d: [f64; 3]) -> Option<(f64, [f64; 3])> {
+        let inv = d.map(|x| 1.0 / x);
+        let mut best: Option<(f64, usize)> = None;
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let node = self.nodes[i as usize];
+            let limit = best.map_or(f64::INFINITY, |b| b.0);
+            if !slab(node.lo, node.hi, o, inv, limit) {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.index as usize;
+                for t in start..start + node.count as usize {
+                    if let Some(dist) = triangle_hit(&self.triangles[t], o, d) {
+                        if best.is_none_or(|b| dist < b.0) {
+                            best = Some((dist, t));
+                        }
+                    }
+                }
+            } else {
+                stack.push(node.index);
+                stack.push(i + 1);
+            }
+        }
+        best.map(|(t, i)| {
+            let [a, b, c] = self.triangles[i];
+            (t, crate::scene::normalize(cross(sub(b, a), sub(c, a))))
+        })
+    }
+}
+
+/// A mesh as a file holds it: vertices and triangles of vertex indices (0-based).
+type Indexed = (Vec<[f64; 3]>, Vec<[usize; 3]>);
+
+fn read_obj(bytes: &[u8], fail: impl Fn(String) -> Error) -> Result<Indexed, Error> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ..Default::default()
+    };
+    let mut reader = std::io::BufReader::new(bytes);
+    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| fail(format!("not a readable OBJ file: {e}")))?;
+    let mut vertices = Vec::new();
+    let mut faces = Vec::new();
+    for m in &models {
+        let base = vertices.len();
+        vertices.extend(
+            m.mesh
+                .positions
+                .chunks(3)
+                .map(|p| [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]),
+        );
+        faces.extend(
+            m.mesh
+                .indices
+                .chunks(3)
+                .map(|f| [0, 1, 2].map(|k| base + f[k] as usize)),
+        );
+    }
+    Ok((vertices, faces))
+}
+
+fn read_stl(bytes: &[u8], fail: impl Fn(String) -> Error) -> Result<Indexed, Error> {
+    let mut cursor = std::io::Cursor::new(bytes);
+    let mesh =
+        stl_io::read_stl(&mut cursor).map_err(|e| fail(format!("not a readable STL file: {e}")))?;
+    let vertices = mesh
+        .vertices
+        .iter()
+        .map(|v| [f64::from(v[0]), f64::from(v[1]), f64::from(v[2])])
+        .collect();
+    let faces = mesh.faces.iter().map(|f| f.vertices).collect();
+    Ok((vertices, faces))
+}
+
+/// Builds the subtree of `tris[start..end]` (reordering them) and returns its node index.
+fn build(tris: &mut [[[f64; 3]; 3]], start: usize, end: usize, nodes: &mut Vec<Node>) -> u32 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for t in &tris[start..end] {
+        for v in t {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+    }
+    let me = nodes.len() as u32;
+    nodes.push(Node {
+        lo,
+        hi,
+        index: start as u32,
+        count: (end - start) as u32,
+    });
+    if end - start <= LEAF {
+        return me;
+    }
+    // Split at the median centroid along the box's longest axis.
+    let axis = (0..3)
+        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
+        .expect("three axes");
+    let centroid = |t: &[[f64; 3]; 3]| t[0][axis] + t[1][axis] + t[2][axis];
+    let mid = start + (end - start) / 2;
+    tris[start..end]
+        .select_nth_unstable_by(mid - start, |a, b| centroid(a).total_cmp(&centroid(b)));
+    build(tris, start, mid, nodes);
+    let right = build(tris, mid, end, nodes);
+    nodes[me as usize].index = right;
+    nodes[me as usize].count = 0;
+    me
+}
+
+/// Whether a ray meets a box before distance `limit`.
+fn slab(lo: [f64; 3], hi: [f64; 3], o: [f64; 3], inv: [f64; 3], limit: f64) -> bool {
+    let (mut t0, mut t1) = (0.0f64, limit);
+    for k in 0..3 {
+        let a = (lo[k] - o[k]) * inv[k];
+        let b = (hi[k] - o[k]) * inv[k];
+        let (near, far) = if a <= b { (a, b) } else { (b, a) };
+        // NaN (a ray in the box's plane, 0 * inf) leaves the interval as it is.
+        t0 = if near > t0 { near } else { t0 };
+        t1 = if far < t1 { far } else { t1 };
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
+/// Möller-Trumbore: the distance along the ray to the triangle, if it is hit ahead.
+fn triangle_hit(t: &[[f64; 3]; 3], o: [f64; 3], d: [f64; 3]) -> Option<f64> {
+    let e1 = sub(t[1], t[0]);
+    let e2 = sub(t[2], t[0]);
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = sub(o, t[0]);
+    let u = dot(s, p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = cross(s, e1);
+    let v = dot(d, q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let dist = dot(e2, q) * inv;
+    (dist > 1e-9).then_some(dist)
+}
