@@ -131,6 +131,29 @@ fn a_diffuse_sphere_matches_lambert_off_centre() {
     }
 }
 
+/// FLIP of an image against itself is 0 everywhere; against a different one it is not.
+#[test]
+fn flip_is_zero_exactly_where_the_images_agree() {
+    use specfx::scene::render::{flip_errors, image_error};
+    let scene = Scene::from_toml(
+        &sphere_scene(0.02, 500, 1.0, 0.03)
+            .replace("width = 3\nheight = 3", "width = 64\nheight = 48"),
+    )
+    .unwrap();
+    let mut r = render(&scene, &datapath_for(&scene), &|_, _| {});
+    assert!(flip_errors(&r, 2, 2).iter().all(|&f| f == 0.0));
+    // Darken one channel of a block of covered pixels in path 2.
+    for y in 20..28 {
+        for x in 28..36 {
+            r.codes[2][y * 64 + x][0] /= 2;
+        }
+    }
+    let flip = flip_errors(&r, 2, 0);
+    assert!(flip[24 * 64 + 32] > 0.05);
+    let e = image_error(&r, 2, 0, None, &flip);
+    assert!(e.flip_mean > 0.0 && e.max_lsb > 10);
+}
+
 #[test]
 fn the_default_scene_and_the_examples_are_valid() {
     let s = Scene::default_scene();
@@ -224,12 +247,16 @@ fn render_writes_the_images_and_the_table() {
     assert_eq!(v[0]["material"], "m");
     assert_eq!(v[0]["n"], 300);
     assert!(v[0]["total"]["pixels"].as_u64().unwrap() > 100);
+    let flip = v[0]["total"]["flip_mean"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&flip));
     for f in [
         "f64_cos_n.png",
         "f64_model.png",
         "datapath.png",
         "diff_vs_cos_n.png",
         "diff_vs_f64_model.png",
+        "flip_vs_cos_n.png",
+        "flip_vs_f64_model.png",
         "render.md",
         "render.json",
     ] {

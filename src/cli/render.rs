@@ -12,8 +12,8 @@ use super::output::{print_json, write_atomic};
 use super::Outcome;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
-use specfx::report::scene::{heatmap_png, path_png, table_markdown, MaterialRow};
-use specfx::scene::render::{difference, image_error, render, PATHS};
+use specfx::report::scene::{flip_png, heatmap_png, path_png, table_markdown, MaterialRow};
+use specfx::scene::render::{difference, flip_errors, image_error, render, PATHS};
 use specfx::scene::Scene;
 
 /// Arguments of `specfx render`.
@@ -75,6 +75,8 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
         b.finish_and_clear();
     }
     let datapath = 2;
+    let flip_total = flip_errors(&r, datapath, 0);
+    let flip_quant = flip_errors(&r, datapath, 1);
     let mut rows: Vec<MaterialRow> = scene
         .materials
         .iter()
@@ -82,15 +84,15 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
         .map(|(i, m)| MaterialRow {
             material: m.name.clone(),
             n: m.n,
-            total: image_error(&r, datapath, 0, Some(i as u16)),
-            quant: image_error(&r, datapath, 1, Some(i as u16)),
+            total: image_error(&r, datapath, 0, Some(i as u16), &flip_total),
+            quant: image_error(&r, datapath, 1, Some(i as u16), &flip_quant),
         })
         .collect();
     rows.push(MaterialRow {
         material: "all".into(),
         n: 0,
-        total: image_error(&r, datapath, 0, None),
-        quant: image_error(&r, datapath, 1, None),
+        total: image_error(&r, datapath, 0, None, &flip_total),
+        quant: image_error(&r, datapath, 1, None, &flip_quant),
     });
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
@@ -107,9 +109,17 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
         &args.out.join("diff_vs_f64_model.png"),
         &heatmap_png(&r, &quant, "vs f64 model")?,
     )?;
+    write_atomic(
+        &args.out.join("flip_vs_cos_n.png"),
+        &flip_png(&r, &flip_total, "vs cos^n")?,
+    )?;
+    write_atomic(
+        &args.out.join("flip_vs_f64_model.png"),
+        &flip_png(&r, &flip_quant, "vs f64 model")?,
+    )?;
     let table = table_markdown(&rows, r.bits);
     let md = format!(
-        "# Render of {} through {}\n\nImages: `f64_cos_n.png` (f64 cos^n, classic coefficient), `f64_model.png` (the f64 model of the datapath's algorithm and coefficient), `datapath.png` (bit-accurate, the fragment's cosine quantized to {}); differences `diff_vs_cos_n.png`, `diff_vs_f64_model.png`.\n\n\"vs cos^n\" is the total error the viewer sees: the approximation of cos^n by the datapath's algorithm (large near highlights of high n) plus its quantization; \"vs f64 model\" is the quantization alone.\n\n{table}",
+        "# Render of {} through {}\n\nImages: `f64_cos_n.png` (f64 cos^n, classic coefficient), `f64_model.png` (the f64 model of the datapath's algorithm and coefficient), `datapath.png` (bit-accurate, the fragment's cosine quantized to {}); differences in display LSBs `diff_vs_cos_n.png`, `diff_vs_f64_model.png`, and FLIP maps `flip_vs_cos_n.png`, `flip_vs_f64_model.png`.\n\n\"vs cos^n\" is the total error the viewer sees: the approximation of cos^n by the datapath's algorithm (large near highlights of high n) plus its quantization; \"vs f64 model\" is the quantization alone.\n\n{table}",
         args.scene
             .as_ref()
             .map_or("the built-in scene".to_string(), |p| p.display().to_string()),

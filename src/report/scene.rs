@@ -68,15 +68,42 @@ fn diff_colour(d: u32, max: u32, covered: bool) -> [u8; 3] {
 /// A heat map of per-pixel differences in display LSBs, with a colour bar labelled from 1 to
 /// the largest difference (grey: no difference; black: background).
 pub fn heatmap_png(r: &Rendered, diff: &[u32], title: &str) -> Result<Vec<u8>, Error> {
+    let max = diff.iter().copied().max().unwrap_or(0).max(1);
+    let colour = |i: usize| diff_colour(diff[i], max, r.material[i].is_some());
+    panel_png(
+        r,
+        colour,
+        [title, "display LSBs"],
+        (&max.to_string(), "1"),
+        true,
+    )
+}
+
+/// The FLIP error of each pixel (0..1) on the same colour scale, the background black.
+pub fn flip_png(r: &Rendered, flip: &[f32], title: &str) -> Result<Vec<u8>, Error> {
+    let colour = |i: usize| match r.material[i] {
+        None => [0, 0, 0],
+        Some(_) => heat(f64::from(flip[i])),
+    };
+    panel_png(r, colour, [title, "FLIP error"], ("1", "0"), false)
+}
+
+/// A picture coloured pixel by pixel, with a colour bar (top and bottom labels) and, for
+/// difference maps, a grey "0" swatch.
+fn panel_png(
+    r: &Rendered,
+    colour: impl Fn(usize) -> [u8; 3],
+    title: [&str; 2],
+    labels: (&str, &str),
+    zero_swatch: bool,
+) -> Result<Vec<u8>, Error> {
     register_font();
     let (w, h) = (r.width, r.height.max(160));
     let size = (w + BAR, h);
-    let max = diff.iter().copied().max().unwrap_or(0).max(1);
     let mut rgb = vec![255u8; (size.0 * size.1 * 3) as usize];
     for y in 0..r.height {
         for x in 0..r.width {
-            let i = (y * r.width + x) as usize;
-            let c = diff_colour(diff[i], max, r.material[i].is_some());
+            let c = colour((y * r.width + x) as usize);
             let o = ((y * size.0 + x) * 3) as usize;
             rgb[o..o + 3].copy_from_slice(&c);
         }
@@ -87,9 +114,9 @@ pub fn heatmap_png(r: &Rendered, diff: &[u32], title: &str) -> Result<Vec<u8>, E
         let font = ("sans-serif", 13).into_font().color(&BLACK);
         let x0 = w as i32 + 14;
         let (top, bottom) = (34, h as i32 - 24);
-        root.draw(&Text::new(title.to_string(), (x0 - 6, 4), font.clone()))
+        root.draw(&Text::new(title[0].to_string(), (x0 - 6, 4), font.clone()))
             .map_err(err)?;
-        root.draw(&Text::new("display LSBs", (x0 - 6, 18), font.clone()))
+        root.draw(&Text::new(title[1].to_string(), (x0 - 6, 18), font.clone()))
             .map_err(err)?;
         let span = (bottom - top).max(1);
         for yy in top..bottom {
@@ -102,20 +129,26 @@ pub fn heatmap_png(r: &Rendered, diff: &[u32], title: &str) -> Result<Vec<u8>, E
             .map_err(err)?;
         }
         root.draw(&Text::new(
-            format!("{max}"),
+            labels.0.to_string(),
             (x0 + 30, top - 2),
             font.clone(),
         ))
         .map_err(err)?;
-        root.draw(&Text::new("1", (x0 + 30, bottom - 12), font.clone()))
-            .map_err(err)?;
-        root.draw(&Rectangle::new(
-            [(x0, bottom + 6), (x0 + 24, bottom + 18)],
-            RGBColor(96, 96, 96).filled(),
+        root.draw(&Text::new(
+            labels.1.to_string(),
+            (x0 + 30, bottom - 12),
+            font.clone(),
         ))
         .map_err(err)?;
-        root.draw(&Text::new("0", (x0 + 30, bottom + 5), font))
+        if zero_swatch {
+            root.draw(&Rectangle::new(
+                [(x0, bottom + 6), (x0 + 24, bottom + 18)],
+                RGBColor(96, 96, 96).filled(),
+            ))
             .map_err(err)?;
+            root.draw(&Text::new("0", (x0 + 30, bottom + 5), font))
+                .map_err(err)?;
+        }
         root.present().map_err(err)?;
     }
     encode_png(&rgb, size)
@@ -136,7 +169,7 @@ pub struct MaterialRow {
 
 /// The table as Markdown (names are escaped for Markdown and HTML).
 pub fn table_markdown(rows: &[MaterialRow], bits: u32) -> String {
-    let mut s = "| material | n | pixels | max vs cos^n | mean vs cos^n | differing vs cos^n | max vs f64 model | mean vs f64 model | differing vs f64 model |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n".to_string();
+    let mut s = "| material | n | pixels | max vs cos^n | mean vs cos^n | differing vs cos^n | FLIP vs cos^n | max vs f64 model | mean vs f64 model | differing vs f64 model | FLIP vs f64 model |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n".to_string();
     for r in rows {
         let name: String = r
             .material
@@ -151,7 +184,7 @@ pub fn table_markdown(rows: &[MaterialRow], bits: u32) -> String {
             })
             .collect();
         s.push_str(&format!(
-            "| {name} | {} | {} | {} | {:.4} | {:.2}% | {} | {:.4} | {:.2}% |\n",
+            "| {name} | {} | {} | {} | {:.4} | {:.2}% | {:.5} | {} | {:.4} | {:.2}% | {:.5} |\n",
             if r.n == 0 {
                 "-".to_string()
             } else {
@@ -161,13 +194,15 @@ pub fn table_markdown(rows: &[MaterialRow], bits: u32) -> String {
             r.total.max_lsb,
             r.total.mean_lsb,
             100.0 * r.total.differing,
+            r.total.flip_mean,
             r.quant.max_lsb,
             r.quant.mean_lsb,
             100.0 * r.quant.differing,
+            r.quant.flip_mean,
         ));
     }
     s.push_str(&format!(
-        "\nErrors are in display LSBs of the {bits}-bit sRGB image (the largest channel difference of a pixel); \"differing\" is the share of the material's pixels where any channel differs.\n"
+        "\nErrors are in display LSBs of the {bits}-bit sRGB image (the largest channel difference of a pixel); \"differing\" is the share of the material's pixels where any channel differs; FLIP is the mean of NVIDIA's FLIP (LDR, 67 pixels per degree) over the material's pixels.\n"
     ));
     s
 }
