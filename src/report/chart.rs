@@ -236,12 +236,21 @@ pub fn render_png(chart: &Chart) -> Result<Vec<u8>, Error> {
 
 /// Encodes an RGB buffer of `size` pixels as PNG bytes (best compression, deterministic).
 pub fn encode_png(rgb: &[u8], size: (u32, u32)) -> Result<Vec<u8>, Error> {
+    encode_png_depth(rgb, size, png::BitDepth::Eight)
+}
+
+/// [`encode_png`] at 8 or 16 bits per channel (16-bit samples big-endian, as PNG stores them).
+pub fn encode_png_depth(
+    rgb: &[u8],
+    size: (u32, u32),
+    depth: png::BitDepth,
+) -> Result<Vec<u8>, Error> {
     let (w, h) = size;
     let mut png_bytes = Vec::new();
     {
         let mut enc = png::Encoder::new(&mut png_bytes, w, h);
         enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
+        enc.set_depth(depth);
         enc.set_compression(png::Compression::Best);
         let mut writer = enc
             .write_header()

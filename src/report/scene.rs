@@ -4,7 +4,7 @@
 use plotters::prelude::*;
 
 use crate::error::Error;
-use crate::report::chart::{encode_png, register_font, render_error};
+use crate::report::chart::{encode_png, encode_png_depth, register_font, render_error};
 use crate::scene::render::{ImageError, Rendered};
 
 /// One path's picture as PNG: 8 bits per channel, or for 10-bit images 16 bits per channel
@@ -21,19 +21,7 @@ pub fn path_png(r: &Rendered, path: usize) -> Result<Vec<u8>, Error> {
         .flat_map(|c| c.map(|x| ((u32::from(x) * 65535 + max / 2) / max) as u16))
         .flat_map(u16::to_be_bytes)
         .collect();
-    let mut png_bytes = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut png_bytes, r.width, r.height);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Sixteen);
-        enc.set_compression(png::Compression::Best);
-        let mut w = enc
-            .write_header()
-            .map_err(|e| render_error(e.to_string()))?;
-        w.write_image_data(&bytes)
-            .map_err(|e| render_error(e.to_string()))?;
-    }
-    Ok(png_bytes)
+    encode_png_depth(&bytes, (r.width, r.height), png::BitDepth::Sixteen)
 }
 
 /// Width of the colour bar panel beside a heat map.
