@@ -151,6 +151,9 @@ fn report_writes_its_files_and_a_summary() {
         "stability/overview.png",
         "stability/heatmap_cs16_paper.png",
         "stability/heatmap_baseline.svg",
+        "render/datapath.png",
+        "render/diff_vs_cos_n.png",
+        "render/render.md",
         "index.html",
     ] {
         let p = dir.join(name);
@@ -163,6 +166,7 @@ fn report_writes_its_files_and_a_summary() {
     let index = std::fs::read_to_string(dir.join("index.html")).unwrap();
     assert!(index.contains("href=\"budget_baseline/budget.html\""));
     assert!(index.contains("href=\"stability/stability.html\""));
+    assert!(index.contains("src=\"render/datapath.png\""));
     assert!(out.contains("stability: "), "{out}");
     // The baseline's u8.16 coefficient holds coef(n) = 17 n / (32 pi) up to n = 1513.
     let regions = std::fs::read_to_string(dir.join("stability/regions.csv")).unwrap();

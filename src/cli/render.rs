@@ -2,7 +2,7 @@
 //! and writes each picture, difference heat maps and the per-material error table.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -50,9 +50,47 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
     };
     let ns = NSet::from_values(&scene.exponents())?;
     let dp: Datapath = super::datapath::load(&args.config, Some(&ns))?;
+    let label = args
+        .scene
+        .as_ref()
+        .map_or("the built-in scene".to_string(), |p| {
+            p.display().to_string()
+        });
+    let (rows, table) = render_scene(&scene, &label, &dp, &args.out)?;
+    if args.json {
+        print_json(&rows)?;
+    } else {
+        print!("{table}");
+        eprintln!("render: wrote {}", args.out.display());
+    }
+    Ok(Outcome::Ok)
+}
+
+/// The files [`render_scene`] writes, in its output directory.
+pub const RENDER_FILES: [&str; 9] = [
+    "f64_cos_n.png",
+    "f64_model.png",
+    "datapath.png",
+    "diff_vs_cos_n.png",
+    "diff_vs_f64_model.png",
+    "flip_vs_cos_n.png",
+    "flip_vs_f64_model.png",
+    "render.md",
+    "render.json",
+];
+
+/// Renders `scene` (named `label` in the document) through `dp` (whose n set holds the scene's
+/// exponents) into `out`: the pictures, maps and table. Returns the table's rows and its
+/// Markdown.
+pub fn render_scene(
+    scene: &Scene,
+    label: &str,
+    dp: &Datapath,
+    out: &Path,
+) -> Result<(Vec<MaterialRow>, String)> {
     let (w, h) = (scene.image.width, scene.image.height);
     eprintln!(
-        "render: {w}x{h}, {} objects, {} lights, n = {ns}, datapath {}",
+        "render: {w}x{h}, {} objects, {} lights, datapath {}",
         scene.objects.len(),
         scene.lights.len(),
         dp.config().name
@@ -70,7 +108,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
             b.set_position(done as u64);
         }
     };
-    let r = render(&scene, &dp, &progress);
+    let r = render(scene, dp, &progress);
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -94,46 +132,37 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
         total: image_error(&r, datapath, 0, None, &flip_total),
         quant: image_error(&r, datapath, 1, None, &flip_quant),
     });
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     for (p, name) in PATHS.iter().enumerate() {
-        write_atomic(&args.out.join(format!("{name}.png")), &path_png(&r, p)?)?;
+        write_atomic(&out.join(format!("{name}.png")), &path_png(&r, p)?)?;
     }
     let total = difference(&r, datapath, 0);
     let quant = difference(&r, datapath, 1);
     write_atomic(
-        &args.out.join("diff_vs_cos_n.png"),
+        &out.join("diff_vs_cos_n.png"),
         &heatmap_png(&r, &total, "vs cos^n")?,
     )?;
     write_atomic(
-        &args.out.join("diff_vs_f64_model.png"),
+        &out.join("diff_vs_f64_model.png"),
         &heatmap_png(&r, &quant, "vs f64 model")?,
     )?;
     write_atomic(
-        &args.out.join("flip_vs_cos_n.png"),
+        &out.join("flip_vs_cos_n.png"),
         &flip_png(&r, &flip_total, "vs cos^n")?,
     )?;
     write_atomic(
-        &args.out.join("flip_vs_f64_model.png"),
+        &out.join("flip_vs_f64_model.png"),
         &flip_png(&r, &flip_quant, "vs f64 model")?,
     )?;
     let table = table_markdown(&rows, r.bits);
     let md = format!(
         "# Render of {} through {}\n\nImages: `f64_cos_n.png` (f64 cos^n, classic coefficient), `f64_model.png` (the f64 model of the datapath's algorithm and coefficient), `datapath.png` (bit-accurate, the fragment's cosine quantized to {}); differences in display LSBs `diff_vs_cos_n.png`, `diff_vs_f64_model.png`, and FLIP maps `flip_vs_cos_n.png`, `flip_vs_f64_model.png`.\n\n\"vs cos^n\" is the total error the viewer sees: the approximation of cos^n by the datapath's algorithm (large near highlights of high n) plus its quantization; \"vs f64 model\" is the quantization alone.\n\n{table}",
-        args.scene
-            .as_ref()
-            .map_or("the built-in scene".to_string(), |p| p.display().to_string()),
+        label.replace(['<', '>', '`', '*', '_', '[', ']'], " "),
         dp.config().name,
         dp.config().c.format,
     );
-    write_atomic(&args.out.join("render.md"), md.as_bytes())?;
+    write_atomic(&out.join("render.md"), md.as_bytes())?;
     let json = serde_json::to_vec_pretty(&rows)?;
-    write_atomic(&args.out.join("render.json"), &json)?;
-    if args.json {
-        print_json(&rows)?;
-    } else {
-        print!("{table}");
-        eprintln!("render: wrote {}", args.out.display());
-    }
-    Ok(Outcome::Ok)
+    write_atomic(&out.join("render.json"), &json)?;
+    Ok((rows, table))
 }
