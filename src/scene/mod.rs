@@ -466,10 +466,13 @@ impl Scene {
             colour(&key("colour"), l.colour)?;
             non_negative(&key("intensity"), l.intensity)?;
         }
-        if self.materials.is_empty() {
+        if self.materials.is_empty() || self.materials.len() > 4096 {
             return bad(
                 "material".into(),
-                "expected at least one [[material]]".into(),
+                format!(
+                    "expected 1 to 4096 [[material]] tables, got {}",
+                    self.materials.len()
+                ),
             );
         }
         for (i, m) in self.materials.iter().enumerate() {
