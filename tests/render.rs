@@ -129,6 +129,27 @@ fn a_diffuse_sphere_matches_lambert_off_centre() {
     for (codes, name) in r.codes.iter().zip(PATHS) {
         assert_eq!(codes[1].to_vec(), want, "path {name}");
     }
+    // The inputs the scene fed the datapath: the five covered pixels, one light each. The
+    // centre's Phong cosine is 1; the four edge pixels' is R.V with R = 2 (N.L) N - L, N = p,
+    // clamped to [0, 1] (near the rim R turns away from the eye) and rounded to u1.15.
+    let n_dot_l = p[2];
+    let refl = [
+        2.0 * n_dot_l * p[0],
+        2.0 * n_dot_l * p[1],
+        2.0 * n_dot_l * p[2] - 1.0,
+    ];
+    let c = -(refl[0] * d[0] + refl[1] * d[1] + refl[2] * d[2]);
+    assert_eq!(r.inputs.len(), 1);
+    let e = &r.inputs[0];
+    assert_eq!((e.n, e.count), (16, 5));
+    assert_eq!(e.code_max, 32768);
+    let edge = (c.clamp(0.0, 1.0) * 32768.0).round() as i64;
+    assert_eq!(e.code_min, edge);
+    let mut want = vec![0u64; 64];
+    want[63] += 1;
+    // Bin floor(64 c), c = edge / 2^15.
+    want[((edge as f64 / 32768.0) * 64.0).floor().min(63.0) as usize] += 4;
+    assert_eq!(e.histogram, want);
 }
 
 /// FLIP of an image against itself is 0 everywhere; against a different one it is not.
@@ -259,6 +280,7 @@ fn render_writes_the_images_and_the_table() {
         "flip_vs_f64_model.png",
         "render.md",
         "render.json",
+        "inputs.csv",
     ] {
         assert!(out.join(f).is_file(), "{f}");
     }

@@ -13,7 +13,7 @@ use super::Outcome;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
 use specfx::report::scene::{flip_png, heatmap_png, path_png, table_markdown, MaterialRow};
-use specfx::scene::render::{difference, flip_errors, image_error, render, PATHS};
+use specfx::scene::render::{difference, flip_errors, image_error, render, INPUT_BINS, PATHS};
 use specfx::scene::Scene;
 
 /// Arguments of `specfx render`.
@@ -67,7 +67,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
 }
 
 /// The files [`render_scene`] writes, in its output directory.
-pub const RENDER_FILES: [&str; 9] = [
+pub const RENDER_FILES: [&str; 10] = [
     "f64_cos_n.png",
     "f64_model.png",
     "datapath.png",
@@ -77,6 +77,7 @@ pub const RENDER_FILES: [&str; 9] = [
     "flip_vs_f64_model.png",
     "render.md",
     "render.json",
+    "inputs.csv",
 ];
 
 /// Renders `scene` (named `label` in the document) through `dp` (whose n set holds the scene's
@@ -164,5 +165,27 @@ pub fn render_scene(
     write_atomic(&out.join("render.md"), md.as_bytes())?;
     let json = serde_json::to_vec_pretty(&rows)?;
     write_atomic(&out.join("render.json"), &json)?;
+    let mut csv = String::from("n,count,code_min,code_max,c_min,c_max");
+    for i in 0..INPUT_BINS {
+        csv.push_str(&format!(",h{i:02}"));
+    }
+    csv.push('\n');
+    let lsb = dp.config().c.format.lsb();
+    for e in &r.inputs {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{}",
+            e.n,
+            e.count,
+            e.code_min,
+            e.code_max,
+            e.code_min as f64 * lsb,
+            e.code_max as f64 * lsb
+        ));
+        for h in &e.histogram {
+            csv.push_str(&format!(",{h}"));
+        }
+        csv.push('\n');
+    }
+    write_atomic(&out.join("inputs.csv"), csv.as_bytes())?;
     Ok((rows, table))
 }

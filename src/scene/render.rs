@@ -34,6 +34,48 @@ pub struct Rendered {
     pub material: Vec<Option<u16>>,
     /// `codes[path][pixel]`: RGB display codes.
     pub codes: [Vec<[u16; 3]>; 3],
+    /// The datapath inputs the scene produced, per exponent (ascending n).
+    pub inputs: Vec<InputsOfN>,
+}
+
+/// Bins of the input histograms, over c in [0, 1].
+pub const INPUT_BINS: usize = 64;
+
+/// The inputs `(c, n)` a scene feeds the datapath for one exponent: every shaded fragment and
+/// light with N.L > 0 gives one (its cosine quantized to the input format).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct InputsOfN {
+    /// The exponent.
+    pub n: u32,
+    /// Inputs evaluated.
+    pub count: u64,
+    /// The smallest and largest input code.
+    pub code_min: i64,
+    /// See `code_min`.
+    pub code_max: i64,
+    /// `histogram[i]`: inputs with c in `[i/64, (i+1)/64)` (the last bin includes 1).
+    pub histogram: Vec<u64>,
+}
+
+/// Folds `(exponent, code)` pairs into per-exponent input statistics, ascending n.
+fn gather_inputs(pairs: impl Iterator<Item = (u32, i64)>, one: i64) -> Vec<InputsOfN> {
+    let mut by_n: std::collections::BTreeMap<u32, InputsOfN> = Default::default();
+    for (n, code) in pairs {
+        let e = by_n.entry(n).or_insert_with(|| InputsOfN {
+            n,
+            count: 0,
+            code_min: i64::MAX,
+            code_max: i64::MIN,
+            histogram: vec![0; INPUT_BINS],
+        });
+        e.count += 1;
+        e.code_min = e.code_min.min(code);
+        e.code_max = e.code_max.max(code);
+        // floor(c * 64) with c = code / one, the last bin holding c = 1 too.
+        let bin = (code.clamp(0, one) as i128 * INPUT_BINS as i128 / one.max(1) as i128) as usize;
+        e.histogram[bin.min(INPUT_BINS - 1)] += 1;
+    }
+    by_n.into_values().collect()
 }
 
 /// The background's linear radiance.
@@ -194,7 +236,8 @@ struct Lobes<'a> {
 }
 
 impl Lobes<'_> {
-    fn eval(&self, material: usize, c: f64) -> [f64; 3] {
+    /// The three lobes, and the datapath's input code.
+    fn eval(&self, material: usize, c: f64) -> ([f64; 3], i64) {
         let (nc, classic) = self.per_material[material];
         let dp = self.dp;
         let cfg = dp.config();
@@ -206,7 +249,7 @@ impl Lobes<'_> {
         let codes = dp.input_codes();
         let code = ((c / lsb).round() as i64).clamp(*codes.start(), *codes.end());
         let raw = dp.eval(code, nc).values[dp.stage_out()];
-        [exact, model, cfg.out.format.to_f64(raw)]
+        ([exact, model, cfg.out.format.to_f64(raw)], code)
     }
 }
 
@@ -258,22 +301,27 @@ pub fn render(scene: &Scene, dp: &Datapath, progress: &(dyn Fn(usize, usize) + S
         .map(|o| scene.material_index(&o.material).expect("validated"))
         .collect();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let rows: Vec<Vec<Pixel>> = (0..h)
+    let rows: Vec<(Vec<Pixel>, Inputs)> = (0..h)
         .into_par_iter()
         .map(|y| {
+            let mut inputs = Vec::new();
             let row = (0..w)
                 .map(|x| {
                     let sx = (2.0 * (x as f64 + 0.5) / w as f64 - 1.0) * half * aspect;
                     let sy = (1.0 - 2.0 * (y as f64 + 0.5) / h as f64) * half;
                     let dir = normalize(add_scaled(add_scaled(forward, sx, right), sy, up));
-                    shade(scene, &lobes, &material_of, cam.position, dir)
+                    shade(scene, &lobes, &material_of, cam.position, dir, &mut inputs)
                 })
                 .collect();
             let now = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(now, h);
-            row
+            (row, inputs)
         })
         .collect();
+    let inputs = gather_inputs(
+        rows.iter().flat_map(|(_, inputs)| inputs.iter().copied()),
+        dp.one_code(),
+    );
     let mut out = Rendered {
         width: scene.image.width,
         height: scene.image.height,
@@ -284,8 +332,9 @@ pub fn render(scene: &Scene, dp: &Datapath, progress: &(dyn Fn(usize, usize) + S
             Vec::with_capacity(w * h),
             Vec::with_capacity(w * h),
         ],
+        inputs,
     };
-    for (m, codes) in rows.into_iter().flatten() {
+    for (m, codes) in rows.into_iter().flat_map(|(row, _)| row) {
         out.material.push(m);
         for (p, c) in out.codes.iter_mut().zip(codes) {
             p.push(c);
@@ -297,13 +346,18 @@ pub fn render(scene: &Scene, dp: &Datapath, progress: &(dyn Fn(usize, usize) + S
 /// A pixel: the material hit, and each path's display codes.
 type Pixel = (Option<u16>, [[u16; 3]; 3]);
 
-/// The display codes of each path for one primary ray, and the material it hit.
+/// The datapath inputs `(n, code)` of a row of pixels.
+type Inputs = Vec<(u32, i64)>;
+
+/// The display codes of each path for one primary ray, and the material it hit; each datapath
+/// input `(n, code)` it evaluates is pushed onto `inputs`.
 fn shade(
     scene: &Scene,
     lobes: &Lobes<'_>,
     material_of: &[usize],
     eye: [f64; 3],
     dir: [f64; 3],
+    inputs: &mut Inputs,
 ) -> Pixel {
     let bits = scene.image.bits;
     let encode = |rgb: [f64; 3]| rgb.map(|x| display_code(x, bits));
@@ -337,7 +391,8 @@ fn shade(
             }
         }
         .clamp(0.0, 1.0);
-        let spec = lobes.eval(mi, c);
+        let (spec, code) = lobes.eval(mi, c);
+        inputs.push((mat.n, code));
         for (rad, f_s) in radiance.iter_mut().zip(spec) {
             for ((r, &lc), &mc) in rad.iter_mut().zip(&light.colour).zip(&mat.colour) {
                 let e = light.intensity * lc * ndotl;
