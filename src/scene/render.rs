@@ -13,8 +13,8 @@
 use rayon::prelude::*;
 
 use crate::analysis::budget::F64Walk;
-use crate::pipeline::{Datapath, NConstants};
-use crate::reference::normalisation::classic_coefficient;
+use crate::pipeline::{Datapath, NConstants, OutputScratch};
+use crate::reference::normalisation::{classic_coefficient, Form};
 use crate::scene::{add_scaled, cross, dot, norm, normalize, sub, LightKind, Model, Scene, Shape};
 
 /// The three specular paths, in the order of [`Rendered::codes`].
@@ -227,30 +227,110 @@ fn nearest(scene: &Scene, o: [f64; 3], dir: [f64; 3]) -> Option<Hit> {
     })
 }
 
-/// The specular lobe of one path for a cosine `c` (already clamped to [0, 1]) and exponent n:
-/// the normalised lobe `f_s`.
-struct Lobes<'a> {
-    dp: &'a Datapath,
-    /// Per material: its exponent's constants and its classic coefficient.
-    per_material: Vec<(&'a NConstants, f64)>,
+/// A path's specular lobe `f_s(material, c)` for a cosine `c` in [0, 1].
+pub type Lobe<'a> = dyn Fn(usize, f64) -> f64 + Sync + 'a;
+
+/// The input code the datapath receives for a cosine `c` in [0, 1]: rounded to the nearest
+/// code of the input format, clamped to its codes.
+pub fn input_code(dp: &Datapath, c: f64) -> i64 {
+    let codes = dp.input_codes();
+    ((c / dp.config().c.format.lsb()).round() as i64).clamp(*codes.start(), *codes.end())
 }
 
-impl Lobes<'_> {
-    /// The three lobes, and the datapath's input code.
-    fn eval(&self, material: usize, c: f64) -> ([f64; 3], i64) {
-        let (nc, classic) = self.per_material[material];
-        let dp = self.dp;
-        let cfg = dp.config();
-        let exact = classic * c.powf(f64::from(nc.n));
-        let one = dp.one_code() as f64;
-        let below = nc.threshold.is_some_and(|thr| c * one < thr as f64);
-        let model = F64Walk::new(dp, nc, c, below, 0).run().1;
-        let lsb = cfg.c.format.lsb();
+/// The datapath's lobe as a table: per material, the output (as a value) of every input code.
+pub struct DatapathLobe<'a> {
+    dp: &'a Datapath,
+    /// `table[material][code - first code]`.
+    table: Vec<Vec<f64>>,
+}
+
+impl<'a> DatapathLobe<'a> {
+    /// Evaluates the datapath on every input code of every material's exponent.
+    ///
+    /// # Panics
+    /// If the datapath lacks a material's exponent.
+    pub fn new(dp: &'a Datapath, scene: &Scene) -> DatapathLobe<'a> {
         let codes = dp.input_codes();
-        let code = ((c / lsb).round() as i64).clamp(*codes.start(), *codes.end());
-        let raw = dp.eval(code, nc).values[dp.stage_out()];
-        ([exact, model, cfg.out.format.to_f64(raw)], code)
+        let out = dp.config().out.format;
+        let mut by_n: std::collections::BTreeMap<u32, Vec<f64>> = Default::default();
+        let table = scene
+            .materials
+            .iter()
+            .map(|m| {
+                by_n.entry(m.n)
+                    .or_insert_with(|| {
+                        let nc = dp
+                            .constants_for(m.n)
+                            .expect("the datapath holds every material's exponent");
+                        let mut raw = vec![0; (codes.end() - codes.start() + 1) as usize];
+                        dp.eval_outputs_range(
+                            nc,
+                            *codes.start()..*codes.end() + 1,
+                            &mut raw,
+                            &mut OutputScratch::default(),
+                        );
+                        raw.into_iter().map(|r| out.to_f64(r)).collect()
+                    })
+                    .clone()
+            })
+            .collect();
+        DatapathLobe { dp, table }
     }
+
+    /// The lobe of material `m` at cosine `c`.
+    pub fn eval(&self, m: usize, c: f64) -> f64 {
+        let first = *self.dp.input_codes().start();
+        self.table[m][(input_code(self.dp, c) - first) as usize]
+    }
+}
+
+/// The f64 model of a datapath's algorithm and coefficient, per material (the datapath's
+/// lobe without quantization).
+pub struct ModelLobe<'a> {
+    dp: &'a Datapath,
+    /// Per material: its exponent's constants.
+    per_material: Vec<&'a NConstants>,
+}
+
+impl<'a> ModelLobe<'a> {
+    /// The model of `dp` for the scene's materials.
+    ///
+    /// # Panics
+    /// If the datapath lacks a material's exponent.
+    pub fn new(dp: &'a Datapath, scene: &Scene) -> ModelLobe<'a> {
+        ModelLobe {
+            dp,
+            per_material: scene
+                .materials
+                .iter()
+                .map(|m| {
+                    dp.constants_for(m.n)
+                        .expect("the datapath holds every material's exponent")
+                })
+                .collect(),
+        }
+    }
+
+    /// The lobe of material `m` at cosine `c`.
+    pub fn eval(&self, m: usize, c: f64) -> f64 {
+        let nc = self.per_material[m];
+        let one = self.dp.one_code() as f64;
+        let below = nc.threshold.is_some_and(|thr| c * one < thr as f64);
+        F64Walk::new(self.dp, nc, c, below, 0).run().1
+    }
+}
+
+/// The f64 cos^n lobe of a scene's materials, with the classic coefficient of `form`.
+pub fn cos_n_lobe(scene: &Scene, form: Form) -> impl Fn(usize, f64) -> f64 + Sync {
+    let per_material: Vec<(f64, f64)> = scene
+        .materials
+        .iter()
+        .map(|m| {
+            let n = f64::from(m.n);
+            (n, classic_coefficient(form, n))
+        })
+        .collect();
+    move |m, c| per_material[m].1 * c.powf(per_material[m].0)
 }
 
 /// sRGB encoding of a linear value in [0, 1].
@@ -268,26 +348,78 @@ pub fn display_code(x: f64, bits: u32) -> u16 {
     (srgb(x.clamp(0.0, 1.0)) * max).round() as u16
 }
 
-/// Renders a scene through a datapath whose n set holds every material's exponent (the
-/// caller builds it so); `progress(rows done, rows)` is called as rows finish.
-///
-/// # Panics
-/// If the datapath lacks a material's exponent.
-pub fn render(scene: &Scene, dp: &Datapath, progress: &(dyn Fn(usize, usize) + Sync)) -> Rendered {
-    let form = dp.config().coef.form;
-    let lobes = Lobes {
-        dp,
-        per_material: scene
-            .materials
-            .iter()
-            .map(|m| {
-                let nc = dp
-                    .constants_for(m.n)
-                    .expect("the datapath holds every material's exponent");
-                (nc, classic_coefficient(form, f64::from(m.n)))
+/// One light's specular term in a pixel: the material's lobe at cosine `c`, times `weight`
+/// (`pi k_s intensity colour N.L`, per channel).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Term {
+    /// The material index.
+    pub material: u16,
+    /// The lobe's cosine (N.H or R.V), clamped to [0, 1].
+    pub c: f64,
+    /// What the lobe is multiplied by, per channel.
+    pub weight: [f64; 3],
+}
+
+/// A traced scene: everything about each pixel but its specular lobes, so any path (any
+/// datapath) is shaded from it without tracing again.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fragments {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Bits per channel.
+    pub bits: u32,
+    /// The material index of each pixel (`None`: background).
+    pub material: Vec<Option<u16>>,
+    /// Linear radiance without the specular terms (ambient and diffuse; the background).
+    pub base: Vec<[f64; 3]>,
+    /// `terms[start[p]..start[p + 1]]` are pixel p's specular terms, in light order.
+    pub start: Vec<u32>,
+    /// Every specular term.
+    pub terms: Vec<Term>,
+}
+
+impl Fragments {
+    /// The specular terms of pixel `p`.
+    pub fn terms_of(&self, p: usize) -> &[Term] {
+        &self.terms[self.start[p] as usize..self.start[p + 1] as usize]
+    }
+
+    /// The display codes of one path: each pixel's base radiance plus its terms' lobes.
+    pub fn shade(&self, lobe: &Lobe<'_>) -> Vec<[u16; 3]> {
+        let bits = self.bits;
+        (0..self.base.len())
+            .into_par_iter()
+            .map(|p| {
+                let mut rad = self.base[p];
+                for t in self.terms_of(p) {
+                    let f_s = lobe(usize::from(t.material), t.c);
+                    for (r, w) in rad.iter_mut().zip(t.weight) {
+                        *r += f_s * w;
+                    }
+                }
+                rad.map(|x| display_code(x, bits))
             })
-            .collect(),
-    };
+            .collect()
+    }
+
+    /// The datapath inputs `(n, code)` the terms produce, per exponent.
+    pub fn inputs(&self, scene: &Scene, dp: &Datapath) -> Vec<InputsOfN> {
+        gather_inputs(
+            self.terms.iter().map(|t| {
+                (
+                    scene.materials[usize::from(t.material)].n,
+                    input_code(dp, t.c),
+                )
+            }),
+            dp.one_code(),
+        )
+    }
+}
+
+/// Traces one primary ray per pixel; `progress(rows done, rows)` is called as rows finish.
+pub fn trace(scene: &Scene, progress: &(dyn Fn(usize, usize) + Sync)) -> Fragments {
     let (w, h) = (scene.image.width as usize, scene.image.height as usize);
     let cam = &scene.camera;
     let forward = normalize(sub(cam.look_at, cam.position));
@@ -301,68 +433,82 @@ pub fn render(scene: &Scene, dp: &Datapath, progress: &(dyn Fn(usize, usize) + S
         .map(|o| scene.material_index(&o.material).expect("validated"))
         .collect();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let rows: Vec<(Vec<Pixel>, Inputs)> = (0..h)
+    let rows: Vec<Vec<(Option<u16>, [f64; 3], Vec<Term>)>> = (0..h)
         .into_par_iter()
         .map(|y| {
-            let mut inputs = Vec::new();
             let row = (0..w)
                 .map(|x| {
                     let sx = (2.0 * (x as f64 + 0.5) / w as f64 - 1.0) * half * aspect;
                     let sy = (1.0 - 2.0 * (y as f64 + 0.5) / h as f64) * half;
                     let dir = normalize(add_scaled(add_scaled(forward, sx, right), sy, up));
-                    shade(scene, &lobes, &material_of, cam.position, dir, &mut inputs)
+                    fragment(scene, &material_of, cam.position, dir)
                 })
                 .collect();
             let now = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(now, h);
-            (row, inputs)
+            row
         })
         .collect();
-    let inputs = gather_inputs(
-        rows.iter().flat_map(|(_, inputs)| inputs.iter().copied()),
-        dp.one_code(),
-    );
-    let mut out = Rendered {
+    let mut f = Fragments {
         width: scene.image.width,
         height: scene.image.height,
         bits: scene.image.bits,
         material: Vec::with_capacity(w * h),
-        codes: [
-            Vec::with_capacity(w * h),
-            Vec::with_capacity(w * h),
-            Vec::with_capacity(w * h),
-        ],
-        inputs,
+        base: Vec::with_capacity(w * h),
+        start: Vec::with_capacity(w * h + 1),
+        terms: Vec::new(),
     };
-    for (m, codes) in rows.into_iter().flat_map(|(row, _)| row) {
-        out.material.push(m);
-        for (p, c) in out.codes.iter_mut().zip(codes) {
-            p.push(c);
-        }
+    for (m, base, terms) in rows.into_iter().flatten() {
+        f.start.push(f.terms.len() as u32);
+        f.material.push(m);
+        f.base.push(base);
+        f.terms.extend(terms);
     }
-    out
+    f.start.push(f.terms.len() as u32);
+    f
 }
 
-/// A pixel: the material hit, and each path's display codes.
-type Pixel = (Option<u16>, [[u16; 3]; 3]);
+/// Renders a scene through a datapath whose n set holds every material's exponent (the
+/// caller builds it so); `progress(rows done, rows)` is called as rows finish.
+///
+/// # Panics
+/// If the datapath lacks a material's exponent.
+pub fn render(scene: &Scene, dp: &Datapath, progress: &(dyn Fn(usize, usize) + Sync)) -> Rendered {
+    let frags = trace(scene, progress);
+    render_fragments(scene, &frags, dp)
+}
 
-/// The datapath inputs `(n, code)` of a row of pixels.
-type Inputs = Vec<(u32, i64)>;
+/// Shades traced fragments with the three paths.
+///
+/// # Panics
+/// If the datapath lacks a material's exponent.
+pub fn render_fragments(scene: &Scene, frags: &Fragments, dp: &Datapath) -> Rendered {
+    let cos_n = cos_n_lobe(scene, dp.config().coef.form);
+    let model = ModelLobe::new(dp, scene);
+    let table = DatapathLobe::new(dp, scene);
+    Rendered {
+        width: frags.width,
+        height: frags.height,
+        bits: frags.bits,
+        material: frags.material.clone(),
+        codes: [
+            frags.shade(&cos_n),
+            frags.shade(&|m, c| model.eval(m, c)),
+            frags.shade(&|m, c| table.eval(m, c)),
+        ],
+        inputs: frags.inputs(scene, dp),
+    }
+}
 
-/// The display codes of each path for one primary ray, and the material it hit; each datapath
-/// input `(n, code)` it evaluates is pushed onto `inputs`.
-fn shade(
+/// One primary ray: the material hit, the base radiance and the specular terms.
+fn fragment(
     scene: &Scene,
-    lobes: &Lobes<'_>,
     material_of: &[usize],
     eye: [f64; 3],
     dir: [f64; 3],
-    inputs: &mut Inputs,
-) -> Pixel {
-    let bits = scene.image.bits;
-    let encode = |rgb: [f64; 3]| rgb.map(|x| display_code(x, bits));
+) -> (Option<u16>, [f64; 3], Vec<Term>) {
     let Some(hit) = nearest(scene, eye, dir) else {
-        return (None, [encode(BACKGROUND); 3]);
+        return (None, BACKGROUND, Vec::new());
     };
     let mi = material_of[hit.object];
     let mat = &scene.materials[mi];
@@ -373,7 +519,8 @@ fn shade(
         n = n.map(|x| -x);
     }
     let amb = scene.shading.ambient;
-    let mut radiance = [mat.colour.map(|c| amb * c); 3];
+    let mut base = mat.colour.map(|c| amb * c);
+    let mut terms = Vec::with_capacity(scene.lights.len());
     for light in &scene.lights {
         let l = match light.kind {
             LightKind::Directional => normalize(light.direction.expect("validated")),
@@ -391,29 +538,42 @@ fn shade(
             }
         }
         .clamp(0.0, 1.0);
-        let (spec, code) = lobes.eval(mi, c);
-        inputs.push((mat.n, code));
-        for (rad, f_s) in radiance.iter_mut().zip(spec) {
-            for ((r, &lc), &mc) in rad.iter_mut().zip(&light.colour).zip(&mat.colour) {
-                let e = light.intensity * lc * ndotl;
-                *r += (mat.k_d * mc + std::f64::consts::PI * mat.k_s * f_s) * e;
-            }
+        let mut weight = [0.0; 3];
+        for ch in 0..3 {
+            let e = light.intensity * light.colour[ch] * ndotl;
+            base[ch] += mat.k_d * mat.colour[ch] * e;
+            weight[ch] = std::f64::consts::PI * mat.k_s * e;
         }
+        terms.push(Term {
+            material: mi as u16,
+            c,
+            weight,
+        });
     }
-    (Some(mi as u16), radiance.map(encode))
+    (Some(mi as u16), base, terms)
 }
 
 /// NVIDIA's FLIP (LDR) of path `test` against path `reference`, per pixel in [0, 1], at the
 /// default 67 pixels per degree (a 0.7 m viewing distance from a 24-inch 4K screen). FLIP
 /// reads 8-bit sRGB: 10-bit codes are rounded to 8 bits first.
 pub fn flip_errors(r: &Rendered, test: usize, reference: usize) -> Vec<f32> {
-    let image = |path: usize| {
-        let max = u32::from((1u16 << r.bits) - 1);
-        let bytes: Vec<u8> = r.codes[path]
+    flip_of(
+        (r.width, r.height, r.bits),
+        &r.codes[test],
+        &r.codes[reference],
+    )
+}
+
+/// [`flip_errors`] of two images of `(width, height, bits)`.
+pub fn flip_of(size: (u32, u32, u32), test: &[[u16; 3]], reference: &[[u16; 3]]) -> Vec<f32> {
+    let (width, height, bits) = size;
+    let image = |codes: &[[u16; 3]]| {
+        let max = u32::from((1u16 << bits) - 1);
+        let bytes: Vec<u8> = codes
             .iter()
             .flat_map(|c| c.map(|x| ((u32::from(x) * 255 + max / 2) / max) as u8))
             .collect();
-        nv_flip::FlipImageRgb8::with_data(r.width, r.height, &bytes)
+        nv_flip::FlipImageRgb8::with_data(width, height, &bytes)
     };
     nv_flip::flip(
         image(reference),
@@ -441,9 +601,13 @@ pub struct ImageError {
 
 /// The largest channel difference of each pixel between two paths, in display LSBs.
 pub fn difference(r: &Rendered, a: usize, b: usize) -> Vec<u32> {
-    r.codes[a]
-        .iter()
-        .zip(&r.codes[b])
+    difference_of(&r.codes[a], &r.codes[b])
+}
+
+/// The largest channel difference of each pixel between two images, in display LSBs.
+pub fn difference_of(a: &[[u16; 3]], b: &[[u16; 3]]) -> Vec<u32> {
+    a.iter()
+        .zip(b)
         .map(|(x, y)| {
             (0..3)
                 .map(|ch| u32::from(x[ch].abs_diff(y[ch])))
@@ -456,7 +620,18 @@ pub fn difference(r: &Rendered, a: usize, b: usize) -> Vec<u32> {
 /// Error figures of path `a` against path `b` over the pixels of material `m` (`None`: every
 /// covered pixel), with `flip` the per-pixel FLIP of `a` against `b` ([`flip_errors`]).
 pub fn image_error(r: &Rendered, a: usize, b: usize, m: Option<u16>, flip: &[f32]) -> ImageError {
-    let diff = difference(r, a, b);
+    image_error_of(&r.material, &difference(r, a, b), m, flip)
+}
+
+/// Error figures over the pixels of material `m` (`None`: every covered pixel) from each
+/// pixel's material, its difference in display LSBs ([`difference_of`]) and its FLIP (empty:
+/// not computed, the mean is 0).
+pub fn image_error_of(
+    material: &[Option<u16>],
+    diff: &[u32],
+    m: Option<u16>,
+    flip: &[f32],
+) -> ImageError {
     let mut e = ImageError {
         pixels: 0,
         max_lsb: 0,
@@ -467,7 +642,7 @@ pub fn image_error(r: &Rendered, a: usize, b: usize, m: Option<u16>, flip: &[f32
     let mut sum = 0u64;
     let mut differing = 0u64;
     let mut flip_sum = 0.0f64;
-    for ((d, mat), &f) in diff.iter().zip(&r.material).zip(flip) {
+    for (i, (d, mat)) in diff.iter().zip(material).enumerate() {
         let covered = match m {
             Some(m) => *mat == Some(m),
             None => mat.is_some(),
@@ -477,7 +652,7 @@ pub fn image_error(r: &Rendered, a: usize, b: usize, m: Option<u16>, flip: &[f32
             e.max_lsb = e.max_lsb.max(*d);
             sum += u64::from(*d);
             differing += u64::from(*d > 0);
-            flip_sum += f64::from(f);
+            flip_sum += flip.get(i).map_or(0.0, |&f| f64::from(f));
         }
     }
     if e.pixels > 0 {
