@@ -174,8 +174,76 @@ impl Budget {
     }
 }
 
+/// One dimension the search shrinks by bisection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Knob {
+    /// The fraction bits of a quantizing stage (`t`, `b`, a squaring, `out`).
+    Frac(Stage),
+    /// The fraction bits of the input c (and of d = c - 1, which stays exact).
+    InputFrac,
+    /// The fraction bits of the stored coefficient.
+    CoefFrac,
+    /// The integer bits of the stored coefficient (the largest coef(n) must fit).
+    CoefInt,
+    /// The integer bits of the output (fewer saturate the brightest outputs).
+    OutInt,
+}
+
+impl fmt::Display for Knob {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Knob::Frac(s) => write!(f, "{s} fraction bits"),
+            Knob::InputFrac => f.write_str("c fraction bits"),
+            Knob::CoefFrac => f.write_str("coef fraction bits"),
+            Knob::CoefInt => f.write_str("coef integer bits"),
+            Knob::OutInt => f.write_str("out integer bits"),
+        }
+    }
+}
+
+impl Knob {
+    /// The knob's value in a configuration.
+    pub fn get(self, cfg: &Config) -> i32 {
+        match self {
+            Knob::Frac(s) => spec_mut(&mut cfg.clone(), s).format.frac_bits(),
+            Knob::InputFrac => cfg.c.format.frac_bits(),
+            Knob::CoefFrac => cfg.coef.format.frac_bits(),
+            Knob::CoefInt => cfg.coef.format.int_bits(),
+            Knob::OutInt => cfg.out.format.int_bits(),
+        }
+    }
+
+    /// Sets the knob (an error when the format cannot exist).
+    pub fn set(self, cfg: &mut Config, v: i32) -> Result<(), Error> {
+        let with_frac = |f: Format| Format::new(f.is_signed(), f.int_bits(), v);
+        match self {
+            Knob::Frac(s) => set_frac(cfg, s, v)?,
+            Knob::InputFrac => {
+                cfg.c.format = with_frac(cfg.c.format)?;
+                cfg.d.format = with_frac(cfg.d.format)?;
+            }
+            Knob::CoefFrac => cfg.coef.format = with_frac(cfg.coef.format)?,
+            Knob::CoefInt => {
+                let f = cfg.coef.format;
+                cfg.coef.format = Format::new(f.is_signed(), v, f.frac_bits())?;
+            }
+            Knob::OutInt => {
+                let f = cfg.out.format;
+                cfg.out.format = Format::new(f.is_signed(), v, f.frac_bits())?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether the search starts this knob at `start_frac` (the internal stages) rather than
+    /// at the base configuration's value.
+    fn starts_wide(self) -> bool {
+        matches!(self, Knob::Frac(Stage::T | Stage::B | Stage::Square(_)))
+    }
+}
+
 /// The searched stages: `t`, `b`, `sq1`..`sqk`. The output format is the interface the
-/// design must deliver (and the unit of `out <= N ulp`), so it is kept as the base has it.
+/// design must deliver (and the unit of `out <= N ulp`), so `optimize` keeps it.
 fn searched_stages(k: u32) -> Vec<Stage> {
     let mut v = vec![Stage::T, Stage::B];
     v.extend((0..k as usize).map(Stage::Square));
@@ -198,6 +266,41 @@ fn set_frac(cfg: &mut Config, stage: Stage, frac: i32) -> Result<(), Error> {
     let spec = spec_mut(cfg, stage);
     spec.format = Format::new(spec.format.is_signed(), spec.format.int_bits(), frac)?;
     Ok(())
+}
+
+/// Whether a candidate meets the budget, and how far it is from it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Verdict {
+    /// It meets every bound.
+    pub feasible: bool,
+    /// The largest ratio value/limit over the bounds (at most 1 when feasible).
+    pub excess: f64,
+}
+
+/// What the search may change beyond the internal stages' fraction bits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Space {
+    /// The discrete choices.
+    pub choices: Choices,
+    /// Fraction bits the internal stages (t, b, the squarings) start from.
+    pub start_frac: i32,
+    /// Knobs searched after the internal stages', starting at the base's values.
+    pub extra_knobs: Vec<Knob>,
+    /// Whether the local search may change overflow modes.
+    pub overflow_moves: bool,
+}
+
+/// What a search found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SearchResult {
+    /// The cheapest feasible configuration, if any.
+    pub best: Option<Candidate>,
+    /// The closest configuration (least excess) when none is feasible.
+    pub closest: Option<Candidate>,
+    /// Candidates judged.
+    pub n_evaluations: u64,
+    /// Why the answer is minimal within the search.
+    pub minimality: Vec<String>,
 }
 
 /// The discrete choices the local search tries.
@@ -239,7 +342,8 @@ pub struct OptimizeResult {
     pub minimality: Vec<String>,
 }
 
-/// Searches for the cheapest configuration meeting `budget`, starting from `base`.
+/// Searches for the cheapest configuration meeting `budget`, starting from `base`; every
+/// candidate is checked exhaustively ([`check_outputs`]).
 ///
 /// `cost` prices a validated datapath (analytic LUTs, or yosys); `progress` receives a line
 /// per step.
@@ -251,6 +355,49 @@ pub fn optimize(
     cost: &mut dyn FnMut(&Datapath) -> Result<f64, Error>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<OptimizeResult, Error> {
+    let space = Space {
+        choices: choices.clone(),
+        start_frac,
+        extra_knobs: Vec::new(),
+        overflow_moves: true,
+    };
+    let mut judge = |dp: &Datapath| -> Result<Verdict, Error> {
+        let r = check_outputs(dp)?;
+        Ok(Verdict {
+            feasible: budget.met_by(&r),
+            excess: budget.excess(&r),
+        })
+    };
+    let r = search(base, &space, &mut judge, cost, progress)?;
+    Ok(OptimizeResult {
+        budget: budget.clone(),
+        best: r.best,
+        closest: r.closest,
+        n_evaluations: r.n_evaluations,
+        minimality: r.minimality,
+    })
+}
+
+/// The search behind [`optimize`], with any judge: from each combination of the discrete
+/// choices, every internal stage at `start_frac` fraction bits and the extra knobs at the
+/// base's values; per-knob bisection until nothing shrinks; the cheapest feasible point, then
+/// a local search over rounding (and, if allowed, overflow) modes.
+pub fn search(
+    base: &Config,
+    space: &Space,
+    judge: &mut dyn FnMut(&Datapath) -> Result<Verdict, Error>,
+    cost: &mut dyn FnMut(&Datapath) -> Result<f64, Error>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<SearchResult, Error> {
+    let choices = &space.choices;
+    let start_frac = space.start_frac;
+    let knobs_of = |k: u32| -> Vec<Knob> {
+        searched_stages(k)
+            .into_iter()
+            .map(Knob::Frac)
+            .chain(space.extra_knobs.iter().copied())
+            .collect()
+    };
     let mut n_eval = 0u64;
     let mut memo: BTreeMap<String, Option<Candidate>> = BTreeMap::new();
     let mut evaluate = |cfg: &Config, n_eval: &mut u64| -> Result<Option<Candidate>, Error> {
@@ -262,12 +409,12 @@ pub fn optimize(
             Err(_) => None,
             Ok(dp) => {
                 *n_eval += 1;
-                let r = check_outputs(&dp)?;
+                let v = judge(&dp)?;
                 Some(Candidate {
                     config: cfg.clone(),
                     cost: cost(&dp)?,
-                    feasible: budget.met_by(&r),
-                    excess: budget.excess(&r),
+                    feasible: v.feasible,
+                    excess: v.excess,
                 })
             }
         };
@@ -283,9 +430,9 @@ pub fn optimize(
                 cfg.k = k;
                 cfg.square = vec![base.square[0]; k as usize];
                 cfg.variant = variant;
-                let stages = searched_stages(k);
-                for &s in &stages {
-                    set_frac(&mut cfg, s, start_frac)?;
+                let knobs = knobs_of(k);
+                for &knob in knobs.iter().filter(|k| k.starts_wide()) {
+                    knob.set(&mut cfg, start_frac)?;
                 }
                 cfg.t.rounding = rounding;
                 cfg.b.rounding = rounding;
@@ -310,16 +457,14 @@ pub fn optimize(
                 let mut current = start;
                 loop {
                     let mut changed = false;
-                    for &s in &stages {
-                        let frac_of =
-                            |c: &Config| -> i32 { spec_mut(&mut c.clone(), s).format.frac_bits() };
-                        let (mut lo, mut hi) = (-1, frac_of(&current.config));
+                    for &knob in &knobs {
+                        let (mut lo, mut hi) = (-1, knob.get(&current.config));
                         // Invariant: hi feasible; find the smallest feasible in (lo, hi], down
-                        // to 0 fraction bits.
+                        // to 0 bits.
                         while hi - lo > 1 {
                             let mid = (lo + hi) / 2;
                             let mut trial = current.config.clone();
-                            if set_frac(&mut trial, s, mid).is_err() {
+                            if knob.set(&mut trial, mid).is_err() {
                                 lo = mid;
                                 continue;
                             }
@@ -367,7 +512,12 @@ pub fn optimize(
                     }
                     trials.push(trial);
                 }
-                for o in Overflow::ALL.into_iter().filter(|&o| o != spec.overflow) {
+                let overflows = if space.overflow_moves {
+                    Overflow::ALL.to_vec()
+                } else {
+                    Vec::new()
+                };
+                for o in overflows.into_iter().filter(|&o| o != spec.overflow) {
                     let mut trial = current.config.clone();
                     spec_mut(&mut trial, s).overflow = o;
                     trials.push(trial);
@@ -405,27 +555,27 @@ pub fn optimize(
             choices.roundings.iter().map(|r| r.name()).collect::<Vec<_>>()
         ));
         minimality.push(format!(
-            "then a local search over every stage's rounding and overflow modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried, none of the final ones both feasible and cheaper"
+            "then a local search over every stage's rounding{} modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried, none of the final ones both feasible and cheaper",
+            if space.overflow_moves { " and overflow" } else { "" }
         ));
-        for s in searched_stages(b.config.k) {
+        for knob in knobs_of(b.config.k) {
             let mut trial = b.config.clone();
-            let frac = spec_mut(&mut trial, s).format.frac_bits();
-            let verdict = if set_frac(&mut trial, s, frac - 1).is_err() {
+            let bits = knob.get(&trial);
+            let verdict = if knob.set(&mut trial, bits - 1).is_err() {
                 "cannot lose a bit (format limit)".to_string()
             } else {
                 match evaluate(&trial, &mut n_eval)? {
                     Some(c) if c.feasible => {
-                        format!("ALSO FEASIBLE with {} bits (cost {:.0})", frac - 1, c.cost)
+                        format!("ALSO FEASIBLE with {} bits (cost {:.0})", bits - 1, c.cost)
                     }
-                    Some(_) => format!("{} fraction bits: one fewer breaks the budget", frac),
+                    Some(_) => format!("{bits}: one fewer breaks the budget"),
                     None => "one fewer bit is not a valid configuration".to_string(),
                 }
             };
-            minimality.push(format!("{s}: {verdict}"));
+            minimality.push(format!("{knob}: {verdict}"));
         }
     }
-    Ok(OptimizeResult {
-        budget: budget.clone(),
+    Ok(SearchResult {
         best,
         closest,
         n_evaluations: n_eval,
