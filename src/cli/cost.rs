@@ -14,6 +14,7 @@ use specfx::hdl::cost::{
     analytic_cost, parse_stat_json, yosys_script, AnalyticCost, Target, YosysCost,
 };
 use specfx::hdl::params_header;
+use specfx::hdl::rom::{constant_rom, rom_verilog, ConstantRom};
 use specfx::pipeline::Datapath;
 
 /// Arguments of `specfx cost`.
@@ -59,6 +60,10 @@ pub struct CostReport {
     pub dsps: Option<u64>,
     /// yosys flip-flops.
     pub ffs: Option<u64>,
+    /// The per-n constant ROM in front of the datapath (not in the figures above).
+    pub rom: ConstantRom,
+    /// yosys's figures for the ROM alone (`specfx_rom`), when it ran.
+    pub rom_yosys: Option<YosysCost>,
     /// `yosys -V`.
     pub yosys_version: Option<String>,
     /// The exact script yosys ran.
@@ -96,25 +101,43 @@ pub fn run_yosys(
     target: Target,
     hdl_ref: &Path,
 ) -> Result<(YosysCost, String, String)> {
-    let version = Command::new("yosys")
-        .arg("-V")
-        .output()
-        .context("yosys not found: install it (Debian: apt-get install yosys)")?;
-    let version = String::from_utf8_lossy(&version.stdout).trim().to_string();
     let work = tempfile::tempdir().context("cannot create a temporary directory")?;
     std::fs::write(
         work.path().join("specfx_params.vh"),
         params_header(dp, arch),
     )?;
-    let files: Vec<String> = rtl_files(hdl_ref)?
-        .iter()
-        .map(|p| p.display().to_string())
-        .collect();
-    let script = yosys_script(target, &files, &work.path().display().to_string());
-    std::fs::write(work.path().join("cost.ys"), &script)?;
+    let files = rtl_files(hdl_ref)?;
+    yosys_in(work.path(), &files, "specfx_dut", target)
+        .context("yosys failed on the reference Verilog")
+}
+
+/// Runs yosys on the configuration's constant ROM (`specfx_rom`, generated).
+pub fn run_yosys_rom(dp: &Datapath, target: Target) -> Result<(YosysCost, String, String)> {
+    let work = tempfile::tempdir().context("cannot create a temporary directory")?;
+    let file = work.path().join("specfx_rom.v");
+    std::fs::write(&file, rom_verilog(dp))?;
+    yosys_in(work.path(), &[file], "specfx_rom", target)
+        .context("yosys failed on the constant ROM")
+}
+
+/// Runs yosys in `work` on `files` with `top`: (cost, version, script).
+fn yosys_in(
+    work: &Path,
+    files: &[PathBuf],
+    top: &str,
+    target: Target,
+) -> Result<(YosysCost, String, String)> {
+    let version = Command::new("yosys")
+        .arg("-V")
+        .output()
+        .context("yosys not found: install it (Debian: apt-get install yosys)")?;
+    let version = String::from_utf8_lossy(&version.stdout).trim().to_string();
+    let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+    let script = yosys_script(target, &files, &work.display().to_string(), top);
+    std::fs::write(work.join("cost.ys"), &script)?;
     let out = Command::new("yosys")
         .args(["-q", "-s", "cost.ys"])
-        .current_dir(work.path())
+        .current_dir(work)
         .output()
         .context("cannot run yosys")?;
     if !out.status.success() {
@@ -123,11 +146,11 @@ pub fn run_yosys(
             .lines()
             .find(|l| !l.trim().is_empty())
             .unwrap_or("no message");
-        bail!("yosys failed on the reference Verilog: {first}");
+        bail!("{first}");
     }
-    let stat = std::fs::read_to_string(work.path().join("stat.json"))
-        .context("yosys wrote no statistics")?;
-    let cmos = std::fs::read_to_string(work.path().join("stat_cmos.txt")).ok();
+    let stat =
+        std::fs::read_to_string(work.join("stat.json")).context("yosys wrote no statistics")?;
+    let cmos = std::fs::read_to_string(work.join("stat_cmos.txt")).ok();
     let cost = parse_stat_json(&stat, cmos.as_deref()).map_err(anyhow::Error::msg)?;
     Ok((cost, version, script))
 }
@@ -141,11 +164,12 @@ pub fn cost_report(
     analytic_only: bool,
 ) -> Result<CostReport> {
     let analytic = analytic_cost(dp, arch, target);
-    let (yosys, version, script) = if analytic_only {
-        (None, None, None)
+    let (yosys, version, script, rom_yosys) = if analytic_only {
+        (None, None, None, None)
     } else {
         let (c, v, s) = run_yosys(dp, arch, target, hdl_ref)?;
-        (Some(c), Some(v), Some(s))
+        let (rom, _, _) = run_yosys_rom(dp, target)?;
+        (Some(c), Some(v), Some(s), Some(rom))
     };
     let ratio = |a: u64, b: u64| (b > 0).then(|| a as f64 / b as f64);
     Ok(CostReport {
@@ -161,6 +185,8 @@ pub fn cost_report(
             .and_then(|y| ratio(y.ffs, analytic.register_bits)),
         analytic,
         yosys,
+        rom: constant_rom(dp, target),
+        rom_yosys,
         yosys_version: version,
         yosys_script: script,
     })
@@ -220,6 +246,23 @@ pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Resul
         write!(w, " {} {}x{}", m.name, m.a_bits, m.b_bits)?;
     }
     writeln!(w)?;
+    let rom = &r.rom;
+    writeln!(
+        w,
+        "  constant ROM (beside the datapath): {} entries x {} bits ({}), addressed by {}: analytic {} LUTs, yosys {}",
+        rom.entries,
+        rom.fields.iter().map(|f| f.bits).sum::<u32>(),
+        rom.fields
+            .iter()
+            .map(|f| format!("{} {}", f.name, f.bits))
+            .collect::<Vec<_>>()
+            .join(", "),
+        if rom.addressed_by_n { "n" } else { "index" },
+        rom.luts,
+        r.rom_yosys
+            .as_ref()
+            .map_or("-".to_string(), |y| format!("{} LUTs, {} cells", y.luts, y.cells))
+    )?;
     if let Some(v) = &r.yosys_version {
         writeln!(w, "  {v}")?;
     }

@@ -13,6 +13,7 @@ use super::Outcome;
 use specfx::cycle::sim::{simulate, Stimulus, Stop};
 use specfx::cycle::Arch;
 use specfx::hdl::params_header;
+use specfx::hdl::rom::rom_verilog;
 
 /// Arguments of `specfx hdl`.
 #[derive(Debug, Args)]
@@ -25,6 +26,9 @@ pub struct HdlArgs {
 enum HdlCommand {
     /// Prints the `specfx_params.vh` header (Verilog `define macros) of a configuration.
     Params(ParamsArgs),
+    /// Prints the per-n constant ROM (`specfx_rom.v`) of a configuration: a `case` on n (a
+    /// contiguous n range) or on the index of n in the set (a list, e.g. a fitted scene's).
+    Rom(RomArgs),
     /// Writes the valid/ready patterns and expected output cycles for co-simulating a vector
     /// directory.
     Stimulus(StimulusArgs),
@@ -42,6 +46,16 @@ struct ParamsArgs {
     #[arg(long, default_value = "pipelined")]
     arch: Arch,
     /// Write the header here instead of printing it.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+struct RomArgs {
+    /// A TOML configuration file, a vector directory, or a built-in name: baseline.
+    #[arg(long, default_value = "baseline")]
+    config: String,
+    /// Write the module here instead of printing it.
     #[arg(long)]
     out: Option<PathBuf>,
 }
@@ -72,8 +86,26 @@ struct StimulusArgs {
 pub fn run(args: &HdlArgs) -> Result<Outcome> {
     match &args.command {
         HdlCommand::Params(a) => params(a),
+        HdlCommand::Rom(a) => rom(a),
         HdlCommand::Stimulus(a) => stimulus(a),
     }
+}
+
+fn rom(args: &RomArgs) -> Result<Outcome> {
+    let dp = super::datapath::load(&args.config, None)?;
+    print_or_write(args.out.as_deref(), &rom_verilog(&dp))
+}
+
+/// Writes `text` to `out`, or prints it.
+fn print_or_write(out: Option<&std::path::Path>, text: &str) -> Result<Outcome> {
+    match out {
+        Some(path) => write_atomic(path, text.as_bytes())?,
+        None => super::output::print_with(|w| {
+            use std::io::Write;
+            w.write_all(text.as_bytes())
+        })?,
+    }
+    Ok(Outcome::Ok)
 }
 
 fn params(args: &ParamsArgs) -> Result<Outcome> {
@@ -81,15 +113,7 @@ fn params(args: &ParamsArgs) -> Result<Outcome> {
         Some(dir) => super::datapath::load(&dir.to_string_lossy(), None)?,
         None => super::datapath::load(&args.config, None)?,
     };
-    let header = params_header(&dp, args.arch);
-    match &args.out {
-        Some(path) => write_atomic(path, header.as_bytes())?,
-        None => super::output::print_with(|w| {
-            use std::io::Write;
-            w.write_all(header.as_bytes())
-        })?,
-    }
-    Ok(Outcome::Ok)
+    print_or_write(args.out.as_deref(), &params_header(&dp, args.arch))
 }
 
 fn bits_file(bits: &[bool]) -> String {

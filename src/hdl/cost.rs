@@ -233,20 +233,22 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
 
 /// The yosys script for a target, reading `files` with `include_dir` on the include path and
 /// writing `stat.json` (and, for generic, `stat_cmos.txt` with the transistor estimate).
-pub fn yosys_script(target: Target, files: &[String], include_dir: &str) -> String {
+pub fn yosys_script(target: Target, files: &[String], include_dir: &str, top: &str) -> String {
     let mut s = format!("read_verilog -I{include_dir} {}\n", files.join(" "));
-    s.push_str("hierarchy -check -top specfx_dut\n");
+    s.push_str(&format!("hierarchy -check -top {top}\n"));
     match target {
         Target::Generic => {
-            s.push_str("synth -top specfx_dut -flatten\nabc -g cmos2\n");
+            s.push_str(&format!("synth -top {top} -flatten\nabc -g cmos2\n"));
             s.push_str("tee -q -o stat_cmos.txt stat -tech cmos\n");
         }
         Target::GenericFast => {
-            s.push_str("synth -top specfx_dut -flatten\nabc -fast -g cmos2\n");
+            s.push_str(&format!("synth -top {top} -flatten\nabc -fast -g cmos2\n"));
             s.push_str("tee -q -o stat_cmos.txt stat -tech cmos\n");
         }
-        Target::Ice40 => s.push_str("synth_ice40 -top specfx_dut -dsp\n"),
-        Target::Xilinx => s.push_str("synth_xilinx -top specfx_dut -family xc7 -flatten\n"),
+        Target::Ice40 => s.push_str(&format!("synth_ice40 -top {top} -dsp\n")),
+        Target::Xilinx => s.push_str(&format!(
+            "synth_xilinx -top {top} -family xc7 -flatten\n"
+        )),
     }
     s.push_str("tee -q -o stat.json stat -json\n");
     s
