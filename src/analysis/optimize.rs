@@ -286,6 +286,8 @@ pub struct Space {
     pub start_frac: i32,
     /// Knobs searched after the internal stages', starting at the base's values.
     pub extra_knobs: Vec<Knob>,
+    /// The rounding modes the local search tries on each stage.
+    pub local_roundings: Vec<Rounding>,
     /// Whether the local search may change overflow modes.
     pub overflow_moves: bool,
 }
@@ -359,6 +361,7 @@ pub fn optimize(
         choices: choices.clone(),
         start_frac,
         extra_knobs: Vec::new(),
+        local_roundings: Rounding::ALL.to_vec(),
         overflow_moves: true,
     };
     let mut judge = |dp: &Datapath| -> Result<Verdict, Error> {
@@ -501,7 +504,7 @@ pub fn search(
             for &s in &stages {
                 let spec = *spec_mut(&mut current.config.clone(), s);
                 let mut trials = Vec::new();
-                for r in Rounding::ALL.into_iter().filter(|&r| r != spec.rounding) {
+                for &r in space.local_roundings.iter().filter(|&&r| r != spec.rounding) {
                     let mut trial = current.config.clone();
                     spec_mut(&mut trial, s).rounding = r;
                     if s != Stage::Out {

@@ -13,7 +13,10 @@ use super::Outcome;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
 use specfx::report::scene::{flip_png, heatmap_png, path_png, table_markdown, MaterialRow};
-use specfx::scene::render::{difference, flip_errors, image_error, render, INPUT_BINS, PATHS};
+use specfx::scene::render::{
+    difference, flip_errors, image_error, render_fragments, trace, Fragments, InputsOfN,
+    INPUT_BINS, PATHS,
+};
 use specfx::scene::Scene;
 
 /// Arguments of `specfx render`.
@@ -36,18 +39,7 @@ pub struct RenderArgs {
 
 /// Runs `specfx render`.
 pub fn run(args: &RenderArgs) -> Result<Outcome> {
-    let scene = match &args.scene {
-        None => Scene::default_scene(),
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("scene {}: cannot read it", path.display()))?;
-            // Mesh files are named relative to the scene file.
-            let dir = path.parent().map(|d| d.to_path_buf()).unwrap_or_default();
-            let load = |file: &str| std::fs::read(dir.join(file));
-            Scene::from_toml_with(&text, &load)
-                .with_context(|| format!("scene {}", path.display()))?
-        }
-    };
+    let scene = load_scene(args.scene.as_deref())?;
     let ns = NSet::from_values(&scene.exponents())?;
     let dp: Datapath = super::datapath::load(&args.config, Some(&ns))?;
     let label = args
@@ -96,23 +88,8 @@ pub fn render_scene(
         scene.lights.len(),
         dp.config().name
     );
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = ProgressBar::new(u64::from(h));
-        b.set_style(
-            ProgressStyle::with_template("render {bar:40} {pos}/{len} rows, eta {eta}")
-                .expect("valid template"),
-        );
-        b
-    });
-    let progress = |done: usize, _rows: usize| {
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
-        }
-    };
-    let r = render(scene, dp, &progress);
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    let frags = trace_with_progress(scene);
+    let r = render_fragments(scene, &frags, dp);
     let datapath = 2;
     let flip_total = flip_errors(&r, datapath, 0);
     let flip_quant = flip_errors(&r, datapath, 1);
@@ -165,13 +142,42 @@ pub fn render_scene(
     write_atomic(&out.join("render.md"), md.as_bytes())?;
     let json = serde_json::to_vec_pretty(&rows)?;
     write_atomic(&out.join("render.json"), &json)?;
+    let csv = inputs_csv(&r.inputs, dp.config().c.format.lsb());
+    write_atomic(&out.join("inputs.csv"), csv.as_bytes())?;
+    Ok((rows, table))
+}
+
+/// Traces a scene, with a progress bar on a terminal.
+pub fn trace_with_progress(scene: &Scene) -> Fragments {
+    let h = scene.image.height;
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = ProgressBar::new(u64::from(h));
+        b.set_style(
+            ProgressStyle::with_template("trace {bar:40} {pos}/{len} rows, eta {eta}")
+                .expect("valid template"),
+        );
+        b
+    });
+    let progress = |done: usize, _rows: usize| {
+        if let Some(b) = &bar {
+            b.set_position(done as u64);
+        }
+    };
+    let frags = trace(scene, &progress);
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    frags
+}
+
+/// The datapath inputs as CSV: per n the count, code and c range, and the histogram of c.
+pub fn inputs_csv(inputs: &[InputsOfN], lsb: f64) -> String {
     let mut csv = String::from("n,count,code_min,code_max,c_min,c_max");
     for i in 0..INPUT_BINS {
         csv.push_str(&format!(",h{i:02}"));
     }
     csv.push('\n');
-    let lsb = dp.config().c.format.lsb();
-    for e in &r.inputs {
+    for e in inputs {
         csv.push_str(&format!(
             "{},{},{},{},{},{}",
             e.n,
@@ -186,6 +192,21 @@ pub fn render_scene(
         }
         csv.push('\n');
     }
-    write_atomic(&out.join("inputs.csv"), csv.as_bytes())?;
-    Ok((rows, table))
+    csv
+}
+
+/// Reads a scene file (meshes relative to it), or the built-in scene.
+pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
+    Ok(match path {
+        None => Scene::default_scene(),
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("scene {}: cannot read it", path.display()))?;
+            // Mesh files are named relative to the scene file.
+            let dir = path.parent().map(|d| d.to_path_buf()).unwrap_or_default();
+            let load = |file: &str| std::fs::read(dir.join(file));
+            Scene::from_toml_with(&text, &load)
+                .with_context(|| format!("scene {}", path.display()))?
+        }
+    })
 }

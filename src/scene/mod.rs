@@ -5,6 +5,7 @@
 //! `direction` points from the surface towards the light. Every value is checked when the scene
 //! is read, with an error naming its key (`object[2].radius`), so rendering cannot fail.
 
+pub mod fit;
 pub mod mesh;
 pub mod render;
 

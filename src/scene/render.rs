@@ -388,7 +388,7 @@ impl Fragments {
 
     /// The display codes of one path: each pixel's base radiance plus its terms' lobes.
     pub fn shade(&self, lobe: &Lobe<'_>) -> Vec<[u16; 3]> {
-        let bits = self.bits;
+        let enc = Encoder::of(self.bits);
         (0..self.base.len())
             .into_par_iter()
             .map(|p| {
@@ -399,7 +399,7 @@ impl Fragments {
                         *r += f_s * w;
                     }
                 }
-                rad.map(|x| display_code(x, bits))
+                rad.map(|x| enc.encode(x))
             })
             .collect()
     }
@@ -415,6 +415,53 @@ impl Fragments {
             }),
             dp.one_code(),
         )
+    }
+}
+
+/// [`display_code`] by table: the smallest linear value of each code above 0, found once per
+/// bit depth by bisection over the ordered f64s, so encoding is a binary search instead of a
+/// `powf` (equal to [`display_code`] for every f64, tested).
+pub struct Encoder {
+    /// `thresholds[j]`: the smallest x with `display_code(x) >= j + 1`.
+    thresholds: Vec<f64>,
+}
+
+impl Encoder {
+    /// The encoder of a bit depth (8 or 10), built once and shared.
+    pub fn of(bits: u32) -> &'static Encoder {
+        static E8: std::sync::OnceLock<Encoder> = std::sync::OnceLock::new();
+        static E10: std::sync::OnceLock<Encoder> = std::sync::OnceLock::new();
+        let cell = match bits {
+            8 => &E8,
+            10 => &E10,
+            _ => panic!("display bits are 8 or 10"),
+        };
+        cell.get_or_init(|| Encoder::new(bits))
+    }
+
+    fn new(bits: u32) -> Encoder {
+        let max = (1u32 << bits) - 1;
+        let thresholds = (1..=max)
+            .map(|j| {
+                // Non-negative f64s are ordered like their bit patterns: bisect on those.
+                let (mut lo, mut hi) = (0u64, 1.0f64.to_bits());
+                while hi - lo > 1 {
+                    let mid = lo + (hi - lo) / 2;
+                    if u32::from(display_code(f64::from_bits(mid), bits)) >= j {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                f64::from_bits(hi)
+            })
+            .collect();
+        Encoder { thresholds }
+    }
+
+    /// The display code of a linear value.
+    pub fn encode(&self, x: f64) -> u16 {
+        self.thresholds.partition_point(|&t| t <= x) as u16
     }
 }
 

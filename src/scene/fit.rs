@@ -1,0 +1,508 @@
+//! Fitting a datapath to a scene: image-space budgets, the judge that renders a candidate
+//! datapath's image from traced fragments and compares it with f64 cos^n, the f64 floor of
+//! each algorithm, and the search space (only the scene's exponents, the input, coefficient
+//! and output formats searched as well as the internal stages).
+//!
+//! Every figure is over every input the scene produces: each candidate's image is shaded from
+//! every fragment and light with the datapath's bit-accurate output for that input's code.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::Serialize;
+
+use crate::analysis::optimize::{search, Candidate, Choices, Knob, SearchResult, Space, Verdict};
+use crate::error::Error;
+use crate::fixed::Rounding;
+use crate::pipeline::walk::Stage;
+use crate::pipeline::{Config, Datapath, Variant};
+use crate::scene::render::{
+    cos_n_lobe, difference_of, flip_of, image_error_of, DatapathLobe, Fragments,
+    Encoder, ImageError, ModelLobe,
+};
+use crate::scene::Scene;
+
+/// An image-space quantity a budget bounds (every one against the f64 cos^n image).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ImageMetric {
+    /// The largest channel difference of any pixel, in display LSBs (`max_lsb`).
+    MaxLsb,
+    /// The mean over covered pixels of the largest channel difference (`mean_lsb`).
+    MeanLsb,
+    /// The share of covered pixels with any channel different (`differing`).
+    Differing,
+    /// The mean FLIP over covered pixels (`flip`).
+    Flip,
+}
+
+impl ImageMetric {
+    /// The name in budget expressions.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImageMetric::MaxLsb => "max_lsb",
+            ImageMetric::MeanLsb => "mean_lsb",
+            ImageMetric::Differing => "differing",
+            ImageMetric::Flip => "flip",
+        }
+    }
+
+    /// The metric's value in an image's figures.
+    pub fn of(self, e: &ImageError) -> f64 {
+        match self {
+            ImageMetric::MaxLsb => f64::from(e.max_lsb),
+            ImageMetric::MeanLsb => e.mean_lsb,
+            ImageMetric::Differing => e.differing,
+            ImageMetric::Flip => e.flip_mean,
+        }
+    }
+}
+
+/// One bound `metric <= limit`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ImageBound {
+    /// The metric.
+    pub metric: ImageMetric,
+    /// The limit (LSBs, a fraction, or a FLIP value).
+    pub limit: f64,
+}
+
+/// An image-space budget: every bound must hold over the covered pixels.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ImageBudget {
+    /// The budget as text (`max_lsb <= 31 and differing <= 13.3% and flip <= 0.0141`).
+    pub text: String,
+    /// The bounds.
+    pub bounds: Vec<ImageBound>,
+}
+
+impl FromStr for ImageBudget {
+    type Err = Error;
+    /// Parses `max_lsb <= 2`, `mean_lsb <= 0.1`, `differing <= 1%` (or `0.01`), `flip <=
+    /// 0.01`, several joined by `and` or `,`.
+    fn from_str(s: &str) -> Result<Self, Error> {
+        let bad = |part: &str, why: &str| Error::Config {
+            key: "budget".into(),
+            problem: format!(
+                "{why} in '{part}'; expected e.g. 'max_lsb <= 2 and differing <= 1% and flip <= 0.01' (metrics max_lsb, mean_lsb, differing, flip)"
+            ),
+        };
+        let mut bounds = Vec::new();
+        for part in s.split(',').flat_map(|p| p.split(" and ")) {
+            let part = part.trim();
+            let Some((lhs, rhs)) = part.split_once("<=") else {
+                return Err(bad(part, "no <="));
+            };
+            let metric = match lhs.trim() {
+                "max_lsb" => ImageMetric::MaxLsb,
+                "mean_lsb" => ImageMetric::MeanLsb,
+                "differing" => ImageMetric::Differing,
+                "flip" => ImageMetric::Flip,
+                other => return Err(bad(part, &format!("unknown metric '{other}'"))),
+            };
+            let rhs = rhs.trim();
+            let (number, percent) = match rhs.strip_suffix('%') {
+                Some(n) if metric == ImageMetric::Differing => (n.trim(), true),
+                Some(_) => return Err(bad(part, "only differing takes a percentage")),
+                None => (rhs, false),
+            };
+            let value: f64 = number
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| bad(part, "no non-negative number"))?;
+            let limit = if percent { value / 100.0 } else { value };
+            bounds.push(ImageBound { metric, limit });
+        }
+        Ok(ImageBudget {
+            text: s.trim().to_string(),
+            bounds,
+        })
+    }
+}
+
+impl fmt::Display for ImageBudget {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+impl ImageBudget {
+    /// "No worse than `e`": its max and mean LSBs, differing share and FLIP mean as limits
+    /// (the default budget of `fit`, with `e` the generic datapath's figures).
+    pub fn no_worse_than(e: &ImageError) -> ImageBudget {
+        // Limits rounded up to readable figures (the generic datapath still meets them).
+        let up = |x: f64, digits: i32| {
+            let scale = 10f64.powi(digits);
+            (x * scale).ceil() / scale
+        };
+        let (differing, flip) = (up(100.0 * e.differing, 2), up(e.flip_mean, 5));
+        let bounds = vec![
+            ImageBound {
+                metric: ImageMetric::MaxLsb,
+                limit: f64::from(e.max_lsb),
+            },
+            ImageBound {
+                metric: ImageMetric::Differing,
+                limit: differing / 100.0,
+            },
+            ImageBound {
+                metric: ImageMetric::Flip,
+                limit: flip,
+            },
+        ];
+        let text = format!("max_lsb <= {} and differing <= {differing}% and flip <= {flip}", e.max_lsb);
+        ImageBudget { text, bounds }
+    }
+
+    /// Whether FLIP must be computed to judge.
+    pub fn needs_flip(&self) -> bool {
+        self.bounds.iter().any(|b| b.metric == ImageMetric::Flip)
+    }
+
+    /// Whether the figures meet every bound.
+    pub fn met_by(&self, e: &ImageError) -> bool {
+        self.bounds.iter().all(|b| b.metric.of(e) <= b.limit)
+    }
+
+    /// The largest value/limit ratio (at most 1 when met; a zero limit counts a non-zero
+    /// value as a ratio of value / 1e-12).
+    pub fn excess(&self, e: &ImageError) -> f64 {
+        self.bounds
+            .iter()
+            .map(|b| b.metric.of(e) / b.limit.max(1e-12))
+            .fold(0.0, f64::max)
+    }
+
+    /// The budget's bounds without FLIP.
+    pub fn without_flip(&self) -> ImageBudget {
+        ImageBudget {
+            text: self.text.clone(),
+            bounds: self
+                .bounds
+                .iter()
+                .filter(|b| b.metric != ImageMetric::Flip)
+                .copied()
+                .collect(),
+        }
+    }
+}
+
+/// Judges datapaths on a traced scene: the datapath's image against the f64 cos^n image.
+pub struct SceneJudge<'a> {
+    scene: &'a Scene,
+    frags: &'a Fragments,
+    /// The f64 cos^n image (display codes).
+    pub reference: Vec<[u16; 3]>,
+    /// Pixels with a specular term (the only ones a datapath changes).
+    lit: Vec<u32>,
+}
+
+impl<'a> SceneJudge<'a> {
+    /// The judge of a scene, against cos^n with the classic coefficient of `form`.
+    pub fn new(
+        scene: &'a Scene,
+        frags: &'a Fragments,
+        form: crate::reference::normalisation::Form,
+    ) -> SceneJudge<'a> {
+        let reference = frags.shade(&cos_n_lobe(scene, form));
+        let lit = (0..frags.base.len())
+            .filter(|&p| !frags.terms_of(p).is_empty())
+            .map(|p| p as u32)
+            .collect();
+        SceneJudge {
+            scene,
+            frags,
+            reference,
+            lit,
+        }
+    }
+
+    /// The image of a lobe: the reference everywhere no light adds a specular term.
+    pub fn image(&self, lobe: &(dyn Fn(usize, f64) -> f64 + Sync)) -> Vec<[u16; 3]> {
+        use rayon::prelude::*;
+        let f = self.frags;
+        let enc = Encoder::of(f.bits);
+        let lit: Vec<(u32, [u16; 3])> = self
+            .lit
+            .par_iter()
+            .map(|&p| {
+                let mut rad = f.base[p as usize];
+                for t in f.terms_of(p as usize) {
+                    let f_s = lobe(usize::from(t.material), t.c);
+                    for (r, w) in rad.iter_mut().zip(t.weight) {
+                        *r += f_s * w;
+                    }
+                }
+                (p, rad.map(|x| enc.encode(x)))
+            })
+            .collect();
+        let mut image = self.reference.clone();
+        for (p, c) in lit {
+            image[p as usize] = c;
+        }
+        image
+    }
+
+    /// The datapath's image.
+    pub fn datapath_image(&self, dp: &Datapath) -> Vec<[u16; 3]> {
+        let table = DatapathLobe::new(dp, self.scene);
+        self.image(&|m, c| table.eval(m, c))
+    }
+
+    /// The f64 model image of a datapath's algorithm and coefficient (its floor).
+    pub fn model_image(&self, dp: &Datapath) -> Vec<[u16; 3]> {
+        let model = ModelLobe::new(dp, self.scene);
+        self.image(&|m, c| model.eval(m, c))
+    }
+
+    /// An image's figures against the reference over every covered pixel (material `m`, or
+    /// all), with FLIP when asked.
+    pub fn figures(&self, image: &[[u16; 3]], m: Option<u16>, flip: bool) -> ImageError {
+        let flip = if flip { self.flip(image) } else { Vec::new() };
+        image_error_of(
+            &self.frags.material,
+            &difference_of(image, &self.reference),
+            m,
+            &flip,
+        )
+    }
+
+    /// Per-pixel FLIP of an image against the reference.
+    pub fn flip(&self, image: &[[u16; 3]]) -> Vec<f32> {
+        let f = self.frags;
+        flip_of((f.width, f.height, f.bits), image, &self.reference)
+    }
+
+    /// The verdict of an image on a budget (FLIP computed only when the other bounds hold).
+    pub fn verdict(&self, image: &[[u16; 3]], budget: &ImageBudget) -> Verdict {
+        let cheap = self.figures(image, None, false);
+        let rest = budget.without_flip();
+        if !rest.met_by(&cheap) || !budget.needs_flip() {
+            return Verdict {
+                feasible: rest.met_by(&cheap) && budget.met_by(&cheap),
+                excess: rest.excess(&cheap).max(budget.excess(&cheap)),
+            };
+        }
+        let full = self.figures(image, None, true);
+        Verdict {
+            feasible: budget.met_by(&full),
+            excess: budget.excess(&full),
+        }
+    }
+}
+
+/// The f64 floor of one algorithm on the scene: the image of its f64 model (no quantization).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Floor {
+    /// Squarings.
+    pub k: u32,
+    /// Variant.
+    pub variant: Variant,
+    /// The f64 model image's figures against cos^n (`None`: the algorithm is not valid for
+    /// the scene's exponents; `reason` says why).
+    pub figures: Option<ImageError>,
+    /// Why there are no figures.
+    pub reason: Option<String>,
+    /// Whether the floor meets the budget (the search tries only those that do).
+    pub meets: bool,
+}
+
+/// The starting configuration of an algorithm: the base's with k squarings and a variant,
+/// every internal stage at `start_frac` fraction bits.
+pub fn start_config(base: &Config, k: u32, variant: Variant, start_frac: i32) -> Result<Config, Error> {
+    let mut cfg = base.clone();
+    cfg.k = k;
+    cfg.variant = variant;
+    cfg.square = vec![base.square[0]; k as usize];
+    let mut stages = vec![Stage::T, Stage::B];
+    stages.extend((0..k as usize).map(Stage::Square));
+    for s in stages {
+        Knob::Frac(s).set(&mut cfg, start_frac)?;
+    }
+    Ok(cfg)
+}
+
+/// The f64 floor of every algorithm (k = 1..=7, plain and minimax) on the scene.
+pub fn floors(
+    judge: &SceneJudge<'_>,
+    base: &Config,
+    budget: &ImageBudget,
+    start_frac: i32,
+) -> Vec<Floor> {
+    let mut v = Vec::new();
+    for k in 1..=7 {
+        for variant in [Variant::Plain, Variant::Minimax] {
+            let dp = start_config(base, k, variant, start_frac).and_then(Datapath::new);
+            let floor = match dp {
+                Err(e) => Floor {
+                    k,
+                    variant,
+                    figures: None,
+                    reason: Some(e.to_string()),
+                    meets: false,
+                },
+                Ok(dp) => {
+                    let image = judge.model_image(&dp);
+                    let e = judge.figures(&image, None, budget.needs_flip());
+                    Floor {
+                        k,
+                        variant,
+                        figures: Some(e),
+                        reason: None,
+                        meets: budget.met_by(&e),
+                    }
+                }
+            };
+            v.push(floor);
+        }
+    }
+    v
+}
+
+/// The search space of one algorithm: the internal stages from `start_frac` fraction bits,
+/// then the input's fraction bits, the coefficient's integer and fraction bits and the
+/// output's; TRN or RND everywhere, then per-stage rounding moves; overflow modes are kept
+/// (a scene proves nothing about inputs it does not produce).
+pub fn fit_space(k: u32, variant: Variant, start_frac: i32) -> Space {
+    Space {
+        choices: Choices {
+            k: vec![k],
+            variants: vec![variant],
+            roundings: vec![Rounding::Trn, Rounding::Rnd],
+        },
+        start_frac,
+        extra_knobs: vec![
+            Knob::InputFrac,
+            Knob::CoefInt,
+            Knob::CoefFrac,
+            Knob::Frac(Stage::Out),
+            Knob::OutInt,
+        ],
+        local_roundings: vec![Rounding::Trn, Rounding::Rnd],
+        overflow_moves: false,
+    }
+}
+
+/// The search's objective: the generic analytic LUTs of the pipelined datapath (multipliers
+/// as logic) plus its constant ROM's.
+pub fn objective(dp: &Datapath) -> u64 {
+    crate::hdl::cost::analytic_cost(
+        dp,
+        crate::cycle::Arch::Pipelined,
+        crate::hdl::cost::Target::Generic,
+    )
+    .luts
+        + crate::hdl::rom::constant_rom(dp, crate::hdl::cost::Target::Generic).luts
+}
+
+/// What the fit's search found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitSearch {
+    /// The cheapest datapath meeting the budget, if any.
+    pub best: Option<Candidate>,
+    /// The closest one otherwise.
+    pub closest: Option<Candidate>,
+    /// Candidates judged.
+    pub n_evaluations: u64,
+    /// Why the answer is minimal within the search.
+    pub minimality: Vec<String>,
+}
+
+/// Searches every algorithm whose floor meets the budget (in parallel, results combined in
+/// the floors' order), then the base itself: the cheapest datapath by [`objective`] whose
+/// image meets `budget` on every input of the scene.
+///
+/// FLIP is the costly metric (a full-image filter); each algorithm is first searched with
+/// the budget's other bounds, and its answer checked with FLIP too; only when that fails is
+/// the algorithm searched again with the whole budget. Minimality holds either way: a point
+/// that breaks the looser budget breaks the whole one.
+pub fn fit_search(
+    judge: &SceneJudge<'_>,
+    base: &Config,
+    budget: &ImageBudget,
+    floors: &[Floor],
+    start_frac: i32,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<FitSearch, Error> {
+    use rayon::prelude::*;
+    let cheap = budget.without_flip();
+    let results: Vec<Result<(SearchResult, u64), Error>> = floors
+        .par_iter()
+        .filter(|f| f.meets)
+        .map(|f| {
+            let name = format!("k = {}, {}", f.k, f.variant.name());
+            let space = fit_space(f.k, f.variant, start_frac);
+            let mut cost = |dp: &Datapath| -> Result<f64, Error> { Ok(objective(dp) as f64) };
+            let mut lines = |line: &str| progress(&format!("{name}: {line}"));
+            let run = |b: &ImageBudget,
+                       cost: &mut dyn FnMut(&Datapath) -> Result<f64, Error>,
+                       lines: &mut dyn FnMut(&str)| {
+                let mut j = |dp: &Datapath| -> Result<Verdict, Error> {
+                    Ok(judge.verdict(&judge.datapath_image(dp), b))
+                };
+                search(base, &space, &mut j, cost, lines)
+            };
+            let mut r = run(&cheap, &mut cost, &mut lines)?;
+            let mut extra = 0;
+            if budget.needs_flip() {
+                if let Some(b) = &r.best {
+                    extra += 1;
+                    let dp = Datapath::new(b.config.clone())?;
+                    if !judge.verdict(&judge.datapath_image(&dp), budget).feasible {
+                        progress(&format!("{name}: FLIP breaks the budget, searching again with it"));
+                        let n = r.n_evaluations;
+                        r = run(budget, &mut cost, &mut lines)?;
+                        extra += n;
+                    }
+                }
+            }
+            progress(&format!(
+                "{name}: {}",
+                r.best
+                    .as_ref()
+                    .map_or("nothing fits".to_string(), |b| format!("{:.0} LUTs", b.cost))
+            ));
+            Ok((r, extra))
+        })
+        .collect();
+    let mut out = FitSearch {
+        best: None,
+        closest: None,
+        n_evaluations: 0,
+        minimality: Vec::new(),
+    };
+    for r in results {
+        let (r, extra) = r?;
+        out.n_evaluations += r.n_evaluations + extra;
+        if let Some(b) = r.best {
+            if out.best.as_ref().is_none_or(|x| b.cost < x.cost) {
+                out.best = Some(b);
+                out.minimality = r.minimality;
+            }
+        } else if let Some(c) = r.closest {
+            if out.closest.as_ref().is_none_or(|x| c.excess < x.excess) {
+                out.closest = Some(c);
+            }
+        }
+    }
+    // The base restricted to the scene's exponents renders the scene exactly as the generic
+    // datapath does: a candidate too, so a budget the generic datapath meets has an answer.
+    let dp = Datapath::new(base.clone())?;
+    let v = judge.verdict(&judge.datapath_image(&dp), budget);
+    out.n_evaluations += 1;
+    let cost = objective(&dp) as f64;
+    if v.feasible && out.best.as_ref().is_none_or(|b| cost < b.cost) {
+        out.minimality = vec![
+            "the base datapath restricted to the scene's exponents: no searched point was cheaper"
+                .into(),
+        ];
+        out.best = Some(Candidate {
+            config: base.clone(),
+            cost,
+            feasible: true,
+            excess: v.excess,
+        });
+    }
+    Ok(out)
+}
