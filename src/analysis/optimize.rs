@@ -187,6 +187,10 @@ pub enum Knob {
     CoefInt,
     /// The integer bits of the output (fewer saturate the brightest outputs).
     OutInt,
+    /// The fraction bits of the minimax slope A(n).
+    MinimaxSlopeFrac,
+    /// The fraction bits of the minimax offset A(n) + B(n).
+    MinimaxOffsetFrac,
 }
 
 impl fmt::Display for Knob {
@@ -197,6 +201,8 @@ impl fmt::Display for Knob {
             Knob::CoefFrac => f.write_str("coef fraction bits"),
             Knob::CoefInt => f.write_str("coef integer bits"),
             Knob::OutInt => f.write_str("out integer bits"),
+            Knob::MinimaxSlopeFrac => f.write_str("minimax slope fraction bits"),
+            Knob::MinimaxOffsetFrac => f.write_str("minimax offset fraction bits"),
         }
     }
 }
@@ -210,6 +216,8 @@ impl Knob {
             Knob::CoefFrac => cfg.coef.format.frac_bits(),
             Knob::CoefInt => cfg.coef.format.int_bits(),
             Knob::OutInt => cfg.out.format.int_bits(),
+            Knob::MinimaxSlopeFrac => cfg.minimax.a_format.frac_bits(),
+            Knob::MinimaxOffsetFrac => cfg.minimax.offset_format.frac_bits(),
         }
     }
 
@@ -230,6 +238,10 @@ impl Knob {
             Knob::OutInt => {
                 let f = cfg.out.format;
                 cfg.out.format = Format::new(f.is_signed(), v, f.frac_bits())?;
+            }
+            Knob::MinimaxSlopeFrac => cfg.minimax.a_format = with_frac(cfg.minimax.a_format)?,
+            Knob::MinimaxOffsetFrac => {
+                cfg.minimax.offset_format = with_frac(cfg.minimax.offset_format)?
             }
         }
         Ok(())
@@ -504,7 +516,11 @@ pub fn search(
             for &s in &stages {
                 let spec = *spec_mut(&mut current.config.clone(), s);
                 let mut trials = Vec::new();
-                for &r in space.local_roundings.iter().filter(|&&r| r != spec.rounding) {
+                for &r in space
+                    .local_roundings
+                    .iter()
+                    .filter(|&&r| r != spec.rounding)
+                {
                     let mut trial = current.config.clone();
                     spec_mut(&mut trial, s).rounding = r;
                     if s != Stage::Out {

@@ -116,8 +116,7 @@ pub fn run_yosys_rom(dp: &Datapath, target: Target) -> Result<(YosysCost, String
     let work = tempfile::tempdir().context("cannot create a temporary directory")?;
     let file = work.path().join("specfx_rom.v");
     std::fs::write(&file, rom_verilog(dp))?;
-    yosys_in(work.path(), &[file], "specfx_rom", target)
-        .context("yosys failed on the constant ROM")
+    yosys_in(work.path(), &[file], "specfx_rom", target).context("yosys failed on the constant ROM")
 }
 
 /// Runs yosys in `work` on `files` with `top`: (cost, version, script).

@@ -17,7 +17,9 @@ use specfx::hdl::rom::{constant_rom, rom_verilog};
 use specfx::nset::NSet;
 use specfx::pipeline::{Config, Datapath};
 use specfx::report::scene::{heatmap_png, path_png};
-use specfx::scene::fit::{fit_search, floors, objective, FitSearch, Floor, ImageBudget, SceneJudge};
+use specfx::scene::fit::{
+    fit_search, floors, objective, FitSearch, Floor, ImageBudget, SceneFigures, SceneJudge,
+};
 use specfx::scene::render::{difference_of, image_error, render_fragments, ImageError, Rendered};
 use specfx::scene::Scene;
 
@@ -183,7 +185,9 @@ pub fn run(args: &FitArgs) -> Result<Outcome> {
     let label = args
         .scene
         .as_ref()
-        .map_or("the built-in scene".to_string(), |p| p.display().to_string());
+        .map_or("the built-in scene".to_string(), |p| {
+            p.display().to_string()
+        });
     match fit_scene(&scene, &label, args)? {
         None => Ok(Outcome::CheckFailed),
         Some(report) => {
@@ -206,13 +210,20 @@ fn generic_datapath(config: &str, scene: &Scene) -> Result<Datapath> {
         return Ok(dp);
     }
     let lo = dp.config().n.min().min(ns[0]);
-    let hi = dp.config().n.max().max(*ns.last().expect("a scene has materials"));
+    let hi = dp
+        .config()
+        .n
+        .max()
+        .max(*ns.last().expect("a scene has materials"));
     Ok(super::datapath::load(config, Some(&NSet::range(lo, hi)?))?)
 }
 
 /// Fits a datapath to `scene` and writes everything into `args.out`; `None` when nothing
 /// meets the budget (the floors and the closest point are printed).
 pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<FitReport>> {
+    if let Some(b) = &args.budget {
+        b.check_materials(scene)?;
+    }
     let generic = generic_datapath(&args.config, scene)?;
     let form = generic.config().coef.form;
     eprintln!(
@@ -225,10 +236,11 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
     let frags = super::render::trace_with_progress(scene);
     let judge = SceneJudge::new(scene, &frags, form);
     let generic_image = judge.datapath_image(&generic);
-    let generic_all = judge.figures(&generic_image, None, true);
+    let generic_figures = judge.figures(&generic_image, true);
+    let generic_all = generic_figures.all;
     let (budget, default_budget) = match &args.budget {
         Some(b) => (b.clone(), false),
-        None => (ImageBudget::no_worse_than(&generic_all), true),
+        None => (ImageBudget::no_worse_than(scene, &generic_figures), true),
     };
     eprintln!(
         "fit: generic datapath {} on the scene: max {} LSB, {:.2}% differing, FLIP {:.5}; budget '{}'",
@@ -250,7 +262,7 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
         minimality,
     } = found;
     let Some(best) = best else {
-        print_no_fit(&floors, closest.as_ref(), &judge, &budget)?;
+        print_no_fit(&floors, closest.as_ref(), &judge, scene, &budget)?;
         return Ok(None);
     };
     let mut fitted_cfg = best.config.clone();
@@ -261,10 +273,6 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
     let generic_r = render_fragments(scene, &frags, &generic);
     let flip_fitted = specfx::scene::render::flip_errors(&fitted_r, 2, 0);
     let flip_generic = specfx::scene::render::flip_errors(&generic_r, 2, 0);
-    let fitted_all = image_error(&fitted_r, 2, 0, None, &flip_fitted);
-    if !budget.met_by(&fitted_all) || fitted_r.codes[2] != judge.datapath_image(&fitted) {
-        bail!("the fitted datapath does not meet the budget on re-render: this is a bug");
-    }
     let mut rows: Vec<FitRow> = scene
         .materials
         .iter()
@@ -276,6 +284,14 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
             fitted: image_error(&fitted_r, 2, 0, Some(i as u16), &flip_fitted),
         })
         .collect();
+    let fitted_all = image_error(&fitted_r, 2, 0, None, &flip_fitted);
+    let proof = SceneFigures {
+        all: fitted_all,
+        materials: rows.iter().map(|r| r.fitted).collect(),
+    };
+    if !budget.met_by(scene, &proof) || fitted_r.codes[2] != judge.datapath_image(&fitted) {
+        bail!("the fitted datapath does not meet the budget on re-render: this is a bug");
+    }
     rows.push(FitRow {
         material: "all".into(),
         n: 0,
@@ -413,7 +429,7 @@ fn summary(r: &FitReport) -> String {
 fn floors_markdown(floors: &[Floor]) -> String {
     let mut s = "| k | variant | f64 floor: max LSB | mean LSB | differing | FLIP | meets the budget |\n|---:|---|---:|---:|---:|---:|---|\n".to_string();
     for f in floors {
-        match (&f.figures, &f.reason) {
+        match (f.figures.as_ref().map(|e| &e.all), &f.reason) {
             (Some(e), _) => s.push_str(&format!(
                 "| {} | {} | {} | {:.4} | {:.2}% | {:.5} | {} |\n",
                 f.k,
@@ -440,6 +456,7 @@ fn print_no_fit(
     floors: &[Floor],
     closest: Option<&Candidate>,
     judge: &SceneJudge<'_>,
+    scene: &Scene,
     budget: &ImageBudget,
 ) -> Result<()> {
     println!("fit: no datapath meets '{budget}' on this scene");
@@ -447,21 +464,18 @@ fn print_no_fit(
     print!("{}", floors_markdown(floors));
     let best_floor = floors
         .iter()
-        .filter_map(|f| f.figures.map(|e| (f, budget.excess(&e), e)))
+        .filter_map(|f| f.figures.as_ref().map(|e| (f, budget.excess(scene, e))))
         .min_by(|a, b| a.1.total_cmp(&b.1));
-    if let Some((f, _, e)) = best_floor {
+    if let Some((f, excess)) = best_floor {
         println!(
-            "the closest algorithm is k = {}, {}: a budget it can meet is 'max_lsb <= {} and differing <= {:.2}% and flip <= {:.5}' (or a scene with lower exponents)",
+            "the closest algorithm is k = {}, {}, whose f64 floor alone is {excess:.2}x the budget: no quantization can do better; loosen the budget to its floor's figures (see the table) or lower the scene's exponents",
             f.k,
             f.variant.name(),
-            e.max_lsb,
-            100.0 * e.differing,
-            e.flip_mean
         );
     }
     if let Some(c) = closest {
         let dp = Datapath::new(c.config.clone())?;
-        let e = judge.figures(&judge.datapath_image(&dp), None, true);
+        let e = judge.figures(&judge.datapath_image(&dp), true).all;
         println!(
             "closest datapath searched: k = {}, {}: max {} LSB, {:.2}% differing, FLIP {:.5} ({:.2}x the budget)",
             c.config.k,
@@ -513,7 +527,11 @@ fn fit_markdown(r: &FitReport) -> String {
         ("exponents served", g.rom_entries, f.rom_entries),
         ("ROM bits", g.rom_bits, f.rom_bits),
         ("analytic LUTs, datapath", g.analytic_luts, f.analytic_luts),
-        ("analytic LUTs, ROM", g.rom_analytic_luts, f.rom_analytic_luts),
+        (
+            "analytic LUTs, ROM",
+            g.rom_analytic_luts,
+            f.rom_analytic_luts,
+        ),
         (
             "analytic LUTs, total",
             g.analytic_total_luts,

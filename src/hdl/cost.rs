@@ -246,9 +246,7 @@ pub fn yosys_script(target: Target, files: &[String], include_dir: &str, top: &s
             s.push_str("tee -q -o stat_cmos.txt stat -tech cmos\n");
         }
         Target::Ice40 => s.push_str(&format!("synth_ice40 -top {top} -dsp\n")),
-        Target::Xilinx => s.push_str(&format!(
-            "synth_xilinx -top {top} -family xc7 -flatten\n"
-        )),
+        Target::Xilinx => s.push_str(&format!("synth_xilinx -top {top} -family xc7 -flatten\n")),
     }
     s.push_str("tee -q -o stat.json stat -json\n");
     s

@@ -17,8 +17,8 @@ use crate::fixed::Rounding;
 use crate::pipeline::walk::Stage;
 use crate::pipeline::{Config, Datapath, Variant};
 use crate::scene::render::{
-    cos_n_lobe, difference_of, flip_of, image_error_of, DatapathLobe, Fragments,
-    Encoder, ImageError, ModelLobe,
+    cos_n_lobe, difference_of, flip_of, image_error_of, DatapathLobe, Encoder, Fragments,
+    ImageError, ModelLobe,
 };
 use crate::scene::Scene;
 
@@ -58,11 +58,14 @@ impl ImageMetric {
     }
 }
 
-/// One bound `metric <= limit`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// One bound `metric <= limit`, over every covered pixel or one material's
+/// (`metric[material] <= limit`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ImageBound {
     /// The metric.
     pub metric: ImageMetric,
+    /// The material whose pixels it covers (`None`: every covered pixel).
+    pub material: Option<String>,
     /// The limit (LSBs, a fraction, or a FLIP value).
     pub limit: f64,
 }
@@ -79,13 +82,16 @@ pub struct ImageBudget {
 impl FromStr for ImageBudget {
     type Err = Error;
     /// Parses `max_lsb <= 2`, `mean_lsb <= 0.1`, `differing <= 1%` (or `0.01`), `flip <=
-    /// 0.01`, several joined by `and` or `,`.
+    /// 0.01`, each over every covered pixel or one material's (`max_lsb[vessel] <= 4`),
+    /// several joined by `and` or `,`.
     fn from_str(s: &str) -> Result<Self, Error> {
-        let bad = |part: &str, why: &str| Error::Config {
+        let bad = |part: &str, why: &str| {
+            Error::Config {
             key: "budget".into(),
             problem: format!(
-                "{why} in '{part}'; expected e.g. 'max_lsb <= 2 and differing <= 1% and flip <= 0.01' (metrics max_lsb, mean_lsb, differing, flip)"
+                "{why} in '{part}'; expected e.g. 'max_lsb <= 2 and differing <= 1% and flip <= 0.01' (metrics max_lsb, mean_lsb, differing, flip; metric[material] for one material)"
             ),
+        }
         };
         let mut bounds = Vec::new();
         for part in s.split(',').flat_map(|p| p.split(" and ")) {
@@ -93,7 +99,15 @@ impl FromStr for ImageBudget {
             let Some((lhs, rhs)) = part.split_once("<=") else {
                 return Err(bad(part, "no <="));
             };
-            let metric = match lhs.trim() {
+            let lhs = lhs.trim();
+            let (name, material) = match lhs.split_once('[') {
+                Some((name, rest)) => match rest.strip_suffix(']') {
+                    Some(m) if !m.trim().is_empty() => (name.trim(), Some(m.trim().to_string())),
+                    _ => return Err(bad(part, "a material is written metric[name]")),
+                },
+                None => (lhs, None),
+            };
+            let metric = match name {
                 "max_lsb" => ImageMetric::MaxLsb,
                 "mean_lsb" => ImageMetric::MeanLsb,
                 "differing" => ImageMetric::Differing,
@@ -112,7 +126,11 @@ impl FromStr for ImageBudget {
                 .filter(|v: &f64| v.is_finite() && *v >= 0.0)
                 .ok_or_else(|| bad(part, "no non-negative number"))?;
             let limit = if percent { value / 100.0 } else { value };
-            bounds.push(ImageBound { metric, limit });
+            bounds.push(ImageBound {
+                metric,
+                material,
+                limit,
+            });
         }
         Ok(ImageBudget {
             text: s.trim().to_string(),
@@ -128,31 +146,63 @@ impl fmt::Display for ImageBudget {
 }
 
 impl ImageBudget {
-    /// "No worse than `e`": its max and mean LSBs, differing share and FLIP mean as limits
-    /// (the default budget of `fit`, with `e` the generic datapath's figures).
-    pub fn no_worse_than(e: &ImageError) -> ImageBudget {
-        // Limits rounded up to readable figures (the generic datapath still meets them).
+    /// "No worse than `figures`" for every material: each material's max LSBs, differing share
+    /// and FLIP mean as its limits (the default budget of `fit`, with the generic datapath's
+    /// figures; limits rounded up to readable figures, which the generic datapath still meets).
+    pub fn no_worse_than(scene: &Scene, figures: &SceneFigures) -> ImageBudget {
         let up = |x: f64, digits: i32| {
             let scale = 10f64.powi(digits);
             (x * scale).ceil() / scale
         };
-        let (differing, flip) = (up(100.0 * e.differing, 2), up(e.flip_mean, 5));
-        let bounds = vec![
-            ImageBound {
+        let mut bounds = Vec::new();
+        let mut text = Vec::new();
+        for (m, e) in scene.materials.iter().zip(&figures.materials) {
+            let (differing, flip) = (up(100.0 * e.differing, 2), up(e.flip_mean, 5));
+            let name = Some(m.name.clone());
+            bounds.push(ImageBound {
                 metric: ImageMetric::MaxLsb,
+                material: name.clone(),
                 limit: f64::from(e.max_lsb),
-            },
-            ImageBound {
+            });
+            bounds.push(ImageBound {
                 metric: ImageMetric::Differing,
+                material: name.clone(),
                 limit: differing / 100.0,
-            },
-            ImageBound {
+            });
+            bounds.push(ImageBound {
                 metric: ImageMetric::Flip,
+                material: name,
                 limit: flip,
-            },
-        ];
-        let text = format!("max_lsb <= {} and differing <= {differing}% and flip <= {flip}", e.max_lsb);
-        ImageBudget { text, bounds }
+            });
+            text.push(format!(
+                "max_lsb[{0}] <= {1} and differing[{0}] <= {differing}% and flip[{0}] <= {flip}",
+                m.name, e.max_lsb
+            ));
+        }
+        ImageBudget {
+            text: text.join(" and "),
+            bounds,
+        }
+    }
+
+    /// Checks that every material a bound names is in the scene.
+    pub fn check_materials(&self, scene: &Scene) -> Result<(), Error> {
+        for b in &self.bounds {
+            if let Some(m) = &b.material {
+                if scene.material_index(m).is_none() {
+                    let names: Vec<&str> =
+                        scene.materials.iter().map(|m| m.name.as_str()).collect();
+                    return Err(Error::Config {
+                        key: "budget".into(),
+                        problem: format!(
+                            "no material '{m}' in the scene (it has: {})",
+                            names.join(", ")
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Whether FLIP must be computed to judge.
@@ -160,17 +210,28 @@ impl ImageBudget {
         self.bounds.iter().any(|b| b.metric == ImageMetric::Flip)
     }
 
+    /// A bound's value in a scene's figures.
+    fn value(b: &ImageBound, scene: &Scene, f: &SceneFigures) -> f64 {
+        let e = match &b.material {
+            None => &f.all,
+            Some(m) => &f.materials[scene.material_index(m).expect("checked materials")],
+        };
+        b.metric.of(e)
+    }
+
     /// Whether the figures meet every bound.
-    pub fn met_by(&self, e: &ImageError) -> bool {
-        self.bounds.iter().all(|b| b.metric.of(e) <= b.limit)
+    pub fn met_by(&self, scene: &Scene, f: &SceneFigures) -> bool {
+        self.bounds
+            .iter()
+            .all(|b| Self::value(b, scene, f) <= b.limit)
     }
 
     /// The largest value/limit ratio (at most 1 when met; a zero limit counts a non-zero
     /// value as a ratio of value / 1e-12).
-    pub fn excess(&self, e: &ImageError) -> f64 {
+    pub fn excess(&self, scene: &Scene, f: &SceneFigures) -> f64 {
         self.bounds
             .iter()
-            .map(|b| b.metric.of(e) / b.limit.max(1e-12))
+            .map(|b| Self::value(b, scene, f) / b.limit.max(1e-12))
             .fold(0.0, f64::max)
     }
 
@@ -182,10 +243,19 @@ impl ImageBudget {
                 .bounds
                 .iter()
                 .filter(|b| b.metric != ImageMetric::Flip)
-                .copied()
+                .cloned()
                 .collect(),
         }
     }
+}
+
+/// An image's figures against the reference: every covered pixel, and each material's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SceneFigures {
+    /// Over every covered pixel.
+    pub all: ImageError,
+    /// Per material, in the scene's order.
+    pub materials: Vec<ImageError>,
 }
 
 /// Judges datapaths on a traced scene: the datapath's image against the f64 cos^n image.
@@ -256,16 +326,17 @@ impl<'a> SceneJudge<'a> {
         self.image(&|m, c| model.eval(m, c))
     }
 
-    /// An image's figures against the reference over every covered pixel (material `m`, or
-    /// all), with FLIP when asked.
-    pub fn figures(&self, image: &[[u16; 3]], m: Option<u16>, flip: bool) -> ImageError {
+    /// An image's figures against the reference, with FLIP when asked (else FLIP means 0).
+    pub fn figures(&self, image: &[[u16; 3]], flip: bool) -> SceneFigures {
         let flip = if flip { self.flip(image) } else { Vec::new() };
-        image_error_of(
-            &self.frags.material,
-            &difference_of(image, &self.reference),
-            m,
-            &flip,
-        )
+        let diff = difference_of(image, &self.reference);
+        let material = &self.frags.material;
+        SceneFigures {
+            all: image_error_of(material, &diff, None, &flip),
+            materials: (0..self.scene.materials.len())
+                .map(|m| image_error_of(material, &diff, Some(m as u16), &flip))
+                .collect(),
+        }
     }
 
     /// Per-pixel FLIP of an image against the reference.
@@ -276,18 +347,19 @@ impl<'a> SceneJudge<'a> {
 
     /// The verdict of an image on a budget (FLIP computed only when the other bounds hold).
     pub fn verdict(&self, image: &[[u16; 3]], budget: &ImageBudget) -> Verdict {
-        let cheap = self.figures(image, None, false);
+        let scene = self.scene;
+        let cheap = self.figures(image, false);
         let rest = budget.without_flip();
-        if !rest.met_by(&cheap) || !budget.needs_flip() {
+        if !rest.met_by(scene, &cheap) || !budget.needs_flip() {
             return Verdict {
-                feasible: rest.met_by(&cheap) && budget.met_by(&cheap),
-                excess: rest.excess(&cheap).max(budget.excess(&cheap)),
+                feasible: budget.met_by(scene, &cheap),
+                excess: budget.excess(scene, &cheap),
             };
         }
-        let full = self.figures(image, None, true);
+        let full = self.figures(image, true);
         Verdict {
-            feasible: budget.met_by(&full),
-            excess: budget.excess(&full),
+            feasible: budget.met_by(scene, &full),
+            excess: budget.excess(scene, &full),
         }
     }
 }
@@ -301,7 +373,7 @@ pub struct Floor {
     pub variant: Variant,
     /// The f64 model image's figures against cos^n (`None`: the algorithm is not valid for
     /// the scene's exponents; `reason` says why).
-    pub figures: Option<ImageError>,
+    pub figures: Option<SceneFigures>,
     /// Why there are no figures.
     pub reason: Option<String>,
     /// Whether the floor meets the budget (the search tries only those that do).
@@ -310,7 +382,12 @@ pub struct Floor {
 
 /// The starting configuration of an algorithm: the base's with k squarings and a variant,
 /// every internal stage at `start_frac` fraction bits.
-pub fn start_config(base: &Config, k: u32, variant: Variant, start_frac: i32) -> Result<Config, Error> {
+pub fn start_config(
+    base: &Config,
+    k: u32,
+    variant: Variant,
+    start_frac: i32,
+) -> Result<Config, Error> {
     let mut cfg = base.clone();
     cfg.k = k;
     cfg.variant = variant;
@@ -344,13 +421,13 @@ pub fn floors(
                 },
                 Ok(dp) => {
                     let image = judge.model_image(&dp);
-                    let e = judge.figures(&image, None, budget.needs_flip());
+                    let e = judge.figures(&image, budget.needs_flip());
                     Floor {
                         k,
                         variant,
+                        meets: budget.met_by(judge.scene, &e),
                         figures: Some(e),
                         reason: None,
-                        meets: budget.met_by(&e),
                     }
                 }
             };
@@ -365,6 +442,16 @@ pub fn floors(
 /// output's; TRN or RND everywhere, then per-stage rounding moves; overflow modes are kept
 /// (a scene proves nothing about inputs it does not produce).
 pub fn fit_space(k: u32, variant: Variant, start_frac: i32) -> Space {
+    let mut extra_knobs = vec![
+        Knob::InputFrac,
+        Knob::CoefInt,
+        Knob::CoefFrac,
+        Knob::Frac(Stage::Out),
+        Knob::OutInt,
+    ];
+    if variant == Variant::Minimax {
+        extra_knobs.extend([Knob::MinimaxSlopeFrac, Knob::MinimaxOffsetFrac]);
+    }
     Space {
         choices: Choices {
             k: vec![k],
@@ -372,13 +459,7 @@ pub fn fit_space(k: u32, variant: Variant, start_frac: i32) -> Space {
             roundings: vec![Rounding::Trn, Rounding::Rnd],
         },
         start_frac,
-        extra_knobs: vec![
-            Knob::InputFrac,
-            Knob::CoefInt,
-            Knob::CoefFrac,
-            Knob::Frac(Stage::Out),
-            Knob::OutInt,
-        ],
+        extra_knobs,
         local_roundings: vec![Rounding::Trn, Rounding::Rnd],
         overflow_moves: false,
     }
@@ -450,7 +531,9 @@ pub fn fit_search(
                     extra += 1;
                     let dp = Datapath::new(b.config.clone())?;
                     if !judge.verdict(&judge.datapath_image(&dp), budget).feasible {
-                        progress(&format!("{name}: FLIP breaks the budget, searching again with it"));
+                        progress(&format!(
+                            "{name}: FLIP breaks the budget, searching again with it"
+                        ));
                         let n = r.n_evaluations;
                         r = run(budget, &mut cost, &mut lines)?;
                         extra += n;
@@ -461,7 +544,10 @@ pub fn fit_search(
                 "{name}: {}",
                 r.best
                     .as_ref()
-                    .map_or("nothing fits".to_string(), |b| format!("{:.0} LUTs", b.cost))
+                    .map_or("nothing fits".to_string(), |b| format!(
+                        "{:.0} LUTs",
+                        b.cost
+                    ))
             ));
             Ok((r, extra))
         })
