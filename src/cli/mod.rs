@@ -7,6 +7,7 @@ pub mod budget;
 mod check;
 pub mod cost;
 mod datapath;
+mod furnace;
 mod hdl;
 mod optimize;
 mod output;
@@ -61,6 +62,8 @@ enum Command {
     Tradeoff(tradeoff::TradeoffArgs),
     /// Renders a scene through the datapath beside f64 references: images, error maps, table.
     Render(render::RenderArgs),
+    /// White-furnace check of every normalised form: reflectance against incident angle.
+    Furnace(furnace::FurnaceArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -110,6 +113,7 @@ pub fn main() -> ExitCode {
         Command::Optimize(args) => optimize::run(&args),
         Command::Tradeoff(args) => tradeoff::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Furnace(args) => furnace::run(&args),
         Command::Stability(args) => stability::run(&args),
         Command::Hdl(args) => hdl::run(&args),
         Command::Throughput(args) => throughput::run(&args),
