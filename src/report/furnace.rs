@@ -36,8 +36,25 @@ pub fn write_csv(w: &mut impl Write, r: &FurnaceReport) -> io::Result<()> {
     Ok(())
 }
 
+/// Below this, `|rho - 1|` is the quadratures' round-off and is shown as `< 1e-11`.
+const ROUND_OFF: f64 = 1e-11;
+
+/// `rho - 1` in scientific notation, or `< 1e-11`.
+fn excess(rho: f64) -> String {
+    let d = rho - 1.0;
+    if d.abs() < ROUND_OFF {
+        "< 1e-11".to_string()
+    } else {
+        format!("{d:+.2e}")
+    }
+}
+
 fn deviation_cell(rho: f64, n: u32) -> String {
-    format!("{:+.2e} (n = {n})", rho - 1.0)
+    if (rho - 1.0).abs() < ROUND_OFF {
+        excess(rho)
+    } else {
+        format!("{} (n = {n})", excess(rho))
+    }
 }
 
 /// Angles as compact runs of the run's grid: `0-25, 40` for consecutive angles of the list.
@@ -171,7 +188,7 @@ pub fn document(r: &FurnaceReport) -> Vec<Block> {
                     c.path.name().to_string(),
                     format!("{:.6}", c.coef),
                     format!("{:.6}", c.rho_normal),
-                    format!("{:+.2e}", c.rho_normal - 1.0),
+                    excess(c.rho_normal),
                     format!("{:.6}", c.max),
                     format!("{}", c.max_angle_deg),
                     flag_cell(c),
