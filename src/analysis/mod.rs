@@ -2,6 +2,7 @@
 //! exhaustive accuracy checks.
 pub mod budget;
 pub mod check;
+pub mod furnace;
 pub mod gappa;
 pub mod methods;
 pub mod optimize;

@@ -8,6 +8,7 @@ mod check;
 pub mod cost;
 mod datapath;
 pub mod fit;
+pub mod furnace;
 mod hdl;
 mod optimize;
 mod output;
@@ -65,6 +66,8 @@ enum Command {
     /// Fits the cheapest datapath to a scene: only its exponents, input range and output
     /// depth, within an image-space budget proved on every input the scene produces.
     Fit(fit::FitArgs),
+    /// White-furnace check of every normalised form: reflectance against incident angle.
+    Furnace(furnace::FurnaceArgs),
     /// Writes golden vectors: CSV, $readmemh files and a manifest.
     Vectors(vectors::VectorsArgs),
     /// Shows the cached minimax constants A(n), B(n), or recomputes the table.
@@ -115,6 +118,7 @@ pub fn main() -> ExitCode {
         Command::Tradeoff(args) => tradeoff::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Fit(args) => fit::run(&args),
+        Command::Furnace(args) => furnace::run(&args),
         Command::Stability(args) => stability::run(&args),
         Command::Hdl(args) => hdl::run(&args),
         Command::Throughput(args) => throughput::run(&args),

@@ -4,6 +4,7 @@ pub mod chart;
 pub mod check;
 pub mod csv;
 pub mod doc;
+pub mod furnace;
 pub mod paper;
 pub mod scene;
 pub mod stability;

@@ -1,0 +1,436 @@
+//! The furnace report: its document (tables per form, distance from 1, flagged values), the CSV
+//! of every reflectance, one chart per form (a panel per exponent, a line per path) and the
+//! terminal summary.
+
+use std::io::{self, Write};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::analysis::furnace::{Curve, FormSummary, FurnacePath, FurnaceReport};
+use crate::error::Error;
+use crate::report::chart::{encode_png, register_font, render_error};
+use crate::report::doc::Block;
+
+/// The file stem of a form's chart: `furnace_<form>`.
+pub fn chart_stem(form: crate::reference::normalisation::Form) -> String {
+    format!("furnace_{}", form.name())
+}
+
+/// Writes every reflectance as CSV: `form,n,path,theta_deg,rho`, one row per value.
+pub fn write_csv(w: &mut impl Write, r: &FurnaceReport) -> io::Result<()> {
+    writeln!(w, "form,n,path,theta_deg,rho")?;
+    for f in &r.forms {
+        for c in &f.curves {
+            for (theta, rho) in r.angles_deg.iter().zip(&c.rho) {
+                writeln!(
+                    w,
+                    "{},{},{},{theta},{rho}",
+                    f.form.name(),
+                    c.n,
+                    c.path.name()
+                )?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Below this, `|rho - 1|` is the quadratures' round-off and is shown as `< 1e-11`.
+const ROUND_OFF: f64 = 1e-11;
+
+/// `rho - 1` in scientific notation, or `< 1e-11`.
+fn excess(rho: f64) -> String {
+    let d = rho - 1.0;
+    if d.abs() < ROUND_OFF {
+        "< 1e-11".to_string()
+    } else {
+        format!("{d:+.2e}")
+    }
+}
+
+fn deviation_cell(rho: f64, n: u32) -> String {
+    if (rho - 1.0).abs() < ROUND_OFF {
+        excess(rho)
+    } else {
+        format!("{} (n = {n})", excess(rho))
+    }
+}
+
+/// Angles as compact runs of the run's grid: `0-25, 40` for consecutive angles of the list.
+fn angle_runs(all: &[f64], flagged: &[f64]) -> String {
+    let idx: Vec<usize> = flagged
+        .iter()
+        .filter_map(|a| all.iter().position(|b| b == a))
+        .collect();
+    let mut parts = Vec::new();
+    let mut i = 0;
+    while i < idx.len() {
+        let mut j = i;
+        while j + 1 < idx.len() && idx[j + 1] == idx[j] + 1 {
+            j += 1;
+        }
+        parts.push(if j == i {
+            format!("{}", all[idx[i]])
+        } else {
+            format!("{}-{}", all[idx[i]], all[idx[j]])
+        });
+        i = j + 1;
+    }
+    parts.join(", ")
+}
+
+fn flag_cell(c: &Curve) -> String {
+    if c.flagged_angles_deg.is_empty() {
+        String::new()
+    } else {
+        "> 1".to_string()
+    }
+}
+
+/// The furnace document: settings, the distance of rho(0) from 1 per form and coefficient
+/// source, every flagged curve, and per form a table and its chart.
+pub fn document(r: &FurnaceReport) -> Vec<Block> {
+    let summary = r.summary();
+    let mut doc = vec![
+        Block::Heading(1, format!("White furnace of {}", r.config)),
+        Block::Paragraph(format!(
+            "Directional-hemispherical reflectance rho(theta_i) = ∫ f_r cos(theta_o) dw_o of each normalised form, by deterministic quadrature (the azimuth integrated in closed form; see `docs/furnace.md`). Configuration `{}`: variant {}, m = {} (k = {}), cutoff {}, input {}, output {}. Exponents {}; incident angles {} degrees. A value is flagged when it exceeds 1 + {:.0e}.",
+            r.config,
+            r.variant,
+            r.m,
+            r.k,
+            r.cutoff.name(),
+            r.c_format,
+            r.out_format,
+            r.ns.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", "),
+            r.angles_deg.iter().map(|a| a.to_string()).collect::<Vec<_>>().join(", "),
+            r.flag_tolerance,
+        )),
+        Block::Paragraph(format!(
+            "Paths: `f64_cos_n` f64 cos^n with the classic coefficient; `f64_cs_m_paper` and `f64_cs_m_exact` the configuration's f64 lobe with the paper's (Table 1) and the exact coefficient; `datapath` the bit-accurate datapath with the form's coefficient ({} source), its input x quantized to {} as the renderer does.",
+            r.datapath_coef_source.name(),
+            r.c_format
+        )),
+        Block::Heading(2, "Distance of rho(0) from 1".into()),
+        Block::Paragraph("Per form and path, rho(0) - 1 at the exponent where |rho(0) - 1| is largest. At normal incidence rho(0) = 2 pi coef Int(n) for every form but the NDF ones, whose reflected directions need h within 45 degrees of N: this is how far each coefficient source is from normalising the lobe it is used with.".into()),
+    ];
+    let mut header = vec!["form".to_string()];
+    header.extend(
+        FurnacePath::ALL
+            .iter()
+            .map(|p| format!("{} ({})", p.name(), r.coef_source(*p).name())),
+    );
+    let rows = summary
+        .iter()
+        .map(|s| {
+            let mut row = vec![s.form.name().to_string()];
+            for p in FurnacePath::ALL {
+                row.push(
+                    s.deviations
+                        .iter()
+                        .find(|d| d.path == p)
+                        .map_or("unavailable".to_string(), |d| {
+                            deviation_cell(d.rho_normal, d.n)
+                        }),
+                );
+            }
+            row
+        })
+        .collect();
+    doc.push(Block::Table { header, rows });
+
+    doc.push(Block::Heading(2, "Flagged values".into()));
+    let mut flagged_rows = Vec::new();
+    for f in &r.forms {
+        for c in f.curves.iter().filter(|c| !c.flagged_angles_deg.is_empty()) {
+            flagged_rows.push(vec![
+                f.form.name().to_string(),
+                c.n.to_string(),
+                c.path.name().to_string(),
+                angle_runs(&r.angles_deg, &c.flagged_angles_deg),
+                format!("{:.6}", c.max),
+                format!("{}", c.max_angle_deg),
+            ]);
+        }
+    }
+    if flagged_rows.is_empty() {
+        doc.push(Block::Paragraph(
+            "No reflectance exceeds 1: every form conserves energy on every path.".into(),
+        ));
+    } else {
+        doc.push(Block::Paragraph(format!(
+            "{} curves exceed 1 somewhere ({} values). For `blinn_phong_ndf` and `blinn_phong_heightfield` a rise towards grazing incidence is the missing masking-shadowing term G of the microfacet BRDF (any normalisation of D gains energy there without it), not the coefficient; a flag at normal incidence is the coefficient's.",
+            flagged_rows.len(),
+            summary.iter().map(|s| s.n_flagged_values).sum::<usize>()
+        )));
+        doc.push(Block::Table {
+            header: ["form", "n", "path", "angles (deg)", "max rho", "at (deg)"]
+                .map(String::from)
+                .to_vec(),
+            rows: flagged_rows,
+        });
+    }
+
+    for f in &r.forms {
+        doc.push(Block::Heading(2, f.form.name().to_string()));
+        if let Some(e) = &f.datapath_unavailable {
+            doc.push(Block::Paragraph(format!(
+                "The datapath path is unavailable: the configuration with this form's coefficient does not validate ({e})."
+            )));
+        }
+        let rows = f
+            .curves
+            .iter()
+            .map(|c| {
+                vec![
+                    c.n.to_string(),
+                    c.path.name().to_string(),
+                    format!("{:.6}", c.coef),
+                    format!("{:.6}", c.rho_normal),
+                    excess(c.rho_normal),
+                    format!("{:.6}", c.max),
+                    format!("{}", c.max_angle_deg),
+                    flag_cell(c),
+                ]
+            })
+            .collect();
+        doc.push(Block::Table {
+            header: [
+                "n",
+                "path",
+                "coef",
+                "rho(0)",
+                "rho(0) - 1",
+                "max rho",
+                "at (deg)",
+                "flag",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows,
+        });
+        doc.push(Block::Figure {
+            stem: chart_stem(f.form),
+            caption: format!(
+                "{}: reflectance against incident angle, one panel per exponent, one line per path; red dots exceed 1",
+                f.form.name()
+            ),
+        });
+    }
+    doc
+}
+
+/// One line per form: the worst reflectance and the flags.
+pub fn summary_text(summary: &[FormSummary]) -> String {
+    let mut s = String::new();
+    for f in summary {
+        let worst = f.worst.map_or("no values".to_string(), |w| {
+            format!(
+                "max rho {:.6} ({}, n = {}, {} deg)",
+                w.rho,
+                w.path.name(),
+                w.n,
+                w.theta_deg
+            )
+        });
+        let flags = if f.n_flagged_values == 0 {
+            "no flags".to_string()
+        } else {
+            format!(
+                "{} values > 1 on {} curves",
+                f.n_flagged_values, f.n_flagged_curves
+            )
+        };
+        let unavailable = if f.datapath_unavailable.is_some() {
+            "; datapath unavailable"
+        } else {
+            ""
+        };
+        s.push_str(&format!(
+            "{:<24} {worst}; {flags}{unavailable}\n",
+            f.form.name()
+        ));
+    }
+    s
+}
+
+/// The colour of each path in the charts.
+fn path_colour(p: FurnacePath) -> RGBColor {
+    match p {
+        FurnacePath::F64CosN => RGBColor(40, 40, 40),
+        FurnacePath::F64CsMPaper => RGBColor(230, 130, 0),
+        FurnacePath::F64CsMExact => RGBColor(30, 100, 220),
+        FurnacePath::Datapath => RGBColor(20, 170, 90),
+    }
+}
+
+/// Line widths: the first paths drawn widest, so that lines on top of each other stay visible.
+fn path_width(p: FurnacePath) -> u32 {
+    match p {
+        FurnacePath::F64CosN => 5,
+        FurnacePath::F64CsMPaper => 3,
+        FurnacePath::F64CsMExact => 2,
+        FurnacePath::Datapath => 1,
+    }
+}
+
+const PANEL_COLS: usize = 4;
+
+fn chart_size(n_panels: usize) -> (u32, u32) {
+    let cols = n_panels.clamp(1, PANEL_COLS) as u32;
+    let rows = n_panels.div_ceil(PANEL_COLS).max(1) as u32;
+    (60 + 300 * cols, 90 + 280 * rows)
+}
+
+fn draw_form<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    r: &FurnaceReport,
+    form_idx: usize,
+) -> Result<(), Error> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| render_error(e.to_string());
+    let f = &r.forms[form_idx];
+    root.fill(&WHITE).map_err(err)?;
+    let (top, body) = root.split_vertically(70);
+    top.draw(&Text::new(
+        format!(
+            "White furnace, {} ({}): reflectance against incident angle",
+            f.form.name(),
+            r.config
+        ),
+        (16, 8),
+        ("sans-serif", 20),
+    ))
+    .map_err(err)?;
+    let mut x = 16;
+    for p in FurnacePath::ALL {
+        let c = path_colour(p);
+        top.draw(&PathElement::new(
+            vec![(x, 50), (x + 28, 50)],
+            c.stroke_width(path_width(p).max(2)),
+        ))
+        .map_err(err)?;
+        top.draw(&Text::new(p.label(), (x + 34, 42), ("sans-serif", 14)))
+            .map_err(err)?;
+        x += 210;
+    }
+    top.draw(&Circle::new((x + 6, 50), 4, RED.filled()))
+        .map_err(err)?;
+    top.draw(&Text::new("> 1", (x + 16, 42), ("sans-serif", 14)))
+        .map_err(err)?;
+
+    let n_panels = r.ns.len();
+    let cols = n_panels.clamp(1, PANEL_COLS);
+    let rows = n_panels.div_ceil(PANEL_COLS).max(1);
+    let tiles = body.split_evenly((rows, cols));
+    let x_hi = r.angles_deg.last().copied().unwrap_or(90.0).max(1.0);
+    for (tile, &n) in tiles.iter().zip(&r.ns) {
+        let curves: Vec<&Curve> = f.curves.iter().filter(|c| c.n == n).collect();
+        let (mut lo, mut hi) = (1.0f64, 1.0f64);
+        for c in &curves {
+            for &v in c.rho.iter().filter(|v| v.is_finite()) {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        let pad = 0.06 * (hi - lo).max(1e-3);
+        let (lo, hi) = (lo - pad, hi + pad);
+        let mut chart = ChartBuilder::on(tile)
+            .caption(format!("n = {n}"), ("sans-serif", 15))
+            .margin(8)
+            .x_label_area_size(34)
+            .y_label_area_size(58)
+            .build_cartesian_2d(0f64..x_hi, lo..hi)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("theta_i (deg)")
+            .y_desc("rho")
+            .x_labels(7)
+            .y_labels(6)
+            .x_label_formatter(&|x: &f64| format!("{x:.0}"))
+            .y_label_formatter(&|y: &f64| format!("{y:.3}"))
+            .label_style(("sans-serif", 12))
+            .axis_desc_style(("sans-serif", 12))
+            .draw()
+            .map_err(err)?;
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(0.0, 1.0), (x_hi, 1.0)],
+                6,
+                4,
+                RGBColor(150, 150, 150).stroke_width(1),
+            ))
+            .map_err(err)?;
+        for c in &curves {
+            let pts: Vec<(f64, f64)> = r
+                .angles_deg
+                .iter()
+                .copied()
+                .zip(c.rho.iter().copied())
+                .filter(|p| p.1.is_finite())
+                .collect();
+            let colour = path_colour(c.path);
+            chart
+                .draw_series(LineSeries::new(
+                    pts.clone(),
+                    colour.stroke_width(path_width(c.path)),
+                ))
+                .map_err(err)?;
+            if pts.len() == 1 {
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                    .map_err(err)?;
+            }
+        }
+        for c in &curves {
+            let flagged = r
+                .angles_deg
+                .iter()
+                .copied()
+                .zip(c.rho.iter().copied())
+                .filter(|&(_, v)| v > 1.0 + r.flag_tolerance);
+            chart
+                .draw_series(flagged.map(|p| Circle::new(p, 2, RED.filled())))
+                .map_err(err)?;
+        }
+    }
+    root.present().map_err(err)
+}
+
+/// A form's chart (index into [`FurnaceReport::forms`]) as SVG text.
+pub fn chart_svg(r: &FurnaceReport, form_idx: usize) -> Result<String, Error> {
+    register_font();
+    let size = chart_size(r.ns.len());
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        draw_form(root, r, form_idx)?;
+    }
+    text.push('\n');
+    Ok(text)
+}
+
+/// A form's chart (index into [`FurnaceReport::forms`]) as PNG bytes.
+pub fn chart_png(r: &FurnaceReport, form_idx: usize) -> Result<Vec<u8>, Error> {
+    register_font();
+    let size = chart_size(r.ns.len());
+    let mut rgb = vec![0u8; (size.0 * size.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        draw_form(root, r, form_idx)?;
+    }
+    encode_png(&rgb, size)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angle_runs_merge_consecutive_angles_of_the_grid() {
+        let all = [0.0, 5.0, 10.0, 15.0, 20.0];
+        assert_eq!(angle_runs(&all, &[0.0, 5.0, 10.0, 20.0]), "0-10, 20");
+        assert_eq!(angle_runs(&all, &[15.0]), "15");
+    }
+}
