@@ -55,6 +55,23 @@ pub struct FitArgs {
     json: bool,
 }
 
+impl FitArgs {
+    /// The defaults of `specfx fit` (the built-in scene, the default budget, baseline, iCE40),
+    /// writing into `out`.
+    pub fn defaults(out: PathBuf, analytic_only: bool) -> FitArgs {
+        FitArgs {
+            scene: None,
+            budget: None,
+            config: "baseline".into(),
+            target: Target::Ice40,
+            analytic_only,
+            start_frac: 20,
+            out,
+            json: false,
+        }
+    }
+}
+
 /// The cost of one datapath with its constant ROM.
 #[derive(Debug, Clone, Serialize)]
 pub struct SideCost {

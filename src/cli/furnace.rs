@@ -9,7 +9,9 @@ use clap::Args;
 
 use super::output::{print_json, write_atomic, write_figure};
 use super::Outcome;
-use specfx::analysis::furnace::{furnace, parse_angles, FurnaceSettings, DEFAULT_ANGLES};
+use specfx::analysis::furnace::{
+    furnace, parse_angles, FurnaceReport, FurnaceSettings, DEFAULT_ANGLES,
+};
 use specfx::nset::NSet;
 use specfx::report::doc::write_markdown;
 use specfx::report::furnace::{
@@ -50,9 +52,26 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
         settings.angles_deg().len(),
         dp.config().name
     );
-    let report = furnace(&dp, &settings);
-
+    let report = write_furnace(&dp, &settings, &args.out)?;
     let out = &args.out;
+    let summary = report.summary();
+    if args.json {
+        print_json(&summary)?;
+    } else {
+        print!("{}", summary_text(&summary));
+        eprintln!("furnace: wrote {}", out.display());
+    }
+    Ok(Outcome::Ok)
+}
+
+/// Runs the furnace and writes its files into `out` (charts, `furnace.md`, `.csv`, `.json`);
+/// returns the report and the files written.
+pub fn write_furnace(
+    dp: &specfx::pipeline::Datapath,
+    settings: &FurnaceSettings,
+    out: &std::path::Path,
+) -> Result<FurnaceReport> {
+    let report = furnace(dp, settings);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     for (i, f) in report.forms.iter().enumerate() {
         let svg = chart_svg(&report, i).map_err(anyhow::Error::msg)?;
@@ -68,13 +87,5 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
     let mut json = serde_json::to_vec_pretty(&report)?;
     json.push(b'\n');
     write_atomic(&out.join("furnace.json"), &json)?;
-
-    let summary = report.summary();
-    if args.json {
-        print_json(&summary)?;
-    } else {
-        print!("{}", summary_text(&summary));
-        eprintln!("furnace: wrote {}", out.display());
-    }
-    Ok(Outcome::Ok)
+    Ok(report)
 }
