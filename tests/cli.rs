@@ -154,6 +154,12 @@ fn report_writes_its_files_and_a_summary() {
         "render/datapath.png",
         "render/diff_vs_cos_n.png",
         "render/render.md",
+        "fit/fitted.toml",
+        "fit/fitted_rom.v",
+        "fit/fit.md",
+        "fit/fitted.png",
+        "furnace/furnace.md",
+        "furnace/furnace_phong.png",
         "index.html",
     ] {
         let p = dir.join(name);
@@ -167,6 +173,20 @@ fn report_writes_its_files_and_a_summary() {
     assert!(index.contains("href=\"budget_baseline/budget.html\""));
     assert!(index.contains("href=\"stability/stability.html\""));
     assert!(index.contains("src=\"render/datapath.png\""));
+    assert!(index.contains("href=\"fit/fitted.toml\""));
+    assert!(index.contains("src=\"furnace/furnace_phong.png\""));
+    // The default fit serves only the scene's four exponents, within its budget.
+    let fitted = specfx::pipeline::Config::from_toml(
+        &std::fs::read_to_string(dir.join("fit/fitted.toml")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(fitted.n.values(), &[16, 64, 256, 1024]);
+    let fit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("fit/fit.json")).unwrap()).unwrap();
+    let total = |side: &str| fit[side]["analytic_total_luts"].as_u64().unwrap();
+    assert!(total("fitted_cost") < total("generic_cost"), "{fit}");
+    assert!(out.contains("fit (built-in scene"), "{out}");
+    assert!(out.contains("furnace: 6 forms"), "{out}");
     assert!(out.contains("stability: "), "{out}");
     // The baseline's u8.16 coefficient holds coef(n) = 17 n / (32 pi) up to n = 1513.
     let regions = std::fs::read_to_string(dir.join("stability/regions.csv")).unwrap();

@@ -91,8 +91,8 @@ fn oracle_image(f: &Fragments, lobe: &dyn Fn(usize, f64) -> f64) -> Vec<[u16; 3]
             let mut rad = f.base[p];
             for t in f.terms_of(p) {
                 let s = lobe(usize::from(t.material), t.c);
-                for ch in 0..3 {
-                    rad[ch] += s * t.weight[ch];
+                for (r, w) in rad.iter_mut().zip(t.weight) {
+                    *r += s * w;
                 }
             }
             rad.map(srgb8)

@@ -232,7 +232,7 @@ fn generic_datapath(config: &str, scene: &Scene) -> Result<Datapath> {
         .n
         .max()
         .max(*ns.last().expect("a scene has materials"));
-    Ok(super::datapath::load(config, Some(&NSet::range(lo, hi)?))?)
+    super::datapath::load(config, Some(&NSet::range(lo, hi)?))
 }
 
 /// Fits a datapath to `scene` and writes everything into `args.out`; `None` when nothing

@@ -130,11 +130,7 @@ fn write_index(
     };
     writeln!(w, "<h2>No more than the scene needs</h2><p><code>specfx fit</code> on the built-in scene, with the default budget (every material no worse than the generic baseline renders it, against f64 cos^n): the fitted datapath serves only the scene's {} exponents from a {}-entry constant ROM and costs {} analytic {} LUTs with its ROM against {} for the generic n = 16..1024 datapath{}; proved on all {} inputs the scene produces. Configuration <a href=\"fit/fitted.toml\">fit/fitted.toml</a>, report <a href=\"fit/fit.md\">fit/fit.md</a>.</p><img src=\"fit/fitted.png\" alt=\"the scene through the fitted datapath\"><img src=\"fit/diff_fitted_vs_generic.png\" alt=\"fitted against generic, display LSBs\">",
         f.rom_entries, f.rom_entries, f.analytic_total_luts, fit.target, g.analytic_total_luts, yosys, fit.inputs)?;
-    let flagged: usize = furnace
-        .summary()
-        .iter()
-        .map(|s| s.n_flagged_values)
-        .sum();
+    let flagged: usize = furnace.summary().iter().map(|s| s.n_flagged_values).sum();
     writeln!(w, "<h2>Energy conservation</h2><p>The white furnace: the reflectance of each of the six normalised forms against incident angle, for f64 cos^n, the f64 lobe with the paper's and with the exact coefficient, and the bit-accurate datapath; {flagged} values above 1 are flagged (see <a href=\"furnace/furnace.md\">furnace/furnace.md</a>: the paper's coefficients overshoot slightly, the microfacet forms gain energy near grazing without a masking term).</p><img src=\"furnace/furnace_phong.png\" alt=\"white furnace, Phong\">")?;
     writeln!(w, "<h2>Every file</h2><ul>")?;
     for f in files {

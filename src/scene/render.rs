@@ -480,7 +480,7 @@ pub fn trace(scene: &Scene, progress: &(dyn Fn(usize, usize) + Sync)) -> Fragmen
         .map(|o| scene.material_index(&o.material).expect("validated"))
         .collect();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let rows: Vec<Vec<(Option<u16>, [f64; 3], Vec<Term>)>> = (0..h)
+    let rows: Vec<Vec<Fragment>> = (0..h)
         .into_par_iter()
         .map(|y| {
             let row = (0..w)
@@ -547,13 +547,11 @@ pub fn render_fragments(scene: &Scene, frags: &Fragments, dp: &Datapath) -> Rend
     }
 }
 
+/// One pixel's material (`None`: background), base radiance and specular terms.
+type Fragment = (Option<u16>, [f64; 3], Vec<Term>);
+
 /// One primary ray: the material hit, the base radiance and the specular terms.
-fn fragment(
-    scene: &Scene,
-    material_of: &[usize],
-    eye: [f64; 3],
-    dir: [f64; 3],
-) -> (Option<u16>, [f64; 3], Vec<Term>) {
+fn fragment(scene: &Scene, material_of: &[usize], eye: [f64; 3], dir: [f64; 3]) -> Fragment {
     let Some(hit) = nearest(scene, eye, dir) else {
         return (None, BACKGROUND, Vec::new());
     };
