@@ -62,7 +62,8 @@ fn index_bits(count: u64) -> u32 {
 /// let mut cfg = Config::baseline();
 /// cfg.n = NSet::from_values(&[16, 64, 256, 1024]).unwrap();
 /// let rom = constant_rom(&Datapath::new(cfg).unwrap(), Target::Ice40);
-/// assert_eq!((rom.entries, rom.address_bits, rom.bits), (4, 2, 4 * (7 + 24)));
+/// // slope: n = 1024 with k = 4 fraction bits, 11 bits.
+/// assert_eq!((rom.entries, rom.address_bits, rom.bits), (4, 2, 4 * (11 + 24)));
 /// ```
 pub fn constant_rom(dp: &Datapath, target: Target) -> ConstantRom {
     let cfg = dp.config();
