@@ -25,6 +25,7 @@ module specfx_dut (
                 .C_W((`SPECFX_C_W)), .C_F((`SPECFX_C_F)), .C_S((`SPECFX_C_S)),
                 .D_W((`SPECFX_D_W)), .D_F((`SPECFX_D_F)),
                 .SLOPE_W((`SPECFX_SLOPE_W)), .SLOPE_F((`SPECFX_SLOPE_F)), .SLOPE_S((`SPECFX_SLOPE_S)),
+                .SLOPE_POW2((`SPECFX_SLOPE_POW2)),
                 .OFFSET_W((`SPECFX_OFFSET_W)), .OFFSET_F((`SPECFX_OFFSET_F)), .OFFSET_S((`SPECFX_OFFSET_S)),
                 .T_W((`SPECFX_T_W)), .T_F((`SPECFX_T_F)), .T_S((`SPECFX_T_S)),
                 .T_RND((`SPECFX_T_RND)), .T_OVF((`SPECFX_T_OVF)),

@@ -119,6 +119,18 @@ fn conv_sym_k5_matches_bit_and_cycle() {
     );
 }
 
+/// Every n a power of two: the pipelined RTL's t product is a shifter (`SLOPE_POW2`), checked
+/// on every exponent (corner cases hold each n) and in both simulators; folded keeps its
+/// shared multiplier.
+#[test]
+fn power_of_two_slopes_shift_and_match_bit_and_cycle() {
+    let config = config_path("pow2_shift.toml");
+    let header = specfx(&["hdl", "params", "--config", &config]);
+    assert!(String::from_utf8_lossy(&header.stdout).contains("`define SPECFX_SLOPE_POW2 1\n"));
+    check_all(&config, "pow2", "pipelined", "corner,random:400");
+    check_all(&config, "pow2_folded", "folded", "corner,random:100");
+}
+
 #[test]
 fn folded_matches_bit_and_cycle() {
     check_all("baseline", "baseline_folded", "folded", "random:300");
@@ -160,6 +172,7 @@ fn rtl_is_lint_clean_for_every_test_configuration() {
         config_path("narrow_trn_wrap.toml"),
         config_path("conv_sym_k5.toml"),
         config_path("minimax_folded.toml"),
+        config_path("pow2_shift.toml"),
     ];
     for config in &configs {
         for arch in ["pipelined", "folded"] {

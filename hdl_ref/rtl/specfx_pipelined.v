@@ -29,6 +29,7 @@ module specfx_pipelined #(
     parameter integer SLOPE_W  = 11,
     parameter integer SLOPE_F  = 4,
     parameter integer SLOPE_S  = 0,
+    parameter integer SLOPE_POW2 = 0,
     parameter integer OFFSET_W = 1,
     parameter integer OFFSET_F = 0,
     parameter integer OFFSET_S = 0,
@@ -129,7 +130,8 @@ module specfx_pipelined #(
     wire [T_W-1:0] t_1;
     specfx_mul_t #(
         .D_W(D_W), .D_F(D_F), .SLOPE_W(SLOPE_W), .SLOPE_F(SLOPE_F), .SLOPE_S(SLOPE_S),
-        .T_W(T_W), .T_F(T_F), .T_S(T_S), .T_RND(T_RND), .T_OVF(T_OVF)
+        .T_W(T_W), .T_F(T_F), .T_S(T_S), .T_RND(T_RND), .T_OVF(T_OVF),
+        .SLOPE_POW2(SLOPE_POW2)
     ) u_mul_t (
         .d(d_1), .slope(slope_1), .t(t_1)
     );

@@ -118,11 +118,25 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
     let cfg = dp.config();
     let (slope, offset) = constant_formats(cfg);
     let w = |f: crate::fixed::Format| f.width();
-    let mut products = vec![Multiplier {
-        name: "mul_t".into(),
-        a_bits: w(cfg.d.format),
-        b_bits: w(slope),
-    }];
+    // Every slope a power of two (pipelined): t's product is a shift of d by one of the
+    // slope's bit positions, a multiplexer per product bit and select bit, not a multiplier.
+    let shift_t = arch == Arch::Pipelined && crate::hdl::slope_is_pow2(cfg);
+    let shifter_luts = if shift_t {
+        let shifts = u64::from(w(slope));
+        let select_bits = u64::from(64 - (shifts.max(2) - 1).leading_zeros());
+        u64::from(w(cfg.d.format) + w(slope)) * select_bits
+    } else {
+        0
+    };
+    let mut products = if shift_t {
+        Vec::new()
+    } else {
+        vec![Multiplier {
+            name: "mul_t".into(),
+            a_bits: w(cfg.d.format),
+            b_bits: w(slope),
+        }]
+    };
     let mut prev = cfg.b.format;
     for (i, sq) in cfg.square.iter().enumerate() {
         products.push(Multiplier {
@@ -217,7 +231,8 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
             .sum(),
         None => 0,
     };
-    let luts = adder_bits + overflow_bits + if dsps == 0 { multiplier_bits } else { 0 };
+    let luts =
+        adder_bits + overflow_bits + shifter_luts + if dsps == 0 { multiplier_bits } else { 0 };
     AnalyticCost {
         arch,
         multipliers,

@@ -100,6 +100,7 @@ pub fn params_header(dp: &Datapath, arch: Arch) -> String {
     def("D_W", cfg.d.format.width().to_string());
     def("D_F", cfg.d.format.frac_bits().to_string());
     fmt_defs(&mut def, "SLOPE", slope);
+    def("SLOPE_POW2", u32::from(slope_is_pow2(cfg)).to_string());
     fmt_defs(&mut def, "OFFSET", offset);
     stage_defs(&mut def, "T", &cfg.t);
     stage_defs(&mut def, "B", &cfg.b);
@@ -135,4 +136,23 @@ pub fn params_header(dp: &Datapath, arch: Arch) -> String {
         arch,
         arch.latency(cfg)
     )
+}
+
+/// Whether every slope is a power of two: the plain variant (slope n with k fraction bits) with
+/// every n a power of two. The pipelined RTL then shifts d by the slope's one set bit instead
+/// of multiplying (`SPECFX_SLOPE_POW2`), and the cost model prices a shifter.
+///
+/// # Examples
+/// ```
+/// use specfx::hdl::slope_is_pow2;
+/// use specfx::nset::NSet;
+/// use specfx::pipeline::Config;
+/// let mut cfg = Config::baseline();
+/// assert!(!slope_is_pow2(&cfg)); // n = 16..1024
+/// cfg.n = NSet::from_values(&[16, 64, 256, 1024]).unwrap();
+/// assert!(slope_is_pow2(&cfg));
+/// ```
+pub fn slope_is_pow2(cfg: &crate::pipeline::Config) -> bool {
+    cfg.variant == crate::pipeline::Variant::Plain
+        && cfg.n.values().iter().all(|n| n.is_power_of_two())
 }
