@@ -3,7 +3,7 @@
 //! fitted configuration's golden vectors co-simulated in Icarus Verilog).
 
 mod common;
-use common::specfx;
+use common::{specfx, srgb8};
 
 use std::path::{Path, PathBuf};
 
@@ -71,17 +71,6 @@ fn temp_dir(name: &str) -> PathBuf {
     let p = std::env::temp_dir().join(format!("specfx-fit-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&p);
     p
-}
-
-/// sRGB display code of a linear value, 8 bits, from IEC 61966-2-1.
-fn srgb8(x: f64) -> u16 {
-    let x = x.clamp(0.0, 1.0);
-    let s = if x <= 0.0031308 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round() as u16
 }
 
 /// The oracle's image of a lobe: each pixel's base radiance plus every light's term, encoded.

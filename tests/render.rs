@@ -7,17 +7,8 @@ use specfx::pipeline::{Config, Datapath};
 use specfx::scene::render::{render, PATHS};
 use specfx::scene::Scene;
 
-/// sRGB encoding, written from the standard (IEC 61966-2-1).
-fn srgb(x: f64) -> f64 {
-    if x <= 0.0031308 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 fn code(x: f64) -> u16 {
-    (srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u16
+    common::srgb8(x)
 }
 
 /// A unit sphere at the origin seen from (0, 0, 5) in a 3x3 image, lit from the camera.

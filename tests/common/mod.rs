@@ -9,3 +9,16 @@ pub fn specfx(args: &[&str]) -> Output {
         .output()
         .expect("the specfx binary runs")
 }
+
+/// The 8-bit sRGB display code of a linear value clamped to [0, 1], written from the standard
+/// (IEC 61966-2-1): the tests' oracle of the renderer's encoding.
+#[allow(dead_code)]
+pub fn srgb8(x: f64) -> u16 {
+    let x = x.clamp(0.0, 1.0);
+    let s = if x <= 0.0031308 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u16
+}
