@@ -601,3 +601,224 @@ pub fn search(
         minimality,
     })
 }
+
+/// One algorithm the optimiser may choose: k squarings and a variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Algorithm {
+    /// Squarings.
+    pub k: u32,
+    /// Variant.
+    pub variant: Variant,
+}
+
+/// The f64 floor of an algorithm: max |f64 lobe - cos^n| over the input codes and the n set
+/// (`shape_approx` of an exhaustive check of a wide configuration), which no fraction bits
+/// remove.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AlgorithmFloor {
+    /// The algorithm.
+    pub algorithm: Algorithm,
+    /// The floor, if the algorithm is valid for the base (else `reason`).
+    pub shape_total: Option<f64>,
+    /// Why the algorithm is not valid for the base.
+    pub reason: Option<String>,
+    /// Whether the floor leaves the budget reachable (budgets without `shape_total` always do).
+    pub reachable: bool,
+}
+
+/// The floors of every algorithm (k in `ks`, each variant), from `base` with the internal
+/// stages at `start_frac` fraction bits.
+pub fn algorithm_floors(
+    base: &Config,
+    budget: &Budget,
+    ks: &[u32],
+    variants: &[Variant],
+    start_frac: i32,
+) -> Vec<AlgorithmFloor> {
+    use rayon::prelude::*;
+    let algorithms: Vec<Algorithm> = ks
+        .iter()
+        .flat_map(|&k| {
+            variants
+                .iter()
+                .map(move |&variant| Algorithm { k, variant })
+        })
+        .collect();
+    algorithms
+        .par_iter()
+        .map(|&algorithm| {
+            let dp = start_of(base, algorithm, start_frac).and_then(Datapath::new);
+            let figures = dp.and_then(|dp| check_outputs(&dp));
+            match figures {
+                Err(e) => AlgorithmFloor {
+                    algorithm,
+                    shape_total: None,
+                    reason: Some(e.to_string()),
+                    reachable: false,
+                },
+                Ok(f) => AlgorithmFloor {
+                    algorithm,
+                    shape_total: Some(f.shape_approx_max_abs),
+                    reason: None,
+                    reachable: budget
+                        .bounds
+                        .iter()
+                        .filter(|b| b.metric == Metric::ShapeTotal)
+                        .all(|b| f.shape_approx_max_abs <= b.limit),
+                },
+            }
+        })
+        .collect()
+}
+
+/// The starting point of an algorithm: the base with k squarings (each like the base's first)
+/// and the variant, every internal stage at `start_frac` fraction bits.
+pub fn start_of(base: &Config, a: Algorithm, start_frac: i32) -> Result<Config, Error> {
+    let mut cfg = base.clone();
+    cfg.k = a.k;
+    cfg.variant = a.variant;
+    cfg.square = vec![base.square[0]; a.k as usize];
+    for s in searched_stages(a.k) {
+        set_frac(&mut cfg, s, start_frac)?;
+    }
+    Ok(cfg)
+}
+
+/// The optimiser's search space for one algorithm: the internal stages; the coefficient's
+/// fraction bits when the budget measures the output (`out`, `correct`: the shape metrics
+/// measure the lobe before the coefficient, so they cannot constrain it); the output's
+/// fraction bits when it measures correct rounding but not output LSBs (whose unit the output
+/// format is); for minimax, the stored constants' fraction bits. TRN or RND everywhere as
+/// starting points; every rounding and overflow mode in the local search.
+pub fn optimize_space(a: Algorithm, budget: &Budget, start_frac: i32) -> Space {
+    let has = |m: Metric| budget.bounds.iter().any(|b| b.metric == m);
+    let mut extra_knobs = Vec::new();
+    if has(Metric::Out) || has(Metric::Correct) {
+        extra_knobs.push(Knob::CoefFrac);
+    }
+    if has(Metric::Correct) && !has(Metric::Out) {
+        extra_knobs.push(Knob::Frac(Stage::Out));
+    }
+    if a.variant == Variant::Minimax {
+        extra_knobs.extend([Knob::MinimaxSlopeFrac, Knob::MinimaxOffsetFrac]);
+    }
+    Space {
+        choices: Choices {
+            k: vec![a.k],
+            variants: vec![a.variant],
+            roundings: vec![Rounding::Trn, Rounding::Rnd],
+        },
+        start_frac,
+        extra_knobs,
+        local_roundings: Rounding::ALL.to_vec(),
+        overflow_moves: true,
+    }
+}
+
+/// The exhaustive judge of a budget, with a quick rejection: for budgets of maxima only, a
+/// candidate is first checked on every 8th exponent (and the last); a subset's maximum never
+/// exceeds the whole set's, so failing there is failing.
+pub fn exhaustive_judge(dp: &Datapath, budget: &Budget) -> Result<Verdict, Error> {
+    let maxima_only = budget.bounds.iter().all(|b| b.metric != Metric::Correct);
+    let ns = dp.config().n.values();
+    if maxima_only && ns.len() > 64 {
+        let mut subset: Vec<u32> = ns.iter().step_by(8).copied().collect();
+        if subset.last() != ns.last() {
+            subset.push(*ns.last().expect("not empty"));
+        }
+        let mut cfg = dp.config().clone();
+        cfg.n = crate::nset::NSet::from_values(&subset)?;
+        let quick = check_outputs(&Datapath::new(cfg)?)?;
+        if !budget.met_by(&quick) {
+            return Ok(Verdict {
+                feasible: false,
+                excess: budget.excess(&quick),
+            });
+        }
+    }
+    let r = check_outputs(dp)?;
+    Ok(Verdict {
+        feasible: budget.met_by(&r),
+        excess: budget.excess(&r),
+    })
+}
+
+/// What [`optimize_all`] found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OptimizeAll {
+    /// The budget.
+    pub budget: Budget,
+    /// Every algorithm's floor (searched only where reachable).
+    pub floors: Vec<AlgorithmFloor>,
+    /// The cheapest feasible configuration, if any.
+    pub best: Option<Candidate>,
+    /// The closest configuration (least excess) when none is feasible.
+    pub closest: Option<Candidate>,
+    /// Candidates judged (each exhaustively, or rejected on a subset of n).
+    pub n_evaluations: u64,
+    /// Why the answer is minimal within the search.
+    pub minimality: Vec<String>,
+}
+
+/// Searches every reachable algorithm (in parallel, results combined in the floors' order) for
+/// the cheapest configuration meeting `budget`; `done(algorithm)` is called as each finishes.
+pub fn optimize_all(
+    base: &Config,
+    budget: &Budget,
+    floors: Vec<AlgorithmFloor>,
+    start_frac: i32,
+    cost: &(dyn Fn(&Datapath) -> Result<f64, Error> + Sync),
+    done: &(dyn Fn(Algorithm, &SearchResult) + Sync),
+) -> Result<OptimizeAll, Error> {
+    use rayon::prelude::*;
+    let results: Vec<Result<SearchResult, Error>> = floors
+        .par_iter()
+        .filter(|f| f.reachable)
+        .map(|f| {
+            let space = optimize_space(f.algorithm, budget, start_frac);
+            let mut judge = |dp: &Datapath| exhaustive_judge(dp, budget);
+            let mut cost = |dp: &Datapath| cost(dp);
+            let r = search(base, &space, &mut judge, &mut cost, &mut |_| {})?;
+            done(f.algorithm, &r);
+            Ok(r)
+        })
+        .collect();
+    let mut out = OptimizeAll {
+        budget: budget.clone(),
+        floors: Vec::new(),
+        best: None,
+        closest: None,
+        n_evaluations: 0,
+        minimality: Vec::new(),
+    };
+    for r in results {
+        let r = r?;
+        out.n_evaluations += r.n_evaluations;
+        if let Some(b) = r.best {
+            if out.best.as_ref().is_none_or(|x| b.cost < x.cost) {
+                out.best = Some(b);
+                out.minimality = r.minimality;
+            }
+        } else if let Some(c) = r.closest {
+            if out.closest.as_ref().is_none_or(|x| c.excess < x.excess) {
+                out.closest = Some(c);
+            }
+        }
+    }
+    let skipped: Vec<String> = floors
+        .iter()
+        .filter(|f| !f.reachable)
+        .map(|f| format!("k = {} {}", f.algorithm.k, f.algorithm.variant.name()))
+        .collect();
+    if out.best.is_some() && !skipped.is_empty() {
+        out.minimality.insert(
+            0,
+            format!(
+                "not searched, their f64 floor (the algorithm's own error against cos^n, before any quantization) already breaks the budget or they are not valid: {}",
+                skipped.join(", ")
+            ),
+        );
+    }
+    out.floors = floors;
+    Ok(out)
+}

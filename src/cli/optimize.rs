@@ -2,15 +2,17 @@
 
 use std::path::PathBuf;
 
+use std::io::IsTerminal;
+
 use anyhow::{bail, Result};
 use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
 
 use super::output::write_atomic;
 use super::Outcome;
 use specfx::analysis::check::check;
-use specfx::analysis::optimize::{optimize, Budget, Choices};
+use specfx::analysis::optimize::{algorithm_floors, optimize_all, Algorithm, Budget, SearchResult};
 use specfx::cycle::Arch;
-use specfx::fixed::Rounding;
 use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;
 use specfx::pipeline::{Datapath, Variant};
@@ -20,7 +22,7 @@ use specfx::pipeline::{Datapath, Variant};
 pub struct OptimizeArgs {
     /// The budget, e.g. "shape_total <= 1 lsb8", "shape_quant <= 0.5 lsb8", "out <= 1 ulp",
     /// "correct >= 99%", several joined by commas.
-    #[arg(long, default_value = "shape_quant <= 0.5 lsb8")]
+    #[arg(long, default_value = "shape_total <= 1 lsb8")]
     budget: Budget,
     /// The base configuration (formats' integer bits, coefficient, cutoff ... are kept).
     #[arg(long, default_value = "baseline")]
@@ -31,12 +33,13 @@ pub struct OptimizeArgs {
     /// Cost to minimise: analytic (LUTs, instant) or yosys (iCE40 LUTs, seconds per candidate).
     #[arg(long, default_value = "analytic")]
     objective: String,
-    /// Numbers of squarings to try.
-    #[arg(long, default_value = "3,4,5")]
+    /// Numbers of squarings to try (each is searched only if its f64 floor can meet the
+    /// budget).
+    #[arg(long, default_value = "1..=7")]
     k: NSet,
-    /// Also try the minimax variant.
-    #[arg(long)]
-    minimax: bool,
+    /// Variants to try: plain, minimax or both.
+    #[arg(long, default_value = "plain,minimax", value_delimiter = ',')]
+    variants: Vec<String>,
     /// Fraction bits every searched stage starts from (must meet the budget).
     #[arg(long, default_value_t = 20)]
     start_frac: i32,
@@ -62,7 +65,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     };
     let hdl = super::cost::hdl_ref_dir(None);
     let arch = args.arch;
-    let mut cost = |dp: &Datapath| -> Result<f64, specfx::Error> {
+    let cost = |dp: &Datapath| -> Result<f64, specfx::Error> {
         if yosys {
             super::cost::run_yosys(dp, arch, Target::Ice40, &hdl)
                 .map(|(c, _, _)| c.luts as f64)
@@ -74,31 +77,106 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             Ok(analytic_cost(dp, arch, Target::Generic).luts as f64)
         }
     };
-    let choices = Choices {
-        k: args.k.values().to_vec(),
-        variants: if args.minimax {
-            vec![Variant::Plain, Variant::Minimax]
-        } else {
-            vec![Variant::Plain]
-        },
-        roundings: vec![Rounding::Trn, Rounding::Rnd],
-    };
-    let mut progress = |line: &str| eprintln!("optimize: {line}");
-    let r = optimize(
+    let variants: Vec<Variant> = args
+        .variants
+        .iter()
+        .map(|v| match v.trim() {
+            "plain" => Ok(Variant::Plain),
+            "minimax" => Ok(Variant::Minimax),
+            other => bail!("--variants: expected plain, minimax or both, got '{other}'"),
+        })
+        .collect::<Result<_>>()?;
+    eprintln!(
+        "optimize: f64 floor of {} algorithms (k in {}, {})",
+        args.k.len() * variants.len(),
+        args.k,
+        args.variants.join(", ")
+    );
+    let floors = algorithm_floors(
         &base,
         &args.budget,
-        &choices,
+        args.k.values(),
+        &variants,
         args.start_frac,
-        &mut cost,
-        &mut progress,
-    )
-    .map_err(anyhow::Error::msg)?;
+    );
+    let reachable = floors.iter().filter(|f| f.reachable).count();
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = ProgressBar::new(reachable as u64);
+        b.set_style(
+            ProgressStyle::with_template("optimize {bar:40} {pos}/{len} algorithms, eta {eta}")
+                .expect("valid template"),
+        );
+        b
+    });
+    let done = |a: Algorithm, r: &SearchResult| {
+        let line = format!(
+            "optimize: k = {}, {}: {}",
+            a.k,
+            a.variant.name(),
+            r.best
+                .as_ref()
+                .map_or("nothing meets the budget".to_string(), |b| format!(
+                    "{:.0} LUTs",
+                    b.cost
+                ))
+        );
+        match &bar {
+            Some(b) => {
+                b.println(line);
+                b.inc(1);
+            }
+            None => eprintln!("{line}"),
+        }
+    };
+    let r = optimize_all(&base, &args.budget, floors, args.start_frac, &cost, &done)
+        .map_err(anyhow::Error::msg)?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
     println!(
         "optimize: budget '{}', {} exhaustive checks",
         r.budget, r.n_evaluations
     );
     let Some(best) = &r.best else {
         println!("no configuration in the space meets the budget");
+        println!("the f64 floor of each algorithm (its own error against cos^n before any quantization):");
+        for f in &r.floors {
+            let a = f.algorithm;
+            match (f.shape_total, &f.reason) {
+                (Some(x), _) => println!(
+                    "  k = {} {:<8} shape_total floor {:.3e} ({:.2} lsb8){}",
+                    a.k,
+                    a.variant.name(),
+                    x,
+                    x * 256.0,
+                    if f.reachable {
+                        ""
+                    } else {
+                        ": beyond the budget"
+                    }
+                ),
+                (None, reason) => println!(
+                    "  k = {} {:<8} not valid: {}",
+                    a.k,
+                    a.variant.name(),
+                    reason.as_deref().unwrap_or("")
+                ),
+            }
+        }
+        if let Some(f) = r
+            .floors
+            .iter()
+            .filter(|f| f.shape_total.is_some())
+            .min_by(|a, b| a.shape_total.unwrap().total_cmp(&b.shape_total.unwrap()))
+        {
+            println!(
+                "closest algorithm: k = {} {}, whose f64 floor is {:.3e} ({:.2} lsb8); what would meet the budget: a shape_total limit above that floor (quantization adds to it), or fewer exponents (--n: the floors fall when every n is at least m = 2^k)",
+                f.algorithm.k,
+                f.algorithm.variant.name(),
+                f.shape_total.unwrap(),
+                f.shape_total.unwrap() * 256.0
+            );
+        }
         if let Some(c) = &r.closest {
             let dp = Datapath::new(c.config.clone())?;
             let chk = check(&dp).map_err(anyhow::Error::msg)?;

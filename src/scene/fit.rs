@@ -11,7 +11,9 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
-use crate::analysis::optimize::{search, Candidate, Choices, Knob, SearchResult, Space, Verdict};
+use crate::analysis::optimize::{
+    search, start_of, Algorithm, Candidate, Choices, Knob, SearchResult, Space, Verdict,
+};
 use crate::error::Error;
 use crate::fixed::Rounding;
 use crate::pipeline::walk::Stage;
@@ -380,26 +382,6 @@ pub struct Floor {
     pub meets: bool,
 }
 
-/// The starting configuration of an algorithm: the base's with k squarings and a variant,
-/// every internal stage at `start_frac` fraction bits.
-pub fn start_config(
-    base: &Config,
-    k: u32,
-    variant: Variant,
-    start_frac: i32,
-) -> Result<Config, Error> {
-    let mut cfg = base.clone();
-    cfg.k = k;
-    cfg.variant = variant;
-    cfg.square = vec![base.square[0]; k as usize];
-    let mut stages = vec![Stage::T, Stage::B];
-    stages.extend((0..k as usize).map(Stage::Square));
-    for s in stages {
-        Knob::Frac(s).set(&mut cfg, start_frac)?;
-    }
-    Ok(cfg)
-}
-
 /// The f64 floor of every algorithm (k = 1..=7, plain and minimax) on the scene.
 pub fn floors(
     judge: &SceneJudge<'_>,
@@ -410,7 +392,7 @@ pub fn floors(
     let mut v = Vec::new();
     for k in 1..=7 {
         for variant in [Variant::Plain, Variant::Minimax] {
-            let dp = start_config(base, k, variant, start_frac).and_then(Datapath::new);
+            let dp = start_of(base, Algorithm { k, variant }, start_frac).and_then(Datapath::new);
             let floor = match dp {
                 Err(e) => Floor {
                     k,
