@@ -239,7 +239,52 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         proof.out_max_ulp,
         100.0 * proof.stages[dp.stage_out()].correctly_rounded
     );
-    println!("why minimal:");
+    // Overflow: a stage left to wrap must never overflow on any input (the exhaustive check
+    // counts every event).
+    let wrapping: Vec<String> = proof
+        .stages
+        .iter()
+        .filter(|s| s.wrapped > 0)
+        .map(|s| format!("{} ({} times)", s.stage, s.wrapped))
+        .collect();
+    if wrapping.is_empty() {
+        println!("overflow: no stage wraps on any input (exhaustive)");
+    } else {
+        println!(
+            "overflow: WARNING, these stages wrap on some inputs although the budget holds: {}",
+            wrapping.join(", ")
+        );
+    }
+    // The answer's cost on every target, beside the paper's datapath (baseline: plain, k = 4)
+    // serving the same exponents.
+    let mut paper_cfg = specfx::pipeline::Config::baseline();
+    paper_cfg.n = config.n.clone();
+    let paper = Datapath::new(paper_cfg)?;
+    let paper_check = specfx::analysis::check::check_outputs(&paper)?;
+    println!(
+        "against the paper's datapath (baseline: plain, k = 4, same n): shape_total {:.3e} ({:.2} lsb8) against {:.3e} ({:.2} lsb8)",
+        proof.shape_total_max_abs,
+        proof.shape_total_max_abs * 256.0,
+        paper_check.shape_total_max_abs,
+        paper_check.shape_total_max_abs * 256.0
+    );
+    println!(
+        "  analytic cost, {arch}:      {:>22} {:>22}",
+        "this", "paper's"
+    );
+    for target in [Target::Generic, Target::Ice40, Target::Xilinx] {
+        let a = analytic_cost(&dp, arch, target);
+        let p = analytic_cost(&paper, arch, target);
+        println!(
+            "    {:<8} {:>12} LUTs {:>3} DSPs {:>12} LUTs {:>3} DSPs",
+            target.name(),
+            a.luts,
+            a.dsps,
+            p.luts,
+            p.dsps
+        );
+    }
+    println!("why minimal (within this search, not over every possible datapath):");
     for m in &r.minimality {
         println!("  {m}");
     }
