@@ -239,3 +239,56 @@ fn the_goal_alone_finds_a_datapath_within_one_lsb8() {
     }
     assert!(stdout.contains("beyond the budget"), "{stdout}");
 }
+
+/// Cost ceilings: a k = 5 minimax datapath needs 7 multipliers, so on iCE40 (one SB_MAC16 per
+/// product of at most 16 x 16 bits, at least one each) it cannot fit in 6 DSPs, and no other
+/// algorithm reaches 1 lsb8 over n = 16..1024; a LUT ceiling the answer meets is confirmed by
+/// `specfx cost`.
+#[test]
+fn cost_ceilings_bound_the_answer() {
+    let o = specfx(&[
+        "optimize",
+        "--budget",
+        "shape_total <= 1 lsb8 and dsps <= 6 on ice40",
+        "--out",
+        temp("dsp.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("its analytic dsps on ice40: 7 (limit 6)"),
+        "{stdout}"
+    );
+
+    let out = temp("luts.toml");
+    let o = specfx(&[
+        "optimize",
+        "--n",
+        "64",
+        "--budget",
+        "shape_total <= 1 lsb8 and luts <= 1500 on generic",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let c = specfx(&[
+        "cost",
+        "--config",
+        out.to_str().unwrap(),
+        "--target",
+        "generic",
+        "--analytic-only",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+    assert!(v["analytic"]["luts"].as_u64().unwrap() <= 1500, "{v}");
+
+    for bad in ["shape_total <= 1 lsb8 on ice40", "dsps <= 8 on fpga"] {
+        let o = specfx(&["optimize", "--budget", bad, "--out", "/tmp/x.toml"]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains("budget"),
+            "{bad}"
+        );
+    }
+}

@@ -945,7 +945,7 @@ pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, E
         b.bounds
             .iter()
             .map(|bound| {
-                let value = metric_value(&report.output_figures(), bound.metric);
+                let value = metric_value(&report.output_figures(), dp, b.arch, bound.metric);
                 let pass = match bound.metric {
                     Metric::Correct => value >= bound.limit,
                     _ => value <= bound.limit,

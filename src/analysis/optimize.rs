@@ -19,8 +19,10 @@ use std::str::FromStr;
 use serde::Serialize;
 
 use crate::analysis::check::{check_outputs, OutputFigures};
+use crate::cycle::Arch;
 use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
+use crate::hdl::cost::{analytic_cost, AnalyticCost, Target};
 use crate::pipeline::walk::Stage;
 use crate::pipeline::StageSpec;
 use crate::pipeline::{Config, Datapath, Variant};
@@ -37,6 +39,33 @@ pub enum Metric {
     Out,
     /// Share of outputs correctly rounded (`correct`, a fraction or a percentage).
     Correct,
+    /// Analytic LUTs on a target (`luts <= 800 on ice40`), of the budget's microarchitecture.
+    Luts(Target),
+    /// Analytic DSP blocks on a target (`dsps <= 8 on ice40`).
+    Dsps(Target),
+    /// Analytic register bits on a target (`ffs <= 400 on ice40`).
+    Ffs(Target),
+}
+
+impl fmt::Display for Metric {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Metric::ShapeTotal => f.write_str("shape_total"),
+            Metric::ShapeQuant => f.write_str("shape_quant"),
+            Metric::Out => f.write_str("out"),
+            Metric::Correct => f.write_str("correct"),
+            Metric::Luts(t) => write!(f, "luts on {}", t.name()),
+            Metric::Dsps(t) => write!(f, "dsps on {}", t.name()),
+            Metric::Ffs(t) => write!(f, "ffs on {}", t.name()),
+        }
+    }
+}
+
+impl Metric {
+    /// Whether the metric is a cost ceiling (evaluated from the formats, no check needed).
+    pub fn is_cost(self) -> bool {
+        matches!(self, Metric::Luts(_) | Metric::Dsps(_) | Metric::Ffs(_))
+    }
 }
 
 /// One bound: `metric <= value` (or `>=` for `correct`).
@@ -55,17 +84,22 @@ pub struct Budget {
     pub text: String,
     /// The bounds.
     pub bounds: Vec<Bound>,
+    /// The microarchitecture cost ceilings are counted on (pipelined unless the command sets
+    /// it, as `optimize --arch` does).
+    pub arch: Arch,
 }
 
 impl FromStr for Budget {
     type Err = Error;
     /// Parses `shape_total <= 1 lsb8`, `shape_quant <= 0.5 lsb8`, `out <= 1 ulp`,
-    /// `correct >= 99%` (or `0.99`), several joined by `,` or `and`. `lsbN` is 2^-N.
+    /// `correct >= 99%` (or `0.99`), and cost ceilings `luts <= 800 on ice40`, `dsps <= 8 on
+    /// ice40`, `ffs <= 400 on xilinx` (analytic; target generic when `on` is left out),
+    /// several joined by `,` or `and`. `lsbN` is 2^-N.
     fn from_str(s: &str) -> Result<Self, Error> {
         let bad = |part: &str, why: &str| {
             Error::Config {
             key: "budget".into(),
-            problem: format!("{why} in '{part}'; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%'"),
+            problem: format!("{why} in '{part}'; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'"),
         }
         };
         let mut bounds = Vec::new();
@@ -78,13 +112,29 @@ impl FromStr for Budget {
             } else {
                 return Err(bad(part, "no <= or >="));
             };
+            let on = rhs.split_once(" on ");
+            let (rhs, target) = match on {
+                Some((r, t)) => (
+                    r,
+                    t.trim()
+                        .parse::<Target>()
+                        .map_err(|e| bad(part, &e.to_string()))?,
+                ),
+                None => (rhs, Target::Generic),
+            };
             let metric = match lhs.trim() {
+                "luts" => Metric::Luts(target),
+                "dsps" => Metric::Dsps(target),
+                "ffs" => Metric::Ffs(target),
                 "shape_total" => Metric::ShapeTotal,
                 "shape_quant" => Metric::ShapeQuant,
                 "out" => Metric::Out,
                 "correct" => Metric::Correct,
                 other => return Err(bad(part, &format!("unknown metric '{other}'"))),
             };
+            if on.is_some() && !metric.is_cost() {
+                return Err(bad(part, "only luts, dsps and ffs take 'on TARGET'"));
+            }
             let want_op = if metric == Metric::Correct {
                 ">="
             } else {
@@ -114,6 +164,7 @@ impl FromStr for Budget {
                 (Metric::Out, "ulp" | "") => value,
                 (Metric::Correct, "%") => value / 100.0,
                 (Metric::Correct, "") => value,
+                (m, "") if m.is_cost() => value,
                 _ => {
                     return Err(bad(
                         part,
@@ -126,6 +177,7 @@ impl FromStr for Budget {
         Ok(Budget {
             text: s.trim().to_string(),
             bounds,
+            arch: Arch::Pipelined,
         })
     }
 }
@@ -136,41 +188,91 @@ impl fmt::Display for Budget {
     }
 }
 
-/// The value of a metric in a check's output figures.
-pub fn metric_value(r: &OutputFigures, metric: Metric) -> f64 {
+/// The value of a metric: from a check's output figures, or for a cost ceiling the analytic
+/// cost of the datapath on `arch` and the metric's target.
+pub fn metric_value(r: &OutputFigures, dp: &Datapath, arch: Arch, metric: Metric) -> f64 {
     match metric {
         Metric::ShapeTotal => r.shape_total_max_abs,
         Metric::ShapeQuant => r.shape_quant_max_abs,
         Metric::Out => r.out_max_ulp,
         Metric::Correct => r.out_correctly_rounded,
+        Metric::Luts(_) | Metric::Dsps(_) | Metric::Ffs(_) => cost_value(dp, arch, metric),
     }
 }
 
+/// A cost ceiling's value: the analytic cost on the metric's target.
+fn cost_value(dp: &Datapath, arch: Arch, metric: Metric) -> f64 {
+    let (target, pick): (Target, fn(&AnalyticCost) -> u64) = match metric {
+        Metric::Luts(t) => (t, |c| c.luts),
+        Metric::Dsps(t) => (t, |c| c.dsps),
+        Metric::Ffs(t) => (t, |c| c.register_bits),
+        _ => unreachable!("a cost metric"),
+    };
+    pick(&analytic_cost(dp, arch, target)) as f64
+}
+
 impl Budget {
-    /// Whether a check meets every bound.
-    pub fn met_by(&self, r: &OutputFigures) -> bool {
-        self.bounds.iter().all(|b| {
-            let v = metric_value(r, b.metric);
-            match b.metric {
-                Metric::Correct => v >= b.limit,
-                _ => v <= b.limit,
-            }
-        })
+    /// Whether a bound holds for a value.
+    fn holds(b: &Bound, v: f64) -> bool {
+        match b.metric {
+            Metric::Correct => v >= b.limit,
+            _ => v <= b.limit,
+        }
     }
 
-    /// How far a check is from the budget: the largest ratio value/limit (limit/value for
-    /// `correct`); at most 1 when met.
-    pub fn excess(&self, r: &OutputFigures) -> f64 {
+    /// A bound's value/limit ratio (limit/value for `correct`): at most 1 when it holds.
+    fn ratio(b: &Bound, v: f64) -> f64 {
+        match b.metric {
+            Metric::Correct => b.limit / v.max(1e-300),
+            _ => v / b.limit.max(1e-300),
+        }
+    }
+
+    /// Whether a datapath and its check meet every bound.
+    pub fn met_by(&self, r: &OutputFigures, dp: &Datapath) -> bool {
         self.bounds
             .iter()
-            .map(|b| {
-                let v = metric_value(r, b.metric);
-                match b.metric {
-                    Metric::Correct => b.limit / v.max(1e-300),
-                    _ => v / b.limit.max(1e-300),
-                }
-            })
+            .all(|b| Self::holds(b, metric_value(r, dp, self.arch, b.metric)))
+    }
+
+    /// How far a datapath and its check are from the budget: the largest ratio; at most 1 when
+    /// met.
+    pub fn excess(&self, r: &OutputFigures, dp: &Datapath) -> f64 {
+        self.bounds
+            .iter()
+            .map(|b| Self::ratio(b, metric_value(r, dp, self.arch, b.metric)))
             .fold(0.0, f64::max)
+    }
+
+    /// The budget without its cost ceilings.
+    pub fn without_costs(&self) -> Budget {
+        Budget {
+            text: self.text.clone(),
+            bounds: self
+                .bounds
+                .iter()
+                .filter(|b| !b.metric.is_cost())
+                .copied()
+                .collect(),
+            arch: self.arch,
+        }
+    }
+
+    /// The cost ceilings alone: whether they hold, and their largest ratio (no check needed).
+    pub fn cost_verdict(&self, dp: &Datapath) -> Verdict {
+        let costs: Vec<(&Bound, f64)> = self
+            .bounds
+            .iter()
+            .filter(|b| b.metric.is_cost())
+            .map(|b| (b, cost_value(dp, self.arch, b.metric)))
+            .collect();
+        Verdict {
+            feasible: costs.iter().all(|&(b, v)| Self::holds(b, v)),
+            excess: costs
+                .iter()
+                .map(|&(b, v)| Self::ratio(b, v))
+                .fold(0.0, f64::max),
+        }
     }
 }
 
@@ -376,13 +478,7 @@ pub fn optimize(
         local_roundings: Rounding::ALL.to_vec(),
         overflow_moves: true,
     };
-    let mut judge = |dp: &Datapath| -> Result<Verdict, Error> {
-        let r = check_outputs(dp)?;
-        Ok(Verdict {
-            feasible: budget.met_by(&r),
-            excess: budget.excess(&r),
-        })
-    };
+    let mut judge = |dp: &Datapath| -> Result<Verdict, Error> { exhaustive_judge(dp, budget) };
     let r = search(base, &space, &mut judge, cost, progress)?;
     Ok(OptimizeResult {
         budget: budget.clone(),
@@ -719,6 +815,9 @@ pub fn optimize_space(a: Algorithm, budget: &Budget, start_frac: i32) -> Space {
 /// candidate is first checked on every 8th exponent (and the last); a subset's maximum never
 /// exceeds the whole set's, so failing there is failing.
 pub fn exhaustive_judge(dp: &Datapath, budget: &Budget) -> Result<Verdict, Error> {
+    // Cost ceilings are not judged here: the search minimises cost, so its answer is the
+    // point most likely to meet them, and [`optimize_all`] checks them on it.
+    let budget = &budget.without_costs();
     let maxima_only = budget.bounds.iter().all(|b| b.metric != Metric::Correct);
     let ns = dp.config().n.values();
     if maxima_only && ns.len() > 64 {
@@ -729,17 +828,17 @@ pub fn exhaustive_judge(dp: &Datapath, budget: &Budget) -> Result<Verdict, Error
         let mut cfg = dp.config().clone();
         cfg.n = crate::nset::NSet::from_values(&subset)?;
         let quick = check_outputs(&Datapath::new(cfg)?)?;
-        if !budget.met_by(&quick) {
+        if !budget.met_by(&quick, dp) {
             return Ok(Verdict {
                 feasible: false,
-                excess: budget.excess(&quick),
+                excess: budget.excess(&quick, dp),
             });
         }
     }
     let r = check_outputs(dp)?;
     Ok(Verdict {
-        feasible: budget.met_by(&r),
-        excess: budget.excess(&r),
+        feasible: budget.met_by(&r, dp),
+        excess: budget.excess(&r, dp),
     })
 }
 
@@ -778,7 +877,20 @@ pub fn optimize_all(
             let space = optimize_space(f.algorithm, budget, start_frac);
             let mut judge = |dp: &Datapath| exhaustive_judge(dp, budget);
             let mut cost = |dp: &Datapath| cost(dp);
-            let r = search(base, &space, &mut judge, &mut cost, &mut |_| {})?;
+            let mut r = search(base, &space, &mut judge, &mut cost, &mut |_| {})?;
+            // The cheapest point meeting the error bounds must meet the cost ceilings too.
+            if let Some(b) = r.best.take() {
+                let v = budget.cost_verdict(&Datapath::new(b.config.clone())?);
+                if v.feasible {
+                    r.best = Some(b);
+                } else {
+                    r.closest = Some(Candidate {
+                        feasible: false,
+                        excess: v.excess,
+                        ..b
+                    });
+                }
+            }
             done(f.algorithm, &r);
             Ok(r)
         })

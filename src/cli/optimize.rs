@@ -92,13 +92,9 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         args.k,
         args.variants.join(", ")
     );
-    let floors = algorithm_floors(
-        &base,
-        &args.budget,
-        args.k.values(),
-        &variants,
-        args.start_frac,
-    );
+    let mut budget = args.budget.clone();
+    budget.arch = arch;
+    let floors = algorithm_floors(&base, &budget, args.k.values(), &variants, args.start_frac);
     let reachable = floors.iter().filter(|f| f.reachable).count();
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = ProgressBar::new(reachable as u64);
@@ -128,7 +124,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             None => eprintln!("{line}"),
         }
     };
-    let r = optimize_all(&base, &args.budget, floors, args.start_frac, &cost, &done)
+    let r = optimize_all(&base, &budget, floors, args.start_frac, &cost, &done)
         .map_err(anyhow::Error::msg)?;
     if let Some(b) = bar {
         b.finish_and_clear();
@@ -190,6 +186,19 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                 100.0 * chk.stages[dp.stage_out()].correctly_rounded,
                 c.excess
             );
+            for b in r.budget.bounds.iter().filter(|b| b.metric.is_cost()) {
+                println!(
+                    "  its analytic {}: {} (limit {})",
+                    b.metric,
+                    specfx::analysis::optimize::metric_value(
+                        &chk.output_figures(),
+                        &dp,
+                        arch,
+                        b.metric
+                    ),
+                    b.limit
+                );
+            }
         }
         return Ok(Outcome::CheckFailed);
     };
@@ -198,7 +207,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     config.name = "optimized".into();
     let dp = Datapath::new(config.clone())?;
     let proof = check(&dp).map_err(anyhow::Error::msg)?;
-    if !r.budget.met_by(&proof.output_figures()) {
+    if !r.budget.met_by(&proof.output_figures(), &dp) {
         bail!("the configuration found does not meet the budget on re-check: this is a bug");
     }
     let header = format!(

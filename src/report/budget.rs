@@ -159,10 +159,7 @@ pub fn document(r: &BudgetReport) -> Vec<Block> {
                     .iter()
                     .map(|b| {
                         vec![
-                            serde_json::to_value(b.metric)
-                                .ok()
-                                .and_then(|v| v.as_str().map(str::to_string))
-                                .unwrap_or_default(),
+                            b.metric.to_string(),
                             format!("{:.6e}", b.limit),
                             format!("{:.6e}", b.value),
                             s(if b.pass { "pass" } else { "FAIL" }),
