@@ -2,15 +2,16 @@
 //! exhaustive check.
 //!
 //! Search: start from a wide feasible point (every searched stage, t, b and the squarings, at
-//! `start_frac` fraction bits; the output format is kept, it is the design's interface), then
-//! per-stage bisection of the fraction bits (each stage in turn, the others fixed,
+//! `start_frac` fraction bits; the other knobs, such as the coefficient's and output's formats
+//! where the budget measures them, at the base's values), then per-knob bisection of the bits (each stage in turn, the others fixed,
 //! repeated until nothing shrinks), from each combination of the discrete choices (k, the
 //! variant, the rounding of every stage); keep the cheapest feasible result. Then a local
 //! search from it: each stage's rounding and overflow mode changed alone (the output's too),
 //! the rounding also with one fraction bit less, accepting any feasible cheaper move, until no
 //! move improves. Every candidate is checked exhaustively, and the answer is shown locally
 //! minimal: taking one fraction bit from any searched stage breaks the budget, and no single
-//! mode change is feasible and cheaper.
+//! mode change is feasible and cheaper. An overflow mode changes only on a stage the exhaustive
+//! check proves never overflows (every mode then gives the same values).
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -382,6 +383,18 @@ fn set_frac(cfg: &mut Config, stage: Stage, frac: i32) -> Result<(), Error> {
     Ok(())
 }
 
+/// Whether the exhaustive check proves a stage of a configuration never overflows (no wrap,
+/// saturation or zeroing on any input).
+fn never_overflows(cfg: &Config, stage: Stage) -> Result<bool, Error> {
+    let report = crate::analysis::check::check(&Datapath::new(cfg.clone())?)?;
+    let name = stage.to_string();
+    Ok(report
+        .stages
+        .iter()
+        .find(|s| s.stage == name)
+        .is_some_and(|s| s.wrapped == 0 && s.saturated == 0 && s.zeroed == 0))
+}
+
 /// Whether a candidate meets the budget, and how far it is from it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Verdict {
@@ -627,7 +640,9 @@ pub fn search(
                     }
                     trials.push(trial);
                 }
-                let overflows = if space.overflow_moves {
+                // An overflow mode may change only where the exhaustive check proves the stage
+                // never overflows: there every mode gives the same values.
+                let overflows = if space.overflow_moves && never_overflows(&current.config, s)? {
                     Overflow::ALL.to_vec()
                 } else {
                     Vec::new()
@@ -672,6 +687,17 @@ pub fn search(
         minimality.push(format!(
             "then a local search over every stage's rounding{} modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried, none of the final ones both feasible and cheaper",
             if space.overflow_moves { " and overflow" } else { "" }
+        ));
+        if space.overflow_moves {
+            minimality.push("overflow modes were changed only on stages an exhaustive check proves never overflow, where every mode gives the same values".to_string());
+        }
+        minimality.push(format!(
+            "the knobs searched: {}",
+            knobs_of(b.config.k)
+                .iter()
+                .map(|k| k.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         ));
         for knob in knobs_of(b.config.k) {
             let mut trial = b.config.clone();
