@@ -55,6 +55,41 @@ fn check_json_has_the_documented_keys() {
     );
 }
 
+/// The figures that look alarming carry their explanation on the next line: t's saturation,
+/// and the output's error in LSBs as noise bits and effective bits. The noise bits are
+/// log2 of the JSON's max ulp; the relative error is max |err| over the largest output, the
+/// coefficient of n = 1024 (17 * 1024 / (32 pi) = 173.16) at c = 1.
+#[test]
+fn check_table_explains_its_large_figures_beside_them() {
+    let o = specfx(&["check", "--config", "baseline", "--n", "64,1024"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let lines: Vec<&str> = text.lines().collect();
+    let t = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with("t "))
+        .unwrap();
+    assert!(lines[t + 1].contains("^ t saturated"), "{text}");
+    let out = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with("out "))
+        .unwrap();
+    let j = specfx(&["check", "--config", "baseline", "--n", "64,1024", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&j)).unwrap();
+    let s = &v["stages"][8];
+    let ulp = s["max_ulp"].as_f64().unwrap();
+    let rel = s["max_abs_err"].as_f64().unwrap() / (17.0 * 1024.0 / (32.0 * std::f64::consts::PI));
+    let want = format!("about {:.1} of its 16 fraction bits are noise", ulp.log2());
+    assert!(lines[out + 1].contains(&want), "{}\n{want}", lines[out + 1]);
+    assert!(
+        lines[out + 1].contains(&format!("{rel:.2e}")),
+        "{}",
+        lines[out + 1]
+    );
+    assert!(text.contains("lsb8 = 2^-8 = 3.906e-3"), "{text}");
+    assert!(!text.contains("\nnote: t saturated"), "{text}");
+}
+
 #[test]
 fn check_table_reads_a_user_config_on_top_of_baseline() {
     let cfg = temp_path("narrow.toml");

@@ -52,8 +52,24 @@ pub fn write_check_table(w: &mut impl Write, r: &CheckReport) -> io::Result<()> 
             s.wrapped,
             s.zeroed
         )?;
+        // The explanation of a figure sits beside it.
+        for note in r
+            .notes
+            .iter()
+            .filter(|n| n.starts_with(&format!("{} ", s.stage)))
+        {
+            writeln!(w, "        ^ {note}")?;
+        }
+        if s.stage == "out" {
+            if let Some(line) = effective_bits(s) {
+                writeln!(w, "        ^ {line}")?;
+            }
+        }
     }
-    writeln!(w, "normalised lobe (before the coefficient), max |error|:")?;
+    writeln!(
+        w,
+        "normalised lobe (before the coefficient), max |error| (lsb8 = 2^-8 = 3.906e-3, one step of an 8-bit display at the lobe's peak):"
+    )?;
     for (name, v, at) in [
         (
             "quantization  (fixed vs f64 lobe)",
@@ -103,8 +119,34 @@ pub fn write_check_table(w: &mut impl Write, r: &CheckReport) -> io::Result<()> 
         "cutoff: {} evaluations had their base cut to zero",
         r.n_cut
     )?;
-    for note in &r.notes {
+    for note in r.notes.iter().filter(|n| {
+        !r.stages
+            .iter()
+            .any(|s| n.starts_with(&format!("{} ", s.stage)))
+    }) {
         writeln!(w, "note: {note}")?;
     }
     Ok(())
+}
+
+/// What the output's error in LSBs means: the lobe's error times the coefficient, so many of
+/// the output's fraction bits are noise; its effective fraction bits and relative accuracy.
+fn effective_bits(s: &crate::analysis::check::StageStats) -> Option<String> {
+    let format: crate::fixed::Format = s.format.parse().ok()?;
+    let largest = format.to_f64(s.raw_max);
+    if s.max_ulp <= 1.0 || largest <= 0.0 {
+        return None;
+    }
+    let noise_bits = s.max_ulp.log2();
+    let relative = s.max_abs_err / largest;
+    Some(format!(
+        "{:.1} output LSBs: the lobe's error times the coefficient; about {:.1} of its {} fraction bits are noise ({:.1} effective), a relative error of {:.2e} of the largest output {:.4} ({:.1} effective bits)",
+        s.max_ulp,
+        noise_bits,
+        format.frac_bits(),
+        f64::from(format.frac_bits()) - noise_bits,
+        relative,
+        largest,
+        -relative.log2()
+    ))
 }
