@@ -868,6 +868,31 @@ pub fn exhaustive_judge(dp: &Datapath, budget: &Budget) -> Result<Verdict, Error
     })
 }
 
+/// The searches of several algorithms as one: the cheapest answer (with its minimality), or
+/// the closest point when none has one; every evaluation counted. Ties keep the earlier.
+pub fn combine(results: Vec<SearchResult>) -> SearchResult {
+    let mut out = SearchResult {
+        best: None,
+        closest: None,
+        n_evaluations: 0,
+        minimality: Vec::new(),
+    };
+    for r in results {
+        out.n_evaluations += r.n_evaluations;
+        if let Some(b) = r.best {
+            if out.best.as_ref().is_none_or(|x| b.cost < x.cost) {
+                out.best = Some(b);
+                out.minimality = r.minimality;
+            }
+        } else if let Some(c) = r.closest {
+            if out.closest.as_ref().is_none_or(|x| c.excess < x.excess) {
+                out.closest = Some(c);
+            }
+        }
+    }
+    out
+}
+
 /// What [`optimize_all`] found.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OptimizeAll {
@@ -929,20 +954,11 @@ pub fn optimize_all(
         n_evaluations: 0,
         minimality: Vec::new(),
     };
-    for r in results {
-        let r = r?;
-        out.n_evaluations += r.n_evaluations;
-        if let Some(b) = r.best {
-            if out.best.as_ref().is_none_or(|x| b.cost < x.cost) {
-                out.best = Some(b);
-                out.minimality = r.minimality;
-            }
-        } else if let Some(c) = r.closest {
-            if out.closest.as_ref().is_none_or(|x| c.excess < x.excess) {
-                out.closest = Some(c);
-            }
-        }
-    }
+    let combined = combine(results.into_iter().collect::<Result<Vec<_>, Error>>()?);
+    out.best = combined.best;
+    out.closest = combined.closest;
+    out.n_evaluations = combined.n_evaluations;
+    out.minimality = combined.minimality;
     let skipped: Vec<String> = floors
         .iter()
         .filter(|f| !f.reachable)

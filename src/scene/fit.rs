@@ -12,7 +12,7 @@ use std::str::FromStr;
 use serde::Serialize;
 
 use crate::analysis::optimize::{
-    search, start_of, Algorithm, Candidate, Choices, Knob, SearchResult, Space, Verdict,
+    combine, search, start_of, Algorithm, Candidate, Choices, Knob, SearchResult, Space, Verdict,
 };
 use crate::error::Error;
 use crate::fixed::Rounding;
@@ -534,26 +534,20 @@ pub fn fit_search(
             Ok((r, extra))
         })
         .collect();
-    let mut out = FitSearch {
-        best: None,
-        closest: None,
-        n_evaluations: 0,
-        minimality: Vec::new(),
-    };
+    let mut searched = Vec::new();
+    let mut extra = 0;
     for r in results {
-        let (r, extra) = r?;
-        out.n_evaluations += r.n_evaluations + extra;
-        if let Some(b) = r.best {
-            if out.best.as_ref().is_none_or(|x| b.cost < x.cost) {
-                out.best = Some(b);
-                out.minimality = r.minimality;
-            }
-        } else if let Some(c) = r.closest {
-            if out.closest.as_ref().is_none_or(|x| c.excess < x.excess) {
-                out.closest = Some(c);
-            }
-        }
+        let (r, e) = r?;
+        searched.push(r);
+        extra += e;
     }
+    let c = combine(searched);
+    let mut out = FitSearch {
+        best: c.best,
+        closest: c.closest,
+        n_evaluations: c.n_evaluations + extra,
+        minimality: c.minimality,
+    };
     // The base restricted to the scene's exponents renders the scene exactly as the generic
     // datapath does: a candidate too, so a budget the generic datapath meets has an answer.
     let dp = Datapath::new(base.clone())?;
