@@ -174,6 +174,15 @@ fn report_writes_its_files_and_a_summary() {
     assert!(index.contains("href=\"stability/stability.html\""));
     assert!(index.contains("src=\"render/datapath.png\""));
     assert!(index.contains("href=\"fit/fitted.toml\""));
+    // The page opens with a verdict and has sections for cost and the cycle model. The
+    // baseline is 4.36 lsb8 from cos^n (the paper's 1.70e-2 times 256), so it misses 1 lsb8.
+    let verdict = index.find("<b>Verdict.</b>").expect("a verdict");
+    assert!(verdict < index.find("<h2>").unwrap());
+    assert!(
+        index.contains("it does not meet a 1 lsb8 budget"),
+        "{index}"
+    );
+    assert!(index.contains("<h2>The cycle model</h2>"));
     assert!(index.contains("src=\"furnace/furnace_phong.png\""));
     // The default fit serves only the scene's four exponents, within its budget.
     let fitted = specfx::pipeline::Config::from_toml(
