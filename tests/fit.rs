@@ -238,7 +238,18 @@ fn the_judge_renders_what_the_oracle_renders() {
     narrow.coef.format = "u8.2".parse().unwrap();
     narrow.out.format = "u5.6".parse().unwrap();
     let narrow = Datapath::new(narrow).unwrap();
-    for dp in [&base, &narrow] {
+    // At the edges validation accepts: 40-bit squarings (products beyond the i64 kernels, so
+    // the exact fallback runs), a 1-bit-fraction t that wraps, a 2-bit output fraction.
+    let mut edge = base.config().clone();
+    edge.t.format = "s3.1".parse().unwrap();
+    edge.t.overflow = specfx::fixed::Overflow::Wrap;
+    edge.t.rounding = specfx::fixed::Rounding::Trn;
+    for s in &mut edge.square {
+        s.format = "u1.40".parse().unwrap();
+    }
+    edge.out.format = "u9.2".parse().unwrap();
+    let edge = Datapath::new(edge).unwrap();
+    for dp in [&base, &narrow, &edge] {
         let image = judge.datapath_image(dp);
         assert_eq!(
             image,
