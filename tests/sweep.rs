@@ -152,6 +152,10 @@ fn bad_spaces_name_the_axis() {
 }
 
 fn point(index: u64, luts: u64, err: f64) -> PointResult {
+    point_dsp(index, luts, 0, err)
+}
+
+fn point_dsp(index: u64, luts: u64, dsps: u64, err: f64) -> PointResult {
     PointResult {
         index,
         values: String::new(),
@@ -162,6 +166,8 @@ fn point(index: u64, luts: u64, err: f64) -> PointResult {
         out_correctly_rounded: Some(1.0),
         monotonic: Some(true),
         luts: Some(luts),
+        dsps: Some(dsps),
+        ffs: Some(1),
         register_bits: Some(1),
         multiplier_bits: Some(1),
         latency: Some(1),
@@ -187,6 +193,17 @@ fn pareto_front_by_hand() {
     mark_pareto(&mut pts);
     let front: Vec<u64> = pts.iter().filter(|p| p.pareto).map(|p| p.index).collect();
     assert_eq!(front, [0, 1, 4]);
+    // With DSP blocks a third cost: G (20 LUTs, 1 DSP, .2) is beaten by B (20, 0, .2); H
+    // (8 LUTs, 3 DSPs, .5) trades DSPs for LUTs against A and stays on the front.
+    let mut pts = vec![
+        point_dsp(0, 10, 1, 0.5),
+        point_dsp(1, 20, 0, 0.2),
+        point_dsp(2, 20, 1, 0.2),
+        point_dsp(3, 8, 3, 0.5),
+    ];
+    mark_pareto(&mut pts);
+    let front: Vec<u64> = pts.iter().filter(|p| p.pareto).map(|p| p.index).collect();
+    assert_eq!(front, [0, 1, 3]);
 }
 
 #[test]

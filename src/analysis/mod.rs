@@ -10,3 +10,7 @@ pub mod paper;
 pub mod stability;
 pub mod sweep;
 pub mod tradeoff;
+
+/// One lsb8: 2^-8 of the lobe's peak, one step of an 8-bit display; the unit every error
+/// figure of the lobe is printed in.
+pub const LSB8: f64 = 1.0 / 256.0;

@@ -206,7 +206,7 @@ fn cost_value(dp: &Datapath, arch: Arch, metric: Metric) -> f64 {
     let (target, pick): (Target, fn(&AnalyticCost) -> u64) = match metric {
         Metric::Luts(t) => (t, |c| c.luts),
         Metric::Dsps(t) => (t, |c| c.dsps),
-        Metric::Ffs(t) => (t, |c| c.register_bits),
+        Metric::Ffs(t) => (t, |c| c.ffs),
         _ => unreachable!("a cost metric"),
     };
     pick(&analytic_cost(dp, arch, target)) as f64

@@ -24,6 +24,13 @@ pub struct Space {
     pub base: Config,
     /// Axes by key (see [`AXIS_KEYS`]), each with its values as TOML values.
     pub axes: BTreeMap<String, Vec<toml::Value>>,
+    /// The target the points are priced on (analytic model) and the Pareto front drawn for.
+    #[serde(default = "default_target")]
+    pub target: Target,
+}
+
+fn default_target() -> Target {
+    Target::Ice40
 }
 
 /// The keys an axis may have. `<stage>.frac` and `<stage>.int` change the fraction or integer
@@ -62,6 +69,7 @@ pub const AXIS_KEYS: &[&str] = &[
 struct SpaceFile {
     base: Option<toml::Table>,
     n: Option<NSet>,
+    target: Option<String>,
     vary: toml::Table,
 }
 
@@ -160,7 +168,13 @@ impl Space {
             }
             axes.insert(key.clone(), expand(key, v)?);
         }
-        let space = Space { base, axes };
+        let target = match file.target {
+            Some(t) => t
+                .parse()
+                .map_err(|e: Error| space_error("target", e.to_string()))?,
+            None => default_target(),
+        };
+        let space = Space { base, axes, target };
         // Every value must at least be of the right kind for its axis.
         for (key, values) in &space.axes {
             for v in values {
@@ -309,8 +323,14 @@ pub struct PointResult {
     pub out_correctly_rounded: Option<f64>,
     /// Output non-decreasing in c for every n.
     pub monotonic: Option<bool>,
-    /// Analytic LUT estimate (generic target: every product in logic).
+    /// Analytic logic cells on the space's target (LUTs; gates for generic).
     pub luts: Option<u64>,
+    /// Analytic DSP blocks on the space's target.
+    #[serde(default)]
+    pub dsps: Option<u64>,
+    /// Analytic flip-flops on the space's target.
+    #[serde(default)]
+    pub ffs: Option<u64>,
     /// Analytic register bits.
     pub register_bits: Option<u64>,
     /// Partial-product bits of the multipliers.
@@ -351,6 +371,8 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
         out_correctly_rounded: None,
         monotonic: None,
         luts: None,
+        dsps: None,
+        ffs: None,
         register_bits: None,
         multiplier_bits: None,
         latency: None,
@@ -372,7 +394,7 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
         Ok(r) => r,
         Err(e) => return empty(e.to_string()),
     };
-    let cost = analytic_cost(&dp, arch, Target::Generic);
+    let cost = analytic_cost(&dp, arch, space.target);
     PointResult {
         index,
         values,
@@ -383,8 +405,10 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
         out_correctly_rounded: Some(r.out_correctly_rounded),
         monotonic: Some(r.monotonic),
         luts: Some(cost.luts),
-        register_bits: Some(cost.register_bits),
-        multiplier_bits: Some(cost.multiplier_bits),
+        dsps: Some(cost.dsps),
+        ffs: Some(cost.ffs),
+        register_bits: Some(cost.features.register_bits),
+        multiplier_bits: Some(cost.features.multiplier_bits),
         latency: Some(cost.latency),
         initiation_interval: Some(cost.initiation_interval),
         pareto: false,
@@ -394,40 +418,50 @@ pub fn evaluate(space: &Space, index: u64) -> PointResult {
     }
 }
 
-/// Marks the Pareto front: the valid points no other point beats in both cost (analytic
-/// LUTs) and error (`shape_total_max_abs`), ties broken by index. Sorts by index.
+/// Marks the Pareto front: the valid points no other point beats in logic cells, DSP blocks
+/// and error (`shape_total_max_abs`) at once, ties broken by index. Sorts by index.
 pub fn mark_pareto(points: &mut [PointResult]) {
     points.sort_by_key(|p| p.index);
-    let key = |p: &PointResult| p.luts.zip(p.shape_total_max_abs);
+    let key = |p: &PointResult| {
+        p.luts
+            .zip(p.shape_total_max_abs)
+            .map(|(c, e)| (c, p.dsps.unwrap_or(0), e))
+    };
     for i in 0..points.len() {
-        let Some((ci, ei)) = key(&points[i]) else {
+        let Some((ci, di, ei)) = key(&points[i]) else {
             points[i].pareto = false;
             continue;
         };
         let dominated = points.iter().enumerate().any(|(j, q)| {
-            key(q).is_some_and(|(cj, ej)| {
-                j != i
-                    && cj <= ci
-                    && ej <= ei
-                    && (cj < ci || ej < ei || (cj == ci && ej == ei && j < i))
+            key(q).is_some_and(|(cj, dj, ej)| {
+                let le = cj <= ci && dj <= di && ej <= ei;
+                let same = cj == ci && dj == di && ej == ei;
+                j != i && le && (!same || j < i)
             })
         });
         points[i].pareto = !dominated;
     }
 }
 
-/// The CSV of a sweep: one row per point, in index order.
-pub fn write_csv(w: &mut impl std::io::Write, points: &[PointResult]) -> std::io::Result<()> {
+/// The CSV of a sweep: one row per point, in index order; the cost columns are named with the
+/// target and unit (`ice40_luts,ice40_dsps,ice40_ffs`, `generic_gates,..`).
+pub fn write_csv(
+    w: &mut impl std::io::Write,
+    points: &[PointResult],
+    target: Target,
+) -> std::io::Result<()> {
+    let t = target.name().replace('-', "_");
+    let unit = target.logic_unit().to_lowercase();
     writeln!(
         w,
-        "index,values,invalid,shape_total_max_abs,shape_quant_max_abs,out_max_ulp,out_correctly_rounded,monotonic,luts,register_bits,multiplier_bits,latency,initiation_interval,pareto,yosys_luts,yosys_ffs,yosys_dsps"
+        "index,values,invalid,shape_total_max_abs,shape_quant_max_abs,out_max_ulp,out_correctly_rounded,monotonic,{t}_{unit},{t}_dsps,{t}_ffs,register_bits,multiplier_bits,latency,initiation_interval,pareto,yosys_{t}_{unit},yosys_{t}_ffs,yosys_{t}_dsps"
     )?;
     let f = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
     let u = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
     for p in points {
         writeln!(
             w,
-            "{},\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             p.index,
             p.values,
             p.invalid.as_deref().unwrap_or("").replace('"', "'"),
@@ -437,6 +471,8 @@ pub fn write_csv(w: &mut impl std::io::Write, points: &[PointResult]) -> std::io
             f(p.out_correctly_rounded),
             p.monotonic.map_or(String::new(), |m| m.to_string()),
             u(p.luts),
+            u(p.dsps),
+            u(p.ffs),
             u(p.register_bits),
             u(p.multiplier_bits),
             u(p.latency),

@@ -5,7 +5,7 @@ use serde::Serialize;
 
 use crate::cycle::Arch;
 use crate::engine::{fold_n, Codes};
-use crate::hdl::cost::{analytic_cost, Target};
+use crate::hdl::cost::{analytic_cost, figures_on_targets, CostFigures, Target};
 use crate::pipeline::{Config, Datapath, ProbeColumns};
 use crate::reference::lobe::Cutoff;
 use crate::reference::method::Method;
@@ -30,8 +30,9 @@ pub struct MethodFigures {
     pub evals_per_s: f64,
     /// Multipliers of a hardware implementation (None: needs a divider, exp or log unit).
     pub multipliers: Option<u32>,
-    /// Analytic LUTs of the pipelined datapath (fixed-point methods only).
-    pub luts: Option<u64>,
+    /// Analytic cost of the pipelined datapath on every reported target (fixed-point methods
+    /// only): the same figures `specfx cost --analytic-only` prints.
+    pub costs: Vec<CostFigures>,
     /// yosys figures of the pipelined datapath (fixed-point methods, with `--yosys`): the
     /// target, LUTs (logic gates for generic), DSP blocks and flip-flops.
     pub yosys: Option<YosysFigures>,
@@ -120,7 +121,7 @@ pub fn f64_figures(name: &str, method: Method, ns: &[u32], time: Timer) -> Metho
         mean_abs_err: sum / (ns.len() * cs.len()) as f64,
         evals_per_s: (ns.len() * cs.len()) as f64 / secs,
         multipliers,
-        luts: None,
+        costs: Vec::new(),
         yosys: None,
         latency,
         per_n_max_abs_err: per_n,
@@ -157,7 +158,7 @@ pub fn powi_figures(ns: &[u32], time: Timer) -> MethodFigures {
         mean_abs_err: sum / (ns.len() * cs.len()) as f64,
         evals_per_s: (ns.len() * cs.len()) as f64 / secs,
         multipliers: None,
-        luts: None,
+        costs: Vec::new(),
         yosys: None,
         latency: None,
         per_n_max_abs_err: per_n,
@@ -173,6 +174,16 @@ pub fn fixed_config(frac: i32) -> Config {
     for s in &mut cfg.square {
         s.format = fmt;
     }
+    cfg
+}
+
+/// The minimax datapath with `k` squarings in the trade-off: baseline's widths, u1.16 squares.
+pub fn fixed_minimax_config(k: u32) -> Config {
+    let mut cfg = Config::baseline();
+    cfg.name = format!("fixed_mm{k}");
+    cfg.variant = crate::pipeline::Variant::Minimax;
+    cfg.k = k;
+    cfg.square = vec![cfg.square[0]; k as usize];
     cfg
 }
 
@@ -214,7 +225,7 @@ pub fn fixed_figures(dp: &Datapath, time: Timer) -> MethodFigures {
         }
     })
     .max(1e-9);
-    let cost = analytic_cost(dp, Arch::Pipelined, Target::Generic);
+    let cost = analytic_cost(dp, Arch::Pipelined, Target::Ice40);
     MethodFigures {
         method: dp.config().name.clone(),
         kind: "fixed",
@@ -222,7 +233,7 @@ pub fn fixed_figures(dp: &Datapath, time: Timer) -> MethodFigures {
         mean_abs_err: sum / (dp.constants().len() * codes.len()) as f64,
         evals_per_s: (dp.constants().len() * codes.len()) as f64 / secs,
         multipliers: Some(dp.config().k + 2),
-        luts: Some(cost.luts),
+        costs: figures_on_targets(dp, Arch::Pipelined),
         yosys: None,
         latency: Some(cost.latency),
         per_n_max_abs_err: per_n,

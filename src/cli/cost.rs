@@ -179,9 +179,7 @@ pub fn cost_report(
         dsps: yosys.as_ref().map(|y| y.dsps),
         ffs: yosys.as_ref().map(|y| y.ffs),
         lut_ratio: yosys.as_ref().and_then(|y| ratio(y.luts, analytic.luts)),
-        ff_ratio: yosys
-            .as_ref()
-            .and_then(|y| ratio(y.ffs, analytic.register_bits)),
+        ff_ratio: yosys.as_ref().and_then(|y| ratio(y.ffs, analytic.ffs)),
         analytic,
         yosys,
         rom: constant_rom(dp, target),
@@ -209,7 +207,7 @@ pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Resul
     writeln!(
         w,
         "  {:<18} {:>10} {:>10} {:>8}",
-        "LUTs / gates",
+        a.logic_unit,
         a.luts,
         opt(r.luts),
         rat(r.lut_ratio)
@@ -218,7 +216,7 @@ pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Resul
         w,
         "  {:<18} {:>10} {:>10} {:>8}",
         "flip-flops",
-        a.register_bits,
+        a.ffs,
         opt(r.ffs),
         rat(r.ff_ratio)
     )?;
@@ -236,12 +234,21 @@ pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Resul
             writeln!(w, "  {:<18} {:>10} {:>10}", "transistors (CMOS)", "-", t)?;
         }
     }
+    let cal = specfx::hdl::calibrate::calibration(r.target);
+    writeln!(
+        w,
+        "  analytic model: calibrated against yosys on {} configurations; {} within {:.0}% (median), {:.0}% (90th percentile)",
+        cal.error.records,
+        a.logic_unit,
+        100.0 * cal.error.median_rel,
+        100.0 * cal.error.p90_rel
+    )?;
     write!(
         w,
-        "  multipliers ({} partial-product bits):",
-        a.multiplier_bits
+        "  multipliers ({} partial-product bits, {} left to logic):",
+        a.features.multiplier_bits, a.features.soft_multiplier_bits
     )?;
-    for m in &a.multipliers {
+    for m in &a.features.multipliers {
         write!(w, " {} {}x{}", m.name, m.a_bits, m.b_bits)?;
     }
     writeln!(w)?;

@@ -121,7 +121,7 @@ fn side_cost(dp: &Datapath, target: Target, yosys: bool) -> Result<SideCost> {
         n: dp.config().n.to_string(),
         analytic_luts: a.luts,
         analytic_dsps: a.dsps,
-        analytic_ffs: a.register_bits,
+        analytic_ffs: a.ffs,
         rom_entries: rom.entries,
         rom_bits: rom.bits,
         rom_analytic_luts: rom.luts,

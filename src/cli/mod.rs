@@ -4,6 +4,7 @@
 //! I/O error (one line on stderr). A closed stdout (broken pipe) is not an error.
 
 pub mod budget;
+mod calibrate;
 mod check;
 pub mod cost;
 mod datapath;
@@ -51,6 +52,9 @@ enum Command {
     Hdl(hdl::HdlArgs),
     /// Synthesis cost of a configuration: yosys on the reference Verilog, and the analytic model.
     Cost(cost::CostArgs),
+    /// Calibrates the analytic cost model against yosys: a seeded sample synthesised, the
+    /// model's coefficients fitted, the fit error printed.
+    Calibrate(calibrate::CalibrateArgs),
     /// Evaluates a design space: every point checked exhaustively and costed; Pareto front.
     Sweep(sweep::SweepArgs),
     /// Error-budget report: per-stage attribution, headroom, histograms, gappa bounds.
@@ -112,6 +116,7 @@ pub fn main() -> ExitCode {
         Command::Vectors(args) => vectors::run(&args),
         Command::Sim(args) => sim::run(&args),
         Command::Cost(args) => cost::run(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Budget(args) => budget::run(&args),
         Command::Optimize(args) => optimize::run(&args),

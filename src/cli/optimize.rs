@@ -30,9 +30,13 @@ pub struct OptimizeArgs {
     /// Exponents, replacing the configuration's set.
     #[arg(long)]
     n: Option<NSet>,
-    /// Cost to minimise: analytic (LUTs, instant) or yosys (iCE40 LUTs, seconds per candidate).
+    /// Cost to minimise: analytic (the calibrated model's logic cells on --target, instant) or
+    /// yosys (yosys's count on --target, seconds per candidate).
     #[arg(long, default_value = "analytic")]
     objective: String,
+    /// Target whose logic cells are minimised: ice40 (LUTs), xilinx (LUTs) or generic (gates).
+    #[arg(long, default_value = "ice40")]
+    target: Target,
     /// Numbers of squarings to try (each is searched only if its f64 floor can meet the
     /// budget).
     #[arg(long, default_value = "1..=7")]
@@ -65,16 +69,18 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     };
     let hdl = super::cost::hdl_ref_dir(None);
     let arch = args.arch;
+    let target = args.target;
+    let unit = format!("{} on {}", target.logic_unit(), target.name());
     let cost = |dp: &Datapath| -> Result<f64, specfx::Error> {
         if yosys {
-            super::cost::run_yosys(dp, arch, Target::Ice40, &hdl)
+            super::cost::run_yosys(dp, arch, target, &hdl)
                 .map(|(c, _, _)| c.luts as f64)
                 .map_err(|e| specfx::Error::Tool {
                     tool: "yosys",
                     message: format!("{e:#}"),
                 })
         } else {
-            Ok(analytic_cost(dp, arch, Target::Generic).luts as f64)
+            Ok(analytic_cost(dp, arch, target).luts as f64)
         }
     };
     let variants: Vec<Variant> = args
@@ -112,8 +118,8 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             r.best
                 .as_ref()
                 .map_or("nothing meets the budget".to_string(), |b| format!(
-                    "{:.0} LUTs",
-                    b.cost
+                    "{:.0} {unit} ({})",
+                    b.cost, args.objective
                 ))
         );
         match &bar {
@@ -211,7 +217,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         bail!("the configuration found does not meet the budget on re-check: this is a bug");
     }
     let header = format!(
-        "# specfx optimize: cheapest configuration found for the budget '{}'\n# cost {:.0} LUTs ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
+        "# specfx optimize: cheapest configuration found for the budget '{}'\n# cost {:.0} {unit} ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
         r.budget,
         best.cost,
         args.objective,
@@ -226,7 +232,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         format!("{header}{}", config.to_toml()).as_bytes(),
     )?;
     println!(
-        "best: k = {}, {}, t {} b {} squares {} out {}: {:.0} LUTs ({})",
+        "best: k = {}, {}, t {} b {} squares {} out {}: {:.0} {unit} ({})",
         config.k,
         config.variant.name(),
         config.t.format,
@@ -273,25 +279,21 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     println!(
         "against the paper's datapath (baseline: plain, k = 4, same n): shape_total {:.3e} ({:.2} lsb8) against {:.3e} ({:.2} lsb8)",
         proof.shape_total_max_abs,
-        proof.shape_total_max_abs * 256.0,
+        proof.shape_total_max_abs / specfx::analysis::LSB8,
         paper_check.shape_total_max_abs,
-        paper_check.shape_total_max_abs * 256.0
+        paper_check.shape_total_max_abs / specfx::analysis::LSB8
     );
     println!(
-        "  analytic cost, {arch}:      {:>22} {:>22}",
+        "  analytic cost, {arch} (the model `specfx cost` prints): {:>28} {:>28}",
         "this", "paper's"
     );
-    for target in [Target::Generic, Target::Ice40, Target::Xilinx] {
+    for target in specfx::hdl::cost::REPORTED_TARGETS {
         let a = analytic_cost(&dp, arch, target);
         let p = analytic_cost(&paper, arch, target);
-        println!(
-            "    {:<8} {:>12} LUTs {:>3} DSPs {:>12} LUTs {:>3} DSPs",
-            target.name(),
-            a.luts,
-            a.dsps,
-            p.luts,
-            p.dsps
-        );
+        let show = |c: &specfx::hdl::cost::AnalyticCost| {
+            format!("{} {} {} DSPs {} FFs", c.luts, c.logic_unit, c.dsps, c.ffs)
+        };
+        println!("    {:<8} {:>28} {:>28}", target.name(), show(&a), show(&p));
     }
     println!("why minimal (within this search, not over every possible datapath):");
     for m in &r.minimality {

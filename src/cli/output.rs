@@ -62,3 +62,50 @@ pub fn print_json(value: &impl serde::Serialize) -> Result<()> {
         Ok(())
     })
 }
+
+/// A progress bar on a terminal (`label`, position, ETA); elsewhere a line per step on stderr.
+pub struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    label: String,
+    len: u64,
+    pos: std::sync::atomic::AtomicU64,
+}
+
+/// Starts a [`Progress`] of `len` steps.
+pub fn progress(len: u64, label: &str) -> Progress {
+    use std::io::IsTerminal;
+    let bar = io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new(len);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(&format!(
+                "{label} {{bar:40}} {{pos}}/{{len}} eta {{eta}}"
+            ))
+            .expect("valid template"),
+        );
+        b
+    });
+    Progress {
+        bar,
+        label: label.to_string(),
+        len,
+        pos: std::sync::atomic::AtomicU64::new(0),
+    }
+}
+
+impl Progress {
+    /// One step done; `what` names it on the line printed off a terminal.
+    pub fn step(&self, what: &str) {
+        let pos = self.pos.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        match &self.bar {
+            Some(b) => b.inc(1),
+            None => eprintln!("{}: {what} ({pos}/{})", self.label, self.len),
+        }
+    }
+
+    /// Clears the bar.
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}

@@ -30,9 +30,10 @@ pub struct SweepArgs {
     /// Evaluate only the points whose index is I modulo N (written I/N).
     #[arg(long, value_parser = parse_shard)]
     shard: Option<(u64, u64)>,
-    /// Also synthesise the Pareto points with yosys for this target (generic, ice40, xilinx).
-    #[arg(long)]
-    yosys: Option<specfx::hdl::cost::Target>,
+    /// Also synthesise the Pareto points with yosys, on the space's target (`target` in the
+    /// space file, ice40 by default); naming the target is allowed and must match it.
+    #[arg(long, num_args = 0..=1, default_missing_value = "space")]
+    yosys: Option<String>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -146,10 +147,16 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
     }
     let mut points: Vec<PointResult> = done.into_values().collect();
     specfx::analysis::sweep::mark_pareto(&mut points);
-    if let Some(target) = args.yosys {
+    if let Some(named) = &args.yosys {
+        let target = info.space.target;
+        if named != "space" && named.parse::<specfx::hdl::cost::Target>()? != target {
+            bail!(
+                "--yosys {named}: the space is priced on {target}; set target = \"{named}\" in the space file to synthesise on {named}"
+            );
+        }
         synthesise_front(&info.space, &mut points, target, dir)?;
     }
-    write_results(dir, &mut points)?;
+    write_results(dir, &mut points, info.space.target)?;
     println!(
         "sweep: {} points in {} ({} on the Pareto front)",
         points.len(),
@@ -235,15 +242,19 @@ fn read_points(path: &Path) -> Result<BTreeMap<u64, PointResult>> {
     Ok(map)
 }
 
-fn write_results(dir: &Path, points: &mut [PointResult]) -> Result<()> {
+fn write_results(
+    dir: &Path,
+    points: &mut [PointResult],
+    target: specfx::hdl::cost::Target,
+) -> Result<()> {
     mark_pareto(points);
     let mut csv = Vec::new();
-    write_csv(&mut csv, points)?;
+    write_csv(&mut csv, points, target)?;
     write_atomic(&dir.join("sweep.csv"), &csv)?;
     let mut json = serde_json::to_vec_pretty(&points)?;
     json.push(b'\n');
     write_atomic(&dir.join("sweep.json"), &json)?;
-    let chart = specfx::report::sweep::chart(points);
+    let chart = specfx::report::sweep::chart(points, target);
     let svg = specfx::report::chart::render_svg(&chart).map_err(anyhow::Error::msg)?;
     write_atomic(&dir.join("sweep.svg"), svg.as_bytes())?;
     let png = specfx::report::chart::render_png(&chart).map_err(anyhow::Error::msg)?;
@@ -285,6 +296,7 @@ fn merge(out: &Path, shards: &[PathBuf]) -> Result<Outcome> {
         );
     }
     fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let target = info.space.target;
     let merged = SweepInfo {
         shard_index: 0,
         shard_count: 1,
@@ -300,7 +312,7 @@ fn merge(out: &Path, shards: &[PathBuf]) -> Result<Outcome> {
     }
     write_atomic(&out.join("points.jsonl"), lines.as_bytes())?;
     let mut points: Vec<PointResult> = points.into_values().collect();
-    write_results(out, &mut points)?;
+    write_results(out, &mut points, target)?;
     println!(
         "sweep merge: {} points from {} shards into {}",
         points.len(),

@@ -10,9 +10,10 @@ use clap::Args;
 use super::output::{print_json, write_atomic, write_chart};
 use super::Outcome;
 use specfx::analysis::tradeoff::{
-    f64_figures, f64_methods, fixed_config, fixed_figures, powi_figures, MethodFigures,
-    YosysFigures,
+    f64_figures, f64_methods, fixed_config, fixed_figures, fixed_minimax_config, powi_figures,
+    MethodFigures, YosysFigures,
 };
+use specfx::hdl::cost::Target;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
 use specfx::report::tradeoff::{per_n_chart, speed_chart};
@@ -57,8 +58,11 @@ pub fn tradeoff(
     }
     eprintln!("tradeoff: powi");
     figures.insert(1, powi_figures(ns_v, &mut time_it));
-    for frac in [8, 12, 16] {
-        let mut cfg = fixed_config(frac);
+    let configs = [8, 12, 16]
+        .into_iter()
+        .map(fixed_config)
+        .chain((3..=6).map(fixed_minimax_config));
+    for mut cfg in configs {
         cfg.n = ns.clone();
         let dp = Datapath::new(cfg)?;
         eprintln!("tradeoff: {}", dp.config().name);
@@ -83,20 +87,29 @@ pub fn tradeoff(
     let mut csv = Vec::new();
     writeln!(
         csv,
-        "method,kind,max_abs_err,mean_abs_err,evals_per_s,multipliers,luts,latency,yosys_target,yosys_luts,yosys_dsps,yosys_ffs"
+        "method,kind,max_abs_err,max_err_lsb8,mean_abs_err,evals_per_s,multipliers,ice40_luts,ice40_dsps,ice40_ffs,xilinx_luts,xilinx_dsps,xilinx_ffs,generic_gates,generic_ffs,latency,yosys_target,yosys_luts,yosys_dsps,yosys_ffs"
     )?;
     let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
+    let cost = |f: &MethodFigures, t: Target| f.costs.iter().find(|c| c.target == t).copied();
     for f in &figures {
         writeln!(
             csv,
-            "{},{},{:e},{:e},{:e},{},{},{},{},{},{},{}",
+            "{},{},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             f.method,
             f.kind,
             f.max_abs_err,
+            f.max_abs_err / specfx::analysis::LSB8,
             f.mean_abs_err,
             f.evals_per_s,
             opt(f.multipliers.map(u64::from)),
-            opt(f.luts),
+            opt(cost(f, Target::Ice40).map(|c| c.luts)),
+            opt(cost(f, Target::Ice40).map(|c| c.dsps)),
+            opt(cost(f, Target::Ice40).map(|c| c.ffs)),
+            opt(cost(f, Target::Xilinx).map(|c| c.luts)),
+            opt(cost(f, Target::Xilinx).map(|c| c.dsps)),
+            opt(cost(f, Target::Xilinx).map(|c| c.ffs)),
+            opt(cost(f, Target::Generic).map(|c| c.luts)),
+            opt(cost(f, Target::Generic).map(|c| c.ffs)),
             opt(f.latency),
             f.yosys.as_ref().map_or("", |y| y.target.as_str()),
             opt(f.yosys.as_ref().map(|y| y.luts)),
@@ -137,20 +150,30 @@ pub fn run(args: &TradeoffArgs) -> Result<Outcome> {
         let mut out = std::io::stdout().lock();
         writeln!(
             out,
-            "{:<16} {:>6} {:>11} {:>11} {:>12} {:>5} {:>6} {:>7}",
-            "method", "kind", "max |err|", "mean |err|", "Meval/s", "mult", "LUTs", "latency"
+            "{:<16} {:>6} {:>11} {:>11} {:>12} {:>5} {:>22} {:>7}",
+            "method",
+            "kind",
+            "max |err|",
+            "mean |err|",
+            "Meval/s",
+            "mult",
+            "ice40 LUTs+DSPs (an.)",
+            "latency"
         )?;
         for f in &figures {
             writeln!(
                 out,
-                "{:<16} {:>6} {:>11.3e} {:>11.3e} {:>12.1} {:>5} {:>6} {:>7}",
+                "{:<16} {:>6} {:>11.3e} {:>11.3e} {:>12.1} {:>5} {:>22} {:>7}",
                 f.method,
                 f.kind,
                 f.max_abs_err,
                 f.mean_abs_err,
                 f.evals_per_s / 1e6,
                 f.multipliers.map_or("-".into(), |m| m.to_string()),
-                f.luts.map_or("-".into(), |m| m.to_string()),
+                f.costs
+                    .iter()
+                    .find(|c| c.target == Target::Ice40)
+                    .map_or("-".into(), |c| format!("{} + {}", c.luts, c.dsps)),
                 f.latency.map_or("-".into(), |m| m.to_string())
             )?;
         }

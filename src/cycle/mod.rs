@@ -32,7 +32,7 @@ use crate::pipeline::walk::Stage;
 use crate::pipeline::Datapath;
 
 /// The two microarchitectures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Arch {
     /// One new input per cycle; every operation its own stage with its register latency.

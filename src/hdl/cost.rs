@@ -13,13 +13,14 @@ use crate::pipeline::Datapath;
 use crate::reference::lobe::Cutoff;
 
 /// A synthesis target of yosys.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Target {
     /// Generic gates (`synth`, then `abc -g cmos2`), with a CMOS transistor estimate.
     Generic,
     /// Generic gates mapped by `abc -fast -g cmos2`: minutes become seconds on wide or folded
     /// datapaths, for about 15% more cells.
+    #[serde(rename = "generic-fast")]
     GenericFast,
     /// Lattice iCE40 (`synth_ice40 -dsp`): LUT4, carry cells, SB_MAC16 DSPs.
     Ice40,
@@ -62,95 +63,228 @@ crate::names::named_enum!(
     "generic, generic-fast, ice40 or xilinx"
 );
 
-/// One multiplier of a datapath: its name and operand widths.
+/// One multiplier of a datapath: its name and operands.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Multiplier {
     /// Which product (`mul_t`, `sq1`.., `mul_out`, or `shared` for the folded unit).
     pub name: String,
     /// Width of the first operand.
     pub a_bits: u32,
+    /// Whether the first operand is signed.
+    pub a_signed: bool,
     /// Width of the second operand.
     pub b_bits: u32,
+    /// Whether the second operand is signed.
+    pub b_signed: bool,
+    /// Both operands are the same signal (a squaring).
+    pub square: bool,
 }
 
-/// The analytic cost of a datapath: counted from its formats, no synthesis.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AnalyticCost {
-    /// The architecture.
-    pub arch: Arch,
+/// How a target's synthesis maps multipliers onto DSP blocks: yosys's `mul2dsp` parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct DspParams {
+    a_max: u32,
+    b_max: u32,
+    a_max_partial: u32,
+    a_min: u32,
+    b_min: u32,
+    y_min: u32,
+    signed_only: bool,
+}
+
+impl Target {
+    fn dsp_params(self) -> Option<DspParams> {
+        match self {
+            Target::Generic | Target::GenericFast => None,
+            // synth_ice40 -dsp: SB_MAC16, 16 x 16, unsigned or signed.
+            Target::Ice40 => Some(DspParams {
+                a_max: 16,
+                b_max: 16,
+                a_max_partial: 16,
+                a_min: 2,
+                b_min: 2,
+                y_min: 11,
+                signed_only: false,
+            }),
+            // synth_xilinx -family xc7: DSP48E1, 25 x 18 signed, partial products 18 wide.
+            Target::Xilinx => Some(DspParams {
+                a_max: 25,
+                b_max: 18,
+                a_max_partial: 18,
+                a_min: 2,
+                b_min: 2,
+                y_min: 0,
+                signed_only: true,
+            }),
+        }
+    }
+
+    /// The unit of the target's logic figure: `LUTs` on the FPGAs, `gates` for generic.
+    pub fn logic_unit(self) -> &'static str {
+        match self {
+            Target::Generic | Target::GenericFast => "gates",
+            Target::Ice40 | Target::Xilinx => "LUTs",
+        }
+    }
+}
+
+/// How one multiplier maps onto a target: DSP blocks, partial-product bits left to logic,
+/// and the widths of the adders that sum the DSP blocks' partial products.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct MulMap {
+    dsps: u64,
+    soft_bits: u64,
+    glue_bits: u64,
+}
+
+/// Follows yosys's `mul2dsp` technology mapping (techlibs/common/mul2dsp.v): a product too
+/// small for a DSP stays in logic; an unsigned one is widened to signed where the DSP is
+/// signed-only; the wider operand goes first; an operand wider than the DSP is cut into
+/// partial slices whose products are summed.
+fn map_multiplier(
+    p: &DspParams,
+    (a, a_s): (u32, bool),
+    (b, b_s): (u32, bool),
+    y: u32,
+    top: bool,
+    out: &mut MulMap,
+) {
+    if a < p.a_min || b < p.b_min || y < p.y_min {
+        out.soft_bits += u64::from(a) * u64::from(b);
+        return;
+    }
+    if top && p.signed_only && !a_s && !b_s {
+        return map_multiplier(p, (a + 1, true), (b + 1, true), y, true, out);
+    }
+    if top && a < b {
+        return map_multiplier(p, (b, b_s), (a, a_s), y, true, out);
+    }
+    let h = u32::from(p.signed_only);
+    let slices = |w: u32, max: u32, partial: u32, other: u32| {
+        let n = (w - max + partial - h - 1) / (partial - h);
+        let last = w - n * (partial - h);
+        (n, last, y.min(other + partial), other + last)
+    };
+    if a > p.a_max {
+        let (n, last, py, ly) = slices(a, p.a_max, p.a_max_partial, b);
+        for _ in 0..n {
+            map_multiplier(p, (p.a_max_partial, h == 1), (b, b_s), py, false, out);
+        }
+        map_multiplier(p, (last, a_s), (b, b_s), ly, false, out);
+        out.glue_bits += u64::from(n) * u64::from(y);
+    } else if b > p.b_max {
+        let (n, last, py, ly) = slices(b, p.b_max, p.b_max, a);
+        for _ in 0..n {
+            map_multiplier(p, (a, a_s), (p.b_max, h == 1), py, false, out);
+        }
+        map_multiplier(p, (a, a_s), (last, b_s), ly, false, out);
+        out.glue_bits += u64::from(n) * u64::from(y);
+    } else {
+        out.dsps += 1;
+    }
+}
+
+/// The counted quantities of a datapath on a target, from its formats: what the analytic
+/// model weighs with its calibrated coefficients.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Features {
     /// Every multiplier.
     pub multipliers: Vec<Multiplier>,
     /// Sum of a_bits * b_bits over the multipliers (partial-product bits).
     pub multiplier_bits: u64,
-    /// Sum of the widths of the adders (subtraction, base sum, rounding increments).
+    /// Widths of the subtraction, the base sum and the paper cutoff's comparison.
     pub adder_bits: u64,
+    /// Output widths of the quantizers that round (not TRN): an increment each.
+    pub rounding_bits: u64,
+    /// Output widths of the quantizers that saturate (not WRAP): a compare-and-select each.
+    pub overflow_bits: u64,
+    /// Partial-product bits built in logic (every one without DSP blocks).
+    pub soft_multiplier_bits: u64,
+    /// Widths of the adders summing a wide product's DSP slices.
+    pub dsp_glue_bits: u64,
+    /// Multiplexer inputs of the power-of-two slope shifter (pipelined, slopes all 2^j).
+    pub shifter_bits: u64,
+    /// Operand-select inputs of the folded architecture's shared multiplier.
+    pub mux_bits: u64,
     /// Register bits (data, valid bits and the per-n constants carried along).
     pub register_bits: u64,
-    /// DSP blocks on the target (0 for generic).
+    /// DSP blocks.
     pub dsps: u64,
-    /// Estimated LUTs: adders and rounding plus, without DSP blocks, the partial products.
-    pub luts: u64,
-    /// Input-to-output latency in cycles.
-    pub latency: u64,
-    /// Initiation interval in cycles.
-    pub initiation_interval: u64,
 }
 
-/// The analytic cost of a datapath on a target.
-///
-/// The LUT estimate is deliberately simple (one LUT per adder bit, one per quantizer output
-/// bit for rounding unless it is TRN and one for overflow unless it is WRAP, one per
-/// partial-product bit when no DSP takes the product); `specfx cost` prints it
-/// beside yosys's count with their ratio, so sweeps can use it and calibrate it.
-///
-/// # Examples
-/// ```
-/// use specfx::cycle::Arch;
-/// use specfx::hdl::cost::{analytic_cost, Target};
-/// use specfx::pipeline::{Config, Datapath};
-/// let dp = Datapath::new(Config::baseline()).unwrap();
-/// let c = analytic_cost(&dp, Arch::Pipelined, Target::Ice40);
-/// // d (16 bits) x n (11 bits), four 17 x 17 squares, 17 x 24 for the output.
-/// assert_eq!(c.multiplier_bits, 16 * 11 + 4 * 17 * 17 + 17 * 24);
-/// assert_eq!(c.multipliers.len(), 6);
-/// ```
-pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost {
+impl Features {
+    /// Number of logic features weighed by the model.
+    pub const LOGIC: usize = 8;
+    /// Names of the logic features, in the order of [`Features::logic`].
+    pub const LOGIC_NAMES: [&'static str; Features::LOGIC] = [
+        "adder_bits",
+        "rounding_bits",
+        "overflow_bits",
+        "soft_multiplier_bits",
+        "dsp_glue_bits",
+        "shifter_bits",
+        "mux_bits",
+        "constant",
+    ];
+
+    /// The logic features, as the model weighs them.
+    pub fn logic(&self) -> [f64; Features::LOGIC] {
+        [
+            self.adder_bits as f64,
+            self.rounding_bits as f64,
+            self.overflow_bits as f64,
+            self.soft_multiplier_bits as f64,
+            self.dsp_glue_bits as f64,
+            self.shifter_bits as f64,
+            self.mux_bits as f64,
+            1.0,
+        ]
+    }
+
+    /// Logic cells under coefficients `c`.
+    pub fn logic_cells(&self, c: &[f64; Features::LOGIC]) -> f64 {
+        self.logic().iter().zip(c).map(|(x, w)| x * w).sum()
+    }
+}
+
+/// Counts a datapath's features on a target (see [`analytic_cost`]).
+pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
     let cfg = dp.config();
     let (slope, offset) = constant_formats(cfg);
     let w = |f: crate::fixed::Format| f.width();
     // Every slope a power of two (pipelined): t's product is a shift of d by one of the
     // slope's bit positions, a multiplexer per product bit and select bit, not a multiplier.
     let shift_t = arch == Arch::Pipelined && crate::hdl::slope_is_pow2(cfg);
-    let shifter_luts = if shift_t {
+    let shifter_bits = if shift_t {
         let shifts = u64::from(w(slope));
         let select_bits = u64::from(64 - (shifts.max(2) - 1).leading_zeros());
         u64::from(w(cfg.d.format) + w(slope)) * select_bits
     } else {
         0
     };
+    let operand = |name: String, a: crate::fixed::Format, b: crate::fixed::Format| Multiplier {
+        name,
+        a_bits: w(a),
+        a_signed: a.is_signed(),
+        b_bits: w(b),
+        b_signed: b.is_signed(),
+        square: false,
+    };
     let mut products = if shift_t {
         Vec::new()
     } else {
-        vec![Multiplier {
-            name: "mul_t".into(),
-            a_bits: w(cfg.d.format),
-            b_bits: w(slope),
-        }]
+        vec![operand("mul_t".into(), cfg.d.format, slope)]
     };
     let mut prev = cfg.b.format;
     for (i, sq) in cfg.square.iter().enumerate() {
+        let name = crate::pipeline::walk::Stage::Square(i).to_string();
         products.push(Multiplier {
-            name: crate::pipeline::walk::Stage::Square(i).to_string(),
-            a_bits: w(prev),
-            b_bits: w(prev),
+            square: true,
+            ..operand(name, prev, prev)
         });
         prev = sq.format;
     }
-    products.push(Multiplier {
-        name: "mul_out".into(),
-        a_bits: w(prev),
-        b_bits: w(cfg.coef.format),
-    });
+    products.push(operand("mul_out".into(), prev, cfg.coef.format));
     // A quantizer's rounding is an increment across its output (none for TRN, which only
     // drops bits); its overflow handling a compare-and-select per output bit (none for WRAP,
     // which only drops bits).
@@ -173,7 +307,12 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
             + cfg.t.format.frac_bits().max(offset.frac_bits()) as u32
             + 1,
     );
-    let adder_bits = u64::from(w(cfg.c.format)) + 1 + sum_bits + rounding_bits;
+    let compare_bits = if cfg.cutoff == Cutoff::Paper {
+        u64::from(w(cfg.c.format))
+    } else {
+        0
+    };
+    let adder_bits = u64::from(w(cfg.c.format)) + 1 + sum_bits + compare_bits;
     let carried = u64::from(w(offset) + w(cfg.coef.format))
         + if cfg.cutoff == Cutoff::Paper {
             2 * u64::from(w(cfg.c.format))
@@ -181,7 +320,7 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
             0
         };
     let lat = &cfg.latency;
-    let (multipliers, register_bits) = match arch {
+    let (multipliers, register_bits, mux_bits) = match arch {
         Arch::Pipelined => {
             let mut bits = u64::from(lat.sub)
                 * (u64::from(w(cfg.d.format)) + 1 + carried + u64::from(w(slope)));
@@ -193,11 +332,15 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
                     * (u64::from(w(sq.format)) + 1 + u64::from(w(cfg.coef.format)));
             }
             bits += u64::from(lat.mul) * (u64::from(w(cfg.out.format)) + 1);
-            (products, bits)
+            (products, bits, 0)
         }
         Arch::Folded => {
             let a = products.iter().map(|m| m.a_bits).max().unwrap_or(1);
             let b = products.iter().map(|m| m.b_bits).max().unwrap_or(1);
+            let mux: u64 = products
+                .iter()
+                .map(|m| u64::from(m.a_bits + m.b_bits))
+                .sum();
             let widest = dp.widest_stage_bits();
             let bits = u64::from(widest)
                 + carried
@@ -206,43 +349,167 @@ pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost 
                 + 1
                 + 16
                 + u64::from(lat.mul - 1) * u64::from(a + b);
-            (
-                vec![Multiplier {
-                    name: "shared".into(),
-                    a_bits: a,
-                    b_bits: b,
-                }],
-                bits,
-            )
+            let shared = Multiplier {
+                name: "shared".into(),
+                a_bits: a,
+                a_signed: products.iter().any(|m| m.a_signed),
+                b_bits: b,
+                b_signed: products.iter().any(|m| m.b_signed),
+                square: false,
+            };
+            (vec![shared], bits, mux)
         }
     };
     let multiplier_bits: u64 = multipliers
         .iter()
         .map(|m| u64::from(m.a_bits) * u64::from(m.b_bits))
         .sum();
-    let dsps: u64 = match target.dsp_operands() {
-        // yosys maps the largest block that fits to DSPs and the leftover bits to logic.
-        Some((da, db)) => multipliers
-            .iter()
-            .map(|m| {
-                let (a, b) = (m.a_bits.min(m.b_bits), m.a_bits.max(m.b_bits));
-                u64::from(((a / da) * (b / db)).max(1))
-            })
-            .sum(),
-        None => 0,
-    };
-    let luts =
-        adder_bits + overflow_bits + shifter_luts + if dsps == 0 { multiplier_bits } else { 0 };
-    AnalyticCost {
-        arch,
+    let mut map = MulMap::default();
+    match target.dsp_params() {
+        Some(p) => {
+            for m in &multipliers {
+                // The RTL multiplies signed codes; an unsigned operand beside a signed one
+                // keeps its zero sign bit, two unsigned operands lose both (yosys wreduce).
+                let signed = m.a_signed || m.b_signed;
+                let a = (m.a_bits + u32::from(signed && !m.a_signed), signed);
+                let b = (m.b_bits + u32::from(signed && !m.b_signed), signed);
+                let mut one = MulMap::default();
+                // (A square's slices i x j and j x i are not merged by yosys 0.23.)
+                map_multiplier(&p, a, b, a.0 + b.0, true, &mut one);
+                map.dsps += one.dsps;
+                map.soft_bits += one.soft_bits;
+                map.glue_bits += one.glue_bits;
+            }
+        }
+        None => map.soft_bits = multiplier_bits,
+    }
+    Features {
         multipliers,
         multiplier_bits,
         adder_bits,
+        rounding_bits,
+        overflow_bits,
+        soft_multiplier_bits: map.soft_bits,
+        dsp_glue_bits: map.glue_bits,
+        shifter_bits,
+        mux_bits,
         register_bits,
-        dsps,
-        luts,
-        latency: arch.latency(cfg),
-        initiation_interval: arch.initiation_interval(cfg),
+        dsps: map.dsps,
+    }
+}
+
+/// The three figures of a datapath on one target, named with the target: logic cells
+/// (`LUTs` on the FPGAs, `gates` for generic), DSP blocks and flip-flops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct CostFigures {
+    /// The target.
+    pub target: Target,
+    /// Logic cells in the target's unit ([`Target::logic_unit`]).
+    pub luts: u64,
+    /// DSP blocks.
+    pub dsps: u64,
+    /// Flip-flops.
+    pub ffs: u64,
+}
+
+impl CostFigures {
+    /// The figures as text: `813 LUTs + 7 DSPs + 332 FFs on ice40`.
+    pub fn describe(&self) -> String {
+        let dsps = if self.target.dsp_operands().is_some() {
+            format!(" + {} DSPs", self.dsps)
+        } else {
+            String::new()
+        };
+        format!(
+            "{} {}{dsps} + {} FFs on {}",
+            self.luts,
+            self.target.logic_unit(),
+            self.ffs,
+            self.target.name()
+        )
+    }
+}
+
+/// The targets every report prices a datapath on: iCE40, Xilinx 7-series, generic gates.
+pub const REPORTED_TARGETS: [Target; 3] = [Target::Ice40, Target::Xilinx, Target::Generic];
+
+/// The analytic cost of a datapath: counted from its formats, no synthesis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AnalyticCost {
+    /// The architecture.
+    pub arch: Arch,
+    /// The target the figures are for.
+    pub target: Target,
+    /// The unit of `luts`: `LUTs`, or `gates` for the generic targets.
+    pub logic_unit: &'static str,
+    /// Estimated logic cells (LUTs; gates for generic): the calibrated weighted sum of the
+    /// features.
+    pub luts: u64,
+    /// DSP blocks (0 for generic), from the target's DSP mapping rules.
+    pub dsps: u64,
+    /// Estimated flip-flops: the calibrated multiple of the register bits.
+    pub ffs: u64,
+    /// Input-to-output latency in cycles.
+    pub latency: u64,
+    /// Initiation interval in cycles.
+    pub initiation_interval: u64,
+    /// The counted quantities the estimates weigh.
+    pub features: Features,
+}
+
+impl AnalyticCost {
+    /// The three figures, named with the target.
+    pub fn figures(&self) -> CostFigures {
+        CostFigures {
+            target: self.target,
+            luts: self.luts,
+            dsps: self.dsps,
+            ffs: self.ffs,
+        }
+    }
+}
+
+/// The analytic cost figures of a datapath on every [`REPORTED_TARGETS`] target.
+pub fn figures_on_targets(dp: &Datapath, arch: Arch) -> Vec<CostFigures> {
+    REPORTED_TARGETS
+        .iter()
+        .map(|&t| analytic_cost(dp, arch, t).figures())
+        .collect()
+}
+
+/// The analytic cost of a datapath on a target: one model per target, the same figure in
+/// `cost`, `sweep`, `optimize`, `tradeoff`, `fit` and the reports.
+///
+/// The features (adder, rounding and overflow bits, partial-product bits left in logic after
+/// yosys's DSP mapping rules, DSP glue adders, shifter and operand multiplexers, register
+/// bits) are counted from the formats; the LUT and flip-flop estimates weigh them with
+/// coefficients fitted against yosys over the calibration sample in `data/calibration/`
+/// (`specfx calibrate`), whose error `specfx cost` prints.
+///
+/// # Examples
+/// ```
+/// use specfx::cycle::Arch;
+/// use specfx::hdl::cost::{analytic_cost, Target};
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let c = analytic_cost(&dp, Arch::Pipelined, Target::Ice40);
+/// // d (16 bits) x n (11 bits), four 17 x 17 squares, 17 x 24 for the output.
+/// assert_eq!(c.features.multiplier_bits, 16 * 11 + 4 * 17 * 17 + 17 * 24);
+/// assert_eq!(c.features.multipliers.len(), 6);
+/// ```
+pub fn analytic_cost(dp: &Datapath, arch: Arch, target: Target) -> AnalyticCost {
+    let features = features(dp, arch, target);
+    let c = crate::hdl::calibrate::coefficients(target);
+    AnalyticCost {
+        arch,
+        target,
+        logic_unit: target.logic_unit(),
+        luts: features.logic_cells(&c.logic).round().max(0.0) as u64,
+        dsps: features.dsps,
+        ffs: (features.register_bits as f64 * c.ff_per_register_bit).round() as u64,
+        latency: arch.latency(dp.config()),
+        initiation_interval: arch.initiation_interval(dp.config()),
+        features,
     }
 }
 

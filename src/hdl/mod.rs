@@ -4,6 +4,7 @@
 //! header of `` `define `` macros that this module renders for a configuration and an
 //! architecture, so one RTL source serves every configuration.
 
+pub mod calibrate;
 pub mod cost;
 pub mod rom;
 

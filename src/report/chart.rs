@@ -37,6 +37,19 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
+/// The Okabe-Ito palette (colour-blind safe): black, orange, sky blue, bluish green, yellow,
+/// blue, vermillion, reddish purple.
+pub const PALETTE: [(u8, u8, u8); 8] = [
+    (0, 0, 0),
+    (230, 159, 0),
+    (86, 180, 233),
+    (0, 158, 115),
+    (240, 228, 66),
+    (0, 114, 178),
+    (213, 94, 0),
+    (204, 121, 167),
+];
+
 /// A colour for series `i` of `count`, evenly spaced in hue (HSL with s = 0.7, l = 0.45).
 pub fn hue(i: usize, count: usize) -> (u8, u8, u8) {
     let h = i as f64 / count.max(1) as f64;

@@ -1,0 +1,394 @@
+//! Calibration of the analytic cost model against yosys: a seeded sample of configurations,
+//! the records of what yosys counted for each, and the least-squares fit of the model's
+//! coefficients (the records live in `data/calibration/`; `specfx calibrate` writes them).
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::cycle::Arch;
+use crate::error::Error;
+use crate::fixed::{Format, Overflow, Rounding};
+use crate::hdl::cost::{features, Features, Target};
+use crate::nset::NSet;
+use crate::pipeline::{Config, Datapath, StageSpec, Variant};
+use crate::reference::lobe::Cutoff;
+
+/// One synthesised configuration: what was built and what yosys counted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    /// Index in the seeded sample.
+    pub index: u64,
+    /// The microarchitecture synthesised.
+    pub arch: Arch,
+    /// The complete configuration.
+    pub config: Config,
+    /// yosys LUTs (logic gates for the generic target).
+    pub luts: u64,
+    /// yosys carry cells.
+    pub carries: u64,
+    /// yosys DSP blocks.
+    pub dsps: u64,
+    /// yosys flip-flops.
+    pub ffs: u64,
+    /// yosys's first error line when it failed on this configuration (then the counts are 0
+    /// and the record is left out of the fit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failed: Option<String>,
+}
+
+fn format(signed: bool, int: i32, frac: i32) -> Format {
+    Format::new(signed, int, frac).expect("sampled formats are in range")
+}
+
+fn stage(rng: &mut ChaCha8Rng, f: Format) -> StageSpec {
+    StageSpec {
+        format: f,
+        rounding: Rounding::ALL[rng.gen_range(0..Rounding::ALL.len())],
+        overflow: Overflow::ALL[rng.gen_range(0..Overflow::ALL.len())],
+    }
+}
+
+/// Configuration `index` of the calibration sample drawn with `seed`, and its architecture:
+/// k = 1..7, plain or minimax, every cutoff, rounding and overflow mode, input widths
+/// 8..16 bits, internal stages 6..24 fraction bits, coefficient and output 4..16 fraction
+/// bits, multiplier latencies 1..3, and n sets that are ranges, lists or powers of two.
+/// Draws that the datapath rejects are drawn again (deterministically).
+pub fn sample(seed: u64, index: u64) -> (Config, Arch) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    loop {
+        let mut cfg = Config::baseline();
+        cfg.name = format!("cal{index}");
+        cfg.variant = if rng.gen_bool(0.5) {
+            Variant::Plain
+        } else {
+            Variant::Minimax
+        };
+        cfg.k = rng.gen_range(1..=7);
+        cfg.cutoff = Cutoff::ALL[rng.gen_range(0..Cutoff::ALL.len())];
+        cfg.n = match rng.gen_range(0..3) {
+            0 => {
+                let lo = rng.gen_range(1..=64);
+                NSet::range(lo, lo + rng.gen_range(0..=1000)).expect("valid range")
+            }
+            1 => {
+                let mut v: Vec<u32> = (0..rng.gen_range(1..=8))
+                    .map(|_| rng.gen_range(1..=2048))
+                    .collect();
+                v.sort_unstable();
+                v.dedup();
+                NSet::from_values(&v).expect("valid list")
+            }
+            _ => {
+                let lo = rng.gen_range(0..=4);
+                let hi = rng.gen_range(lo..=10);
+                NSet::from_values(&(lo..=hi).map(|e| 1u32 << e).collect::<Vec<_>>())
+                    .expect("valid list")
+            }
+        };
+        let cf = rng.gen_range(8..=16);
+        cfg.c.format = format(false, 1, cf);
+        cfg.d.format = format(true, 1, cf);
+        let t_int = rng.gen_range(1..=3);
+        let t = format(true, t_int, rng.gen_range(6..=24));
+        cfg.t = stage(&mut rng, t);
+        let b = format(rng.gen_bool(0.2), 1, rng.gen_range(6..=24));
+        cfg.b = stage(&mut rng, b);
+        cfg.square = (0..cfg.k)
+            .map(|_| {
+                let f = format(false, 1, rng.gen_range(6..=24));
+                stage(&mut rng, f)
+            })
+            .collect();
+        cfg.coef.format = format(false, rng.gen_range(8..=11), rng.gen_range(4..=16));
+        cfg.coef.rounding = Rounding::ALL[rng.gen_range(0..Rounding::ALL.len())];
+        let out = format(false, rng.gen_range(8..=11), rng.gen_range(4..=16));
+        cfg.out = stage(&mut rng, out);
+        cfg.minimax.a_format = format(false, 11, rng.gen_range(8..=16));
+        cfg.minimax.offset_format = format(false, 1, rng.gen_range(8..=16));
+        cfg.latency.mul = rng.gen_range(1..=3);
+        cfg.latency.sub = rng.gen_range(1..=2);
+        cfg.latency.add = rng.gen_range(1..=2);
+        let arch = if rng.gen_bool(0.3) {
+            Arch::Folded
+        } else {
+            Arch::Pipelined
+        };
+        if Datapath::new(cfg.clone()).is_ok() {
+            return (cfg, arch);
+        }
+    }
+}
+
+/// The coefficients of one target's model: logic cells as a weighted sum of the features,
+/// flip-flops as a multiple of the register bits.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Coefficients {
+    /// Logic cells per feature, in the order of [`Features::logic`].
+    pub logic: [f64; Features::LOGIC],
+    /// Flip-flops per register bit.
+    pub ff_per_register_bit: f64,
+}
+
+/// How well a fitted model matches the records.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FitError {
+    /// Number of records.
+    pub records: usize,
+    /// Median of |model / yosys - 1| over the records (logic cells).
+    pub median_rel: f64,
+    /// 90th percentile of the same.
+    pub p90_rel: f64,
+    /// Largest of the same.
+    pub max_rel: f64,
+    /// Median of |model / yosys - 1| for flip-flops.
+    pub ff_median_rel: f64,
+    /// Share of records whose DSP count the model gives exactly.
+    pub dsp_exact: f64,
+}
+
+/// Least squares on relative error (each row weighted by 1 / yosys), every coefficient kept
+/// non-negative: a feature whose coefficient comes out negative is dropped and the rest refitted.
+pub fn fit_logic(rows: &[(Features, f64)]) -> [f64; Features::LOGIC] {
+    let mut active = [true; Features::LOGIC];
+    loop {
+        let idx: Vec<usize> = (0..Features::LOGIC).filter(|&i| active[i]).collect();
+        let p = idx.len();
+        let mut ata = vec![vec![0.0; p]; p];
+        let mut atb = vec![0.0; p];
+        for (f, y) in rows {
+            let w = 1.0 / y.max(1.0);
+            let x = f.logic();
+            for (a, &i) in idx.iter().enumerate() {
+                atb[a] += w * w * x[i] * y;
+                for (b, &j) in idx.iter().enumerate() {
+                    ata[a][b] += w * w * x[i] * x[j];
+                }
+            }
+        }
+        let sol = solve(ata, atb);
+        let mut out = [0.0; Features::LOGIC];
+        let mut negative = None;
+        for (a, &i) in idx.iter().enumerate() {
+            out[i] = sol[a];
+            if sol[a] < 0.0 && negative.is_none_or(|(_, v)| sol[a] < v) {
+                negative = Some((i, sol[a]));
+            }
+        }
+        match negative {
+            Some((i, _)) => active[i] = false,
+            None => return out,
+        }
+    }
+}
+
+/// Solves a small symmetric system by Gaussian elimination with partial pivoting; a singular
+/// direction (a feature that never varies) gets a zero coefficient.
+fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
+    let n = b.len();
+    let scale = a
+        .iter()
+        .enumerate()
+        .map(|(i, r)| r[i].abs())
+        .fold(0.0, f64::max);
+    let mut pivot_of = vec![None; n];
+    let mut used = vec![false; n];
+    for col in 0..n {
+        let Some(row) = (0..n)
+            .filter(|&r| !used[r])
+            .max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))
+        else {
+            break;
+        };
+        if a[row][col].abs() <= 1e-12 * scale.max(1e-300) {
+            continue;
+        }
+        used[row] = true;
+        pivot_of[col] = Some(row);
+        for r in 0..n {
+            if r != row {
+                let f = a[r][col] / a[row][col];
+                if f != 0.0 {
+                    let pivot_row = a[row].clone();
+                    for (x, p) in a[r][col..].iter_mut().zip(&pivot_row[col..]) {
+                        *x -= f * p;
+                    }
+                    b[r] -= f * b[row];
+                }
+            }
+        }
+    }
+    (0..n)
+        .map(|col| pivot_of[col].map_or(0.0, |row| b[row] / a[row][col]))
+        .collect()
+}
+
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return 0.0;
+    }
+    let i = ((sorted.len() - 1) as f64 * q).round() as usize;
+    sorted[i]
+}
+
+/// Fits a target's coefficients to its records and measures the fit on the same records.
+pub fn fit(records: &[Record], target: Target) -> Result<(Coefficients, FitError), Error> {
+    let mut rows = Vec::with_capacity(records.len());
+    let mut regs = (0.0, 0.0);
+    for r in records.iter().filter(|r| r.failed.is_none()) {
+        let dp = Datapath::new(r.config.clone()).map_err(|e| Error::Config {
+            key: format!("calibration record {}", r.index),
+            problem: e.to_string(),
+        })?;
+        let f = features(&dp, r.arch, target);
+        regs.0 += f.register_bits as f64 * r.ffs as f64;
+        regs.1 += (f.register_bits as f64).powi(2);
+        rows.push((f, r));
+    }
+    let logic = fit_logic(
+        &rows
+            .iter()
+            .map(|(f, r)| (f.clone(), r.luts as f64))
+            .collect::<Vec<_>>(),
+    );
+    let coefficients = Coefficients {
+        logic,
+        ff_per_register_bit: if regs.1 > 0.0 { regs.0 / regs.1 } else { 0.0 },
+    };
+    Ok((coefficients, measure(&rows, &coefficients)))
+}
+
+/// The fit error of `coefficients` on `(features, record)` pairs.
+fn measure(rows: &[(Features, &Record)], c: &Coefficients) -> FitError {
+    let rel = |model: f64, real: u64| (model / (real as f64).max(1.0) - 1.0).abs();
+    let mut logic: Vec<f64> = rows
+        .iter()
+        .map(|(f, r)| rel(f.logic_cells(&c.logic), r.luts))
+        .collect();
+    let mut ffs: Vec<f64> = rows
+        .iter()
+        .map(|(f, r)| rel(f.register_bits as f64 * c.ff_per_register_bit, r.ffs))
+        .collect();
+    logic.sort_by(f64::total_cmp);
+    ffs.sort_by(f64::total_cmp);
+    let exact = rows.iter().filter(|(f, r)| f.dsps == r.dsps).count();
+    FitError {
+        records: rows.len(),
+        median_rel: percentile(&logic, 0.5),
+        p90_rel: percentile(&logic, 0.9),
+        max_rel: logic.last().copied().unwrap_or(0.0),
+        ff_median_rel: percentile(&ffs, 0.5),
+        dsp_exact: if rows.is_empty() {
+            1.0
+        } else {
+            exact as f64 / rows.len() as f64
+        },
+    }
+}
+
+/// Reads a JSON Lines file of records (`path` names it in errors).
+pub fn read_records(text: &str, path: &str) -> Result<Vec<Record>, Error> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            serde_json::from_str(l).map_err(|e| Error::Config {
+                key: format!("{path}: line {}", i + 1),
+                problem: format!("not a calibration record: {e}"),
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_are_valid_and_reproducible() {
+        for i in 0..40 {
+            let (a, arch_a) = sample(7, i);
+            let (b, arch_b) = sample(7, i);
+            assert_eq!((a.clone(), arch_a), (b, arch_b));
+            assert!(Datapath::new(a).is_ok());
+        }
+        assert_ne!(sample(7, 1).0, sample(7, 2).0);
+    }
+
+    #[test]
+    fn least_squares_recovers_known_coefficients() {
+        // y = 2 x0 + 0.5 x2 exactly: the fit recovers them, and a feature whose best
+        // coefficient is negative is held at zero.
+        let mut rows = Vec::new();
+        for i in 0..30u64 {
+            let f = Features {
+                adder_bits: i * 3 + 1,
+                rounding_bits: (i * 7) % 11,
+                overflow_bits: (i * i) % 13 + 2,
+                ..Features::default()
+            };
+            let x = f.logic();
+            rows.push((f, 2.0 * x[0] + 0.5 * x[2]));
+        }
+        let c = fit_logic(&rows);
+        assert!((c[0] - 2.0).abs() < 1e-9, "{c:?}");
+        assert!(c[1].abs() < 1e-9, "{c:?}");
+        assert!((c[2] - 0.5).abs() < 1e-9, "{c:?}");
+        assert!(c.iter().all(|&v| v >= 0.0));
+    }
+}
+
+/// The fitted coefficients of one target, and the fit's error on its records.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Calibration {
+    /// The target.
+    pub target: Target,
+    /// The coefficients.
+    pub coefficients: Coefficients,
+    /// The fit's error over the records it was fitted to.
+    pub error: FitError,
+}
+
+/// The model's coefficients for a target (generic and generic-fast share one fit, made
+/// against `generic-fast`, the mapping a sample of hundreds can afford).
+pub fn coefficients(target: Target) -> Coefficients {
+    calibration(target).coefficients
+}
+
+/// The committed calibration of a target: `specfx calibrate --fit-only` refits it from the
+/// records in `data/calibration/`, and a test checks the two agree.
+pub fn calibration(target: Target) -> Calibration {
+    let (logic, ff_per_register_bit, error) = match target {
+        Target::Ice40 => (
+            [1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0],
+            1.0,
+            (0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        ),
+        Target::Xilinx => (
+            [1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0],
+            1.0,
+            (0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        ),
+        Target::Generic | Target::GenericFast => (
+            [1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0],
+            1.0,
+            (0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        ),
+    };
+    let (records, median_rel, p90_rel, max_rel, ff_median_rel, dsp_exact) = error;
+    Calibration {
+        target,
+        coefficients: Coefficients {
+            logic,
+            ff_per_register_bit,
+        },
+        error: FitError {
+            records,
+            median_rel,
+            p90_rel,
+            max_rel,
+            ff_median_rel,
+            dsp_exact,
+        },
+    }
+}
