@@ -13,6 +13,7 @@ mod hdl;
 mod optimize;
 mod output;
 mod paper;
+mod pnr;
 mod reference;
 pub mod render;
 mod report;
@@ -51,6 +52,9 @@ enum Command {
     Hdl(hdl::HdlArgs),
     /// Synthesis cost of a configuration: yosys on the reference Verilog, and the analytic model.
     Cost(cost::CostArgs),
+    /// Place and route on iCE40 (yosys, nextpnr): Fmax, critical path, utilisation, latency
+    /// and throughput at Fmax; a design too big for the device is flagged (exit code 1).
+    Timing(pnr::TimingArgs),
     /// Evaluates a design space: every point checked exhaustively and costed; Pareto front.
     Sweep(sweep::SweepArgs),
     /// Error-budget report: per-stage attribution, headroom, histograms, gappa bounds.
@@ -112,6 +116,7 @@ pub fn main() -> ExitCode {
         Command::Vectors(args) => vectors::run(&args),
         Command::Sim(args) => sim::run(&args),
         Command::Cost(args) => cost::run(&args),
+        Command::Timing(args) => pnr::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Budget(args) => budget::run(&args),
         Command::Optimize(args) => optimize::run(&args),

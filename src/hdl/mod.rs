@@ -5,6 +5,7 @@
 //! architecture, so one RTL source serves every configuration.
 
 pub mod cost;
+pub mod pnr;
 pub mod rom;
 
 use std::fmt::Write as _;
