@@ -74,17 +74,16 @@ pub fn run_timing(dp: &Datapath, arch: Arch, device: Device, hdl_ref: &Path) -> 
     let work = tempfile::tempdir().context("cannot create a temporary directory")?;
     let dir = work.path();
     std::fs::write(dir.join("specfx_params.vh"), params_header(dp, arch))?;
-    let harness = dir.join("specfx_pnr_top.v");
-    std::fs::write(&harness, harness_verilog())?;
+    std::fs::write(dir.join("specfx_pnr_top.v"), harness_verilog())?;
+    // The work directory's files by relative names: the netlist's source attributes then do
+    // not depend on the temporary directory's name, and neither do nextpnr's results.
     let mut files: Vec<String> = rtl_files(hdl_ref)?
         .iter()
+        .map(|p| std::path::absolute(p).unwrap_or_else(|_| p.clone()))
         .map(|p| p.display().to_string())
         .collect();
-    files.push(harness.display().to_string());
-    std::fs::write(
-        dir.join("pnr.ys"),
-        pnr_yosys_script(device, &files, &dir.display().to_string()),
-    )?;
+    files.push("specfx_pnr_top.v".into());
+    std::fs::write(dir.join("pnr.ys"), pnr_yosys_script(device, &files, "."))?;
     let yosys = run_tool("yosys", &["-q".into(), "-s".into(), "pnr.ys".into()], dir)?;
     if !yosys.status.success() {
         bail!(
@@ -147,9 +146,16 @@ pub fn write_timing(w: &mut impl std::io::Write, t: &Timing) -> std::io::Result<
         let ns = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2} ns"));
         writeln!(
             w,
-            "  unregistered DSPs: nextpnr times paths into them ({}) and out of them ({}), not through them; Fmax is an upper bound",
+            "  combinational DSPs: nextpnr times paths into them ({}) and out of them ({}), not through them",
             ns(u.into_ns),
             ns(u.out_of_ns)
+        )?;
+    }
+    if t.fmax_is_upper_bound {
+        writeln!(
+            w,
+            "  Fmax is an upper bound: nextpnr does not time the delay through the {} DSP blocks",
+            t.synthesis.dsps
         )?;
     }
     if let Some(p) = &t.critical_path {

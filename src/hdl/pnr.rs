@@ -19,17 +19,22 @@
 //! `sin` and `sout` are a different timing domain and are not part of it. The harness adds
 //! [`HarnessBits::total`] flip-flops (one per DUT port bit) to the utilisation.
 //!
-//! # Unregistered DSP blocks
+//! # DSP blocks are not timed through
 //!
-//! nextpnr's iCE40 timing model treats every port of an `SB_MAC16` as a register (clocked by
-//! its `CLK` pin) even when yosys configured the block as a combinational multiplier, as it
-//! does here: the RTL quantizes each product before its pipeline register, so no register is
-//! absorbed into the block. Such a block's `CLK` is tied to a constant, and nextpnr reports the
-//! path *into* the block and the path *out of* it as cross-domain paths of that constant
-//! "clock", never the path through it. A register-to-register path through a DSP takes at
-//! least the longer of those two segments (plus the multiplier's own delay, which no free tool
-//! models), so [`Timing::fmax_mhz`] is the smaller of nextpnr's Fmax and `1000 / longest
-//! segment`, and [`Timing::fmax_is_upper_bound`] says the figure is an upper bound.
+//! nextpnr 0.4's iCE40 timing model treats every port of an `SB_MAC16` as a register clocked
+//! by the block's `CLK` pin and has no delay through the block, so the multiplier's own delay
+//! is never timed (`icetime` stops at the block's inputs too; no free tool models it):
+//!
+//! 1. where yosys left a block combinational (`CLK` tied to 0; the pipelined core quantizes
+//!    each product before its register, so no register is absorbed), nextpnr reports the path
+//!    *into* the block and the path *out of* it as cross-domain paths of that constant "clock",
+//!    never the path through it. A path through the block takes at least the longer segment,
+//!    so [`Timing::fmax_mhz`] is the smaller of nextpnr's Fmax and `1000 / longest segment`;
+//! 2. where yosys absorbed an operand register into the block (`CLK` = `clk`, as in the folded
+//!    core), its output is timed as if it were registered.
+//!
+//! Either way, a design with DSP blocks gets an Fmax that is an upper bound
+//! ([`Timing::fmax_is_upper_bound`]); on a device without DSPs (HX8K) every path is timed.
 
 use std::collections::BTreeMap;
 
@@ -571,8 +576,8 @@ pub struct Timing {
     pub fmax_mhz: Option<f64>,
     /// nextpnr's own Fmax of the clock, MHz.
     pub nextpnr_fmax_mhz: Option<f64>,
-    /// Whether `fmax_mhz` is only an upper bound: paths through combinational DSPs are not
-    /// timed through the multiplier.
+    /// Whether `fmax_mhz` is only an upper bound: the design has DSP blocks, and nextpnr does
+    /// not time the multiplier's delay (see the module docs).
     pub fmax_is_upper_bound: bool,
     /// The segments of paths through combinational DSPs, when there are any.
     pub untimed_dsp: Option<UntimedDsp>,
@@ -661,7 +666,8 @@ impl Timing {
             device_name: device.full_name(),
             package: device.package(),
             fits: report.is_some(),
-            fmax_is_upper_bound: fmax_mhz.is_some() && untimed_dsp.is_some(),
+            fmax_is_upper_bound: fmax_mhz.is_some()
+                && (synthesis.dsps > 0 || untimed_dsp.is_some()),
             latency_ns: fmax_mhz.map(|f| latency_cycles as f64 * 1000.0 / f),
             throughput_samples_per_s: fmax_mhz.map(|f| f * 1e6 / initiation_interval as f64),
             fmax_mhz,
@@ -801,6 +807,23 @@ mod tests {
         // Folded baseline: II = (k + 2) * lat_mul = 6.
         assert_eq!(t.initiation_interval, 6);
         assert!(close(t.throughput_samples_per_s.unwrap(), 20e6 / 6.0));
+    }
+
+    #[test]
+    fn without_dsps_fmax_is_nextpnrs() {
+        let mut r = parse_report(SAMPLE).unwrap();
+        r.critical_paths
+            .retain(|p| !p.from_clock.contains("PACKER") && !p.to_clock.contains("PACKER"));
+        let dp = Datapath::new(Config::baseline()).unwrap();
+        let cells = SynthCells {
+            luts: 4381,
+            ffs: 429,
+            dsps: 0,
+        };
+        let t = Timing::new(&dp, Arch::Pipelined, Device::Hx8k, Some(&r), cells);
+        assert_eq!(t.untimed_dsp, None);
+        assert!(!t.fmax_is_upper_bound);
+        assert!(close(t.fmax_mhz.unwrap(), 25.116));
     }
 
     #[test]
