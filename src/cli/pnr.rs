@@ -73,6 +73,8 @@ fn first_error(out: &std::process::Output, log: Option<&str>) -> String {
 pub fn run_timing(dp: &Datapath, arch: Arch, device: Device, hdl_ref: &Path) -> Result<Timing> {
     let work = tempfile::tempdir().context("cannot create a temporary directory")?;
     let dir = work.path();
+    // A missing nextpnr is reported before yosys spends seconds on synthesis.
+    run_tool("nextpnr-ice40", &["--version".into()], dir)?;
     std::fs::write(dir.join("specfx_params.vh"), params_header(dp, arch))?;
     std::fs::write(dir.join("specfx_pnr_top.v"), harness_verilog())?;
     // The work directory's files by relative names: the netlist's source attributes then do
