@@ -14,6 +14,7 @@ mod hdl;
 mod optimize;
 mod output;
 mod paper;
+mod pnr;
 mod reference;
 pub mod render;
 mod report;
@@ -55,6 +56,9 @@ enum Command {
     /// Calibrates the analytic cost model against yosys: a seeded sample synthesised, the
     /// model's coefficients fitted, the fit error printed.
     Calibrate(calibrate::CalibrateArgs),
+    /// Place and route on iCE40 (yosys, nextpnr): Fmax, critical path, utilisation, latency
+    /// and throughput at Fmax; a design too big for the device is flagged (exit code 1).
+    Timing(pnr::TimingArgs),
     /// Evaluates a design space: every point checked exhaustively and costed; Pareto front.
     Sweep(sweep::SweepArgs),
     /// Error-budget report: per-stage attribution, headroom, histograms, gappa bounds.
@@ -117,6 +121,7 @@ pub fn main() -> ExitCode {
         Command::Sim(args) => sim::run(&args),
         Command::Cost(args) => cost::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
+        Command::Timing(args) => pnr::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Budget(args) => budget::run(&args),
         Command::Optimize(args) => optimize::run(&args),

@@ -6,6 +6,7 @@
 
 pub mod calibrate;
 pub mod cost;
+pub mod pnr;
 pub mod rom;
 
 use std::fmt::Write as _;
