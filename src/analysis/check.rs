@@ -15,6 +15,7 @@ use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
 use crate::pipeline::fast::EventCounts;
 use crate::pipeline::{first_code_where, Datapath, NConstants, MAX_STAGES};
 use crate::reference::lobe::Cutoff;
+use crate::reference::normalisation::classic_coefficient;
 
 /// An input where a figure is reached.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -107,6 +108,17 @@ pub struct CheckReport {
     pub shape_total_worst: Input,
     /// max output error in output LSBs.
     pub out_max_ulp: f64,
+    /// max |output - exact normalised cos^n| (the output against classic coef(n) * cos^n of
+    /// the configured form: the whole datapath's error, approximation, coefficient and
+    /// quantization), in output units.
+    pub norm_total_max_abs: f64,
+    /// Where it is reached.
+    pub norm_total_worst: Input,
+    /// max over n of that error divided by the exact normalised peak coef(n) (relative).
+    pub norm_total_rel: f64,
+    /// The same for the algorithm in f64 (its f64 lobe times its f64 coefficient): the floor
+    /// no fixed-point width removes, relative to coef(n).
+    pub norm_approx_rel: f64,
     /// Whether the output is non-decreasing in c for every n.
     pub monotonic: bool,
     /// Number of monotonicity violations.
@@ -136,8 +148,30 @@ pub struct OutputFigures {
     pub out_max_ulp: f64,
     /// Share of outputs within 1/2 LSB of the f64 output.
     pub out_correctly_rounded: f64,
+    /// max |output - exact normalised cos^n| in output units (see [`CheckReport`]).
+    pub norm_total_max_abs: f64,
+    /// max over n of that error relative to the exact normalised peak coef(n).
+    pub norm_total_rel: f64,
+    /// The same for the algorithm in f64: the floor of `norm_total_rel`.
+    pub norm_approx_rel: f64,
     /// Whether the output never decreases as c increases, for every n.
     pub monotonic: bool,
+}
+
+impl OutputFigures {
+    /// Effective bits of the normalised output: -log2 of its relative total error.
+    pub fn effective_bits(&self) -> f64 {
+        effective_bits(self.norm_total_rel)
+    }
+}
+
+/// Effective bits of a relative error: -log2(rel), 64 for an exact output.
+pub fn effective_bits(rel: f64) -> f64 {
+    if rel > 0.0 {
+        -rel.log2()
+    } else {
+        64.0
+    }
 }
 
 impl CheckReport {
@@ -150,6 +184,9 @@ impl CheckReport {
             shape_total_max_abs: self.shape_total_max_abs,
             out_max_ulp: self.out_max_ulp,
             out_correctly_rounded: self.stages.last().map_or(0.0, |s| s.correctly_rounded),
+            norm_total_max_abs: self.norm_total_max_abs,
+            norm_total_rel: self.norm_total_rel,
+            norm_approx_rel: self.norm_approx_rel,
             monotonic: self.monotonic,
         }
     }
@@ -161,6 +198,9 @@ struct OutputsOfN {
     approx: f64,
     total: f64,
     out_max_abs: f64,
+    norm: f64,
+    norm_rel: f64,
+    norm_approx: f64,
     n_correct: u64,
     n_violations: u64,
 }
@@ -193,9 +233,13 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
         approx: -1.0,
         total: -1.0,
         out_max_abs: -1.0,
+        norm: -1.0,
+        norm_rel: -1.0,
+        norm_approx: -1.0,
         n_correct: n_dead as u64,
         n_violations: 0,
     };
+    let norm_peak = classic_coefficient(cfg.coef.form, nf);
     if n_dead > 0 {
         // Every dead output and lobe is 0 in both models; cos^n grows with c, so the largest
         // dead code bounds the others' shape errors.
@@ -204,6 +248,8 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
         r.approx = cn;
         r.total = cn;
         r.out_max_abs = 0.0;
+        r.norm = norm_peak * cn;
+        r.norm_approx = norm_peak * cn;
     }
     let mut prev_out = (n_dead > 0).then_some(0);
     let (last_sq, out) = (dp.stage_last_square(), dp.stage_out());
@@ -230,6 +276,8 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
             r.quant = r.quant.max((fixed_lobe - s).abs());
             r.approx = r.approx.max((s - cn).abs());
             r.total = r.total.max((fixed_lobe - cn).abs());
+            r.norm = r.norm.max((o as f64 * out_lsb - norm_peak * cn).abs());
+            r.norm_approx = r.norm_approx.max((s * nc.coef - norm_peak * cn).abs());
             if prev_out.is_some_and(|p| o < p) {
                 r.n_violations += 1;
             }
@@ -237,6 +285,8 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
         }
     });
     debug_assert!(last >= lo);
+    r.norm_rel = r.norm / norm_peak;
+    r.norm_approx /= norm_peak;
     r
 }
 
@@ -261,10 +311,16 @@ pub fn check_outputs(dp: &Datapath) -> Result<OutputFigures, Error> {
         approx: -1.0,
         total: -1.0,
         out_max_abs: -1.0,
+        norm: -1.0,
+        norm_rel: -1.0,
+        norm_approx: -1.0,
         n_correct: 0,
         n_violations: 0,
     };
     for p in &per_n {
+        f.norm = f.norm.max(p.norm);
+        f.norm_rel = f.norm_rel.max(p.norm_rel);
+        f.norm_approx = f.norm_approx.max(p.norm_approx);
         f.quant = f.quant.max(p.quant);
         f.approx = f.approx.max(p.approx);
         f.total = f.total.max(p.total);
@@ -280,6 +336,9 @@ pub fn check_outputs(dp: &Datapath) -> Result<OutputFigures, Error> {
         shape_total_max_abs: f.total,
         out_max_ulp: f.out_max_abs / dp.config().out.format.lsb(),
         out_correctly_rounded: f.n_correct as f64 / n_eval as f64,
+        norm_total_max_abs: f.norm,
+        norm_total_rel: f.norm_rel,
+        norm_approx_rel: f.norm_approx,
         monotonic: f.n_violations == 0,
     })
 }
@@ -515,6 +574,9 @@ struct PerN {
     quant: MaxAt,
     approx: MaxAt,
     total: MaxAt,
+    norm: MaxAt,
+    norm_rel: f64,
+    norm_approx_rel: f64,
     n_violations: u64,
     violations: Vec<MonotonicityViolation>,
     n_cut: u64,
@@ -609,6 +671,9 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
     let mut quant = MaxAt::new();
     let mut approx = MaxAt::new();
     let mut total = MaxAt::new();
+    let mut norm = MaxAt::new();
+    let mut norm_approx: f64 = -1.0;
+    let norm_peak = classic_coefficient(cfg.coef.form, nf);
     let mut violations = Vec::new();
     let mut n_violations = 0;
     let mut n_cut = 0;
@@ -740,6 +805,21 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
                 &mut errs,
             );
             acc[stage_idx].add_exact_zeros(n_dead);
+            if stage_idx == out {
+                // The normalised output against the exact normalised cos^n.
+                for (j, &i) in live.iter().enumerate() {
+                    let c = chunk[i] as f64 * c_lsb;
+                    let cos_n = if c <= 0.0 {
+                        0.0
+                    } else {
+                        (nf * ln_chunk[i]).exp()
+                    };
+                    let o = live_raws[j] as f64 * lsb[out];
+                    norm.add((o - norm_peak * cos_n).abs(), (nc.n, chunk[i]));
+                    // live_refs holds the f64 lobe times the f64 coefficient here.
+                    norm_approx = norm_approx.max((live_refs[j] - norm_peak * cos_n).abs());
+                }
+            }
             if stage_idx == last_sq {
                 // The lobe against cos^n, on the live inputs.
                 for (j, &i) in live.iter().enumerate() {
@@ -790,12 +870,17 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
         quant.add(0.0, at);
         approx.add(cos_n, at);
         total.add(cos_n, at);
+        norm.add(norm_peak * cos_n, at);
+        norm_approx = norm_approx.max(norm_peak * cos_n);
     }
     PerN {
         stages: acc,
         quant,
         approx,
         total,
+        norm_rel: norm.value / norm_peak,
+        norm_approx_rel: norm_approx / norm_peak,
+        norm,
         n_violations,
         violations,
         n_cut,
@@ -857,10 +942,16 @@ pub fn check(dp: &Datapath) -> Result<CheckReport, Error> {
     let mut quant = MaxAt::new();
     let mut approx = MaxAt::new();
     let mut total = MaxAt::new();
+    let mut norm = MaxAt::new();
+    let mut norm_rel: f64 = -1.0;
+    let mut norm_approx_rel: f64 = -1.0;
     let mut violations = Vec::new();
     let mut n_violations = 0;
     let mut n_cut = 0;
     for p in &per_n {
+        norm.merge(&p.norm);
+        norm_rel = norm_rel.max(p.norm_rel);
+        norm_approx_rel = norm_approx_rel.max(p.norm_approx_rel);
         for (a, b) in acc.iter_mut().zip(&p.stages) {
             a.merge(b);
         }
@@ -942,6 +1033,10 @@ pub fn check(dp: &Datapath) -> Result<CheckReport, Error> {
         shape_total_max_abs: total.value,
         shape_total_worst: input(total.at),
         out_max_ulp,
+        norm_total_max_abs: norm.value,
+        norm_total_worst: input(norm.at),
+        norm_total_rel: norm_rel,
+        norm_approx_rel,
         monotonic: n_violations == 0,
         n_monotonicity_violations: n_violations,
         monotonicity_violations: violations,

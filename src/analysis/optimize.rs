@@ -40,6 +40,12 @@ pub enum Metric {
     Out,
     /// Share of outputs correctly rounded (`correct`, a fraction or a percentage).
     Correct,
+    /// max |output - exact normalised cos^n| in output LSBs (`out_total`, unit `ulp`).
+    OutTotal,
+    /// The same relative to the exact normalised peak coef(n) (`out_rel`, a fraction or %).
+    OutRel,
+    /// Effective bits of the normalised output, -log2 of `out_rel` (`effective_bits >= 8`).
+    EffectiveBits,
     /// Analytic LUTs on a target (`luts <= 800 on ice40`), of the budget's microarchitecture.
     Luts(Target),
     /// Analytic DSP blocks on a target (`dsps <= 8 on ice40`).
@@ -55,6 +61,9 @@ impl fmt::Display for Metric {
             Metric::ShapeQuant => f.write_str("shape_quant"),
             Metric::Out => f.write_str("out"),
             Metric::Correct => f.write_str("correct"),
+            Metric::OutTotal => f.write_str("out_total"),
+            Metric::OutRel => f.write_str("out_rel"),
+            Metric::EffectiveBits => f.write_str("effective_bits"),
             Metric::Luts(t) => write!(f, "luts on {}", t.name()),
             Metric::Dsps(t) => write!(f, "dsps on {}", t.name()),
             Metric::Ffs(t) => write!(f, "ffs on {}", t.name()),
@@ -66,6 +75,19 @@ impl Metric {
     /// Whether the metric is a cost ceiling (evaluated from the formats, no check needed).
     pub fn is_cost(self) -> bool {
         matches!(self, Metric::Luts(_) | Metric::Dsps(_) | Metric::Ffs(_))
+    }
+
+    /// Whether the bound is a floor (`>=`: `correct`, `effective_bits`) rather than a ceiling.
+    pub fn is_floor(self) -> bool {
+        matches!(self, Metric::Correct | Metric::EffectiveBits)
+    }
+
+    /// Whether the metric measures the normalised output against exact normalised cos^n.
+    pub fn is_normalised(self) -> bool {
+        matches!(
+            self,
+            Metric::OutTotal | Metric::OutRel | Metric::EffectiveBits
+        )
     }
 }
 
@@ -131,16 +153,15 @@ impl FromStr for Budget {
                 "shape_quant" => Metric::ShapeQuant,
                 "out" => Metric::Out,
                 "correct" => Metric::Correct,
+                "out_total" => Metric::OutTotal,
+                "out_rel" => Metric::OutRel,
+                "effective_bits" => Metric::EffectiveBits,
                 other => return Err(bad(part, &format!("unknown metric '{other}'"))),
             };
             if on.is_some() && !metric.is_cost() {
                 return Err(bad(part, "only luts, dsps and ffs take 'on TARGET'"));
             }
-            let want_op = if metric == Metric::Correct {
-                ">="
-            } else {
-                "<="
-            };
+            let want_op = if metric.is_floor() { ">=" } else { "<=" };
             if op != want_op {
                 return Err(bad(part, &format!("{} takes {want_op}", lhs.trim())));
             }
@@ -162,9 +183,10 @@ impl FromStr for Budget {
                         .map_err(|_| bad(part, "lsbN needs a number N"))?;
                     value * (-f64::from(bits)).exp2()
                 }
-                (Metric::Out, "ulp" | "") => value,
-                (Metric::Correct, "%") => value / 100.0,
-                (Metric::Correct, "") => value,
+                (Metric::Out | Metric::OutTotal, "ulp" | "") => value,
+                (Metric::Correct | Metric::OutRel, "%") => value / 100.0,
+                (Metric::Correct | Metric::OutRel, "") => value,
+                (Metric::EffectiveBits, "") => value,
                 (m, "") if m.is_cost() => value,
                 _ => {
                     return Err(bad(
@@ -197,6 +219,9 @@ pub fn metric_value(r: &OutputFigures, dp: &Datapath, arch: Arch, metric: Metric
         Metric::ShapeQuant => r.shape_quant_max_abs,
         Metric::Out => r.out_max_ulp,
         Metric::Correct => r.out_correctly_rounded,
+        Metric::OutTotal => r.norm_total_max_abs / dp.config().out.format.lsb(),
+        Metric::OutRel => r.norm_total_rel,
+        Metric::EffectiveBits => r.effective_bits(),
         Metric::Luts(_) | Metric::Dsps(_) | Metric::Ffs(_) => cost_value(dp, arch, metric),
     }
 }
@@ -215,17 +240,19 @@ fn cost_value(dp: &Datapath, arch: Arch, metric: Metric) -> f64 {
 impl Budget {
     /// Whether a bound holds for a value.
     fn holds(b: &Bound, v: f64) -> bool {
-        match b.metric {
-            Metric::Correct => v >= b.limit,
-            _ => v <= b.limit,
+        if b.metric.is_floor() {
+            v >= b.limit
+        } else {
+            v <= b.limit
         }
     }
 
     /// A bound's value/limit ratio (limit/value for `correct`): at most 1 when it holds.
     fn ratio(b: &Bound, v: f64) -> f64 {
-        match b.metric {
-            Metric::Correct => b.limit / v.max(1e-300),
-            _ => v / b.limit.max(1e-300),
+        if b.metric.is_floor() {
+            b.limit / v.max(1e-300)
+        } else {
+            v / b.limit.max(1e-300)
         }
     }
 
@@ -742,9 +769,13 @@ pub struct AlgorithmFloor {
     pub algorithm: Algorithm,
     /// The floor, if the algorithm is valid for the base (else `reason`).
     pub shape_total: Option<f64>,
+    /// The floor of `out_rel` (the algorithm's f64 lobe times its f64 coefficient against
+    /// exact normalised cos^n, relative to coef(n)).
+    pub norm_rel: Option<f64>,
     /// Why the algorithm is not valid for the base.
     pub reason: Option<String>,
-    /// Whether the floor leaves the budget reachable (budgets without `shape_total` always do).
+    /// Whether the floors leave the budget reachable (`shape_total`, `out_rel` and
+    /// `effective_bits` have floors; other metrics are always reachable).
     pub reachable: bool,
 }
 
@@ -775,6 +806,7 @@ pub fn algorithm_floors(
                 Err(e) => AlgorithmFloor {
                     algorithm,
                     shape_total: None,
+                    norm_rel: None,
                     reason: Some(e.to_string()),
                     reachable: false,
                 },
@@ -782,11 +814,15 @@ pub fn algorithm_floors(
                     algorithm,
                     shape_total: Some(f.shape_approx_max_abs),
                     reason: None,
-                    reachable: budget
-                        .bounds
-                        .iter()
-                        .filter(|b| b.metric == Metric::ShapeTotal)
-                        .all(|b| f.shape_approx_max_abs <= b.limit),
+                    norm_rel: Some(f.norm_approx_rel),
+                    reachable: budget.bounds.iter().all(|b| match b.metric {
+                        Metric::ShapeTotal => f.shape_approx_max_abs <= b.limit,
+                        Metric::OutRel => f.norm_approx_rel <= b.limit,
+                        Metric::EffectiveBits => {
+                            crate::analysis::check::effective_bits(f.norm_approx_rel) >= b.limit
+                        }
+                        _ => true,
+                    }),
                 },
             }
         })
@@ -815,10 +851,12 @@ pub fn start_of(base: &Config, a: Algorithm, start_frac: i32) -> Result<Config, 
 pub fn optimize_space(a: Algorithm, budget: &Budget, start_frac: i32) -> Space {
     let has = |m: Metric| budget.bounds.iter().any(|b| b.metric == m);
     let mut extra_knobs = Vec::new();
-    if has(Metric::Out) || has(Metric::Correct) {
+    let out_lsbs = has(Metric::Out) || has(Metric::OutTotal);
+    let output_side = out_lsbs || has(Metric::Correct) || has(Metric::OutRel);
+    if output_side || has(Metric::EffectiveBits) {
         extra_knobs.push(Knob::CoefFrac);
     }
-    if has(Metric::Correct) && !has(Metric::Out) {
+    if (has(Metric::Correct) || has(Metric::OutRel) || has(Metric::EffectiveBits)) && !out_lsbs {
         extra_knobs.push(Knob::Frac(Stage::Out));
     }
     if a.variant == Variant::Minimax {

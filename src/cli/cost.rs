@@ -36,6 +36,13 @@ pub struct CostArgs {
     /// Only the analytic model: do not run yosys.
     #[arg(long)]
     analytic_only: bool,
+    /// Also place and route on an iCE40 device with nextpnr (target ice40): Fmax, critical
+    /// path, latency and throughput at Fmax (`specfx timing` for the details).
+    #[arg(long)]
+    timing: bool,
+    /// The iCE40 device whose resources the figures are checked against: up5k or hx8k.
+    #[arg(long, default_value = "up5k")]
+    device: specfx::hdl::pnr::Device,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
@@ -70,8 +77,14 @@ pub struct CostReport {
     pub yosys_script: Option<String>,
     /// yosys LUTs / analytic LUTs.
     pub lut_ratio: Option<f64>,
-    /// yosys flip-flops / analytic register bits.
+    /// yosys flip-flops / analytic flip-flops.
     pub ff_ratio: Option<f64>,
+    /// The device the figures are checked against (iCE40 targets only).
+    pub device: Option<specfx::hdl::pnr::Device>,
+    /// Resources beyond the device, from yosys's figures when it ran, else the analytic ones.
+    pub over_limit: Vec<String>,
+    /// Place-and-route timing (`--timing`).
+    pub timing: Option<specfx::hdl::pnr::Timing>,
 }
 
 /// The reference Verilog directory.
@@ -186,6 +199,9 @@ pub fn cost_report(
         rom_yosys,
         yosys_version: version,
         yosys_script: script,
+        device: None,
+        over_limit: Vec::new(),
+        timing: None,
     })
 }
 
@@ -269,6 +285,26 @@ pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Resul
             .as_ref()
             .map_or("-".to_string(), |y| format!("{} LUTs, {} cells", y.luts, y.cells))
     )?;
+    if let Some(d) = r.device {
+        if r.over_limit.is_empty() {
+            writeln!(
+                w,
+                "  fits the {d} ({})",
+                if r.luts.is_some() {
+                    "yosys figures"
+                } else {
+                    "analytic figures"
+                }
+            )?;
+        }
+        for flag in &r.over_limit {
+            writeln!(w, "  EXCEEDS THE DEVICE: {flag}")?;
+        }
+    }
+    if let Some(t) = &r.timing {
+        writeln!(w, "timing (nextpnr place and route on the {}):", t.device)?;
+        super::pnr::write_timing(w, t)?;
+    }
     if let Some(v) = &r.yosys_version {
         writeln!(w, "  {v}")?;
     }
@@ -279,7 +315,21 @@ pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Resul
 pub fn run(args: &CostArgs) -> Result<Outcome> {
     let dp = super::datapath::load(&args.config, None)?;
     let dir = hdl_ref_dir(args.hdl_ref.as_deref());
-    let r = cost_report(&dp, args.arch, args.target, &dir, args.analytic_only)?;
+    let mut r = cost_report(&dp, args.arch, args.target, &dir, args.analytic_only)?;
+    if args.target == Target::Ice40 {
+        let (dsps, luts, ffs) = match &r.yosys {
+            Some(y) => (y.dsps, y.luts, y.ffs),
+            None => (r.analytic.dsps, r.analytic.luts, r.analytic.ffs),
+        };
+        r.device = Some(args.device);
+        r.over_limit = specfx::hdl::pnr::device_check(dsps, luts, ffs, args.device);
+    }
+    if args.timing {
+        if args.target != Target::Ice40 {
+            bail!("--timing: place and route is available for --target ice40 only (nextpnr-ice40)");
+        }
+        r.timing = Some(super::pnr::run_timing(&dp, args.arch, args.device, &dir)?);
+    }
     if args.json {
         print_json(&r)?;
     } else {
