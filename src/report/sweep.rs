@@ -24,13 +24,16 @@ pub fn chart(points: &[PointResult]) -> Chart {
                 points: points.iter().filter_map(xy).collect(),
                 line: false,
                 color: (120, 120, 120),
+                ..Series::default()
             },
             Series {
                 label: format!("Pareto front ({} points)", front.len()),
                 points: front,
                 line: true,
                 color: (200, 30, 30),
+                ..Series::default()
             },
         ],
+        ..Chart::default()
     }
 }

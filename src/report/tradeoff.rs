@@ -23,8 +23,10 @@ pub fn speed_chart(figures: &[MethodFigures]) -> Chart {
                 points: vec![(f.evals_per_s / 1e6, f.max_abs_err.max(1e-17))],
                 line: false,
                 color: hue(i, shown.len()),
+                ..Series::default()
             })
             .collect(),
+        ..Chart::default()
     }
 }
 
@@ -57,7 +59,9 @@ pub fn per_n_chart(figures: &[MethodFigures], ns: &[u32], names: &[&str]) -> Cha
                     .collect(),
                 line: true,
                 color: colors[i % colors.len()],
+                ..Series::default()
             })
             .collect(),
+        ..Chart::default()
     }
 }
