@@ -98,6 +98,8 @@ pub enum Marker {
     TriangleDown,
     /// An x.
     Cross,
+    /// No markers, even on a short line.
+    None,
 }
 
 impl Marker {
@@ -169,7 +171,9 @@ impl Series {
     }
 
     fn marked(&self) -> bool {
-        self.bar_width.is_none() && (!self.line || self.points.len() <= MARKED_LINE_POINTS)
+        self.bar_width.is_none()
+            && self.marker != Marker::None
+            && (!self.line || self.points.len() <= MARKED_LINE_POINTS)
     }
 }
 
@@ -304,19 +308,14 @@ fn tick_label(v: f64, decimals: usize) -> String {
     minus_sign(&format!("{v:.decimals$}"))
 }
 
-/// A step of 1, 2 or 5 times a power of ten, near `raw`.
+/// The smallest step of 1, 2 or 5 times a power of ten that is at least `raw`.
 fn nice_step(raw: f64) -> f64 {
     let mag = 10f64.powi(raw.log10().floor() as i32);
     let f = raw / mag;
-    let m = if f < 1.5 {
-        1.0
-    } else if f < 3.5 {
-        2.0
-    } else if f < 7.5 {
-        5.0
-    } else {
-        10.0
-    };
+    let m = [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .find(|&m| m >= f)
+        .unwrap_or(10.0);
     m * mag
 }
 
@@ -613,6 +612,7 @@ fn draw_marker<DB: DrawingBackend>(
             ],
             color.filled(),
         )),
+        Marker::None => Ok(()),
         Marker::Cross => {
             let st = color.stroke_width(2);
             area.draw(&PathElement::new(vec![(x - s, y - s), (x + s, y + s)], st))?;
@@ -639,12 +639,17 @@ fn distinct_styles(series: &[Series]) -> Vec<(Dash, Marker)> {
     for s in series {
         let d0 = Dash::ALL.iter().position(|&d| d == s.dash).unwrap_or(0);
         let m0 = Marker::ALL.iter().position(|&m| m == s.marker).unwrap_or(0);
+        let keep_marker = s.marker == Marker::None;
         let n = Dash::ALL.len() * Marker::ALL.len();
         let chosen = (0..n)
             .map(|k| {
                 (
                     Dash::ALL[(d0 + k) % Dash::ALL.len()],
-                    Marker::ALL[(m0 + k + k / 12) % Marker::ALL.len()],
+                    if keep_marker {
+                        Marker::None
+                    } else {
+                        Marker::ALL[(m0 + k + k / 12) % Marker::ALL.len()]
+                    },
                 )
             })
             .find(|&(d, m)| !seen.contains(&look(s, d, m)))
@@ -653,6 +658,50 @@ fn distinct_styles(series: &[Series]) -> Vec<(Dash, Marker)> {
         out.push(chosen);
     }
     out
+}
+
+/// A series' look, 24 pixels wide from `at` (its left end, vertically centred): a piece of its
+/// line, a marker, or a bar.
+fn sample_of<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: &Series,
+    marked: bool,
+    at: (f64, f64),
+    width: u32,
+    marker: i32,
+) -> Res<DB> {
+    let c = RGBColor(s.color.0, s.color.1, s.color.2);
+    let (x0, y0) = at;
+    if s.bar_width.is_some() {
+        return area.draw(&Rectangle::new(
+            [ipt((x0 + 4.0, y0 - 6.0)), ipt((x0 + 20.0, y0 + 6.0))],
+            c.filled(),
+        ));
+    }
+    if s.line {
+        draw_polyline(
+            area,
+            &[(x0, y0), (x0 + 24.0, y0)],
+            s.dash,
+            c.stroke_width(width),
+        )?;
+    }
+    if marked {
+        draw_marker(area, (x0 + 12.0, y0), s.marker, marker, c)?;
+    }
+    Ok(())
+}
+
+/// Draws the look of a series (its line's pattern and colour, its marker, or a bar), 24
+/// pixels wide from `at`: for legends drawn outside a chart, such as a figure's shared key.
+pub fn draw_sample<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: &Series,
+    at: (i32, i32),
+) -> Result<(), Error> {
+    let marked = s.bar_width.is_none() && s.marker != Marker::None && !s.line;
+    sample_of(area, s, marked, (f64::from(at.0), f64::from(at.1)), 2, 4)
+        .map_err(|e| render_error(e.to_string()))
 }
 
 /// Sizes of the text and margins: full charts, or the compact panels of a multi-panel figure.
@@ -1040,27 +1089,13 @@ pub fn draw_chart<DB: DrawingBackend>(
     // Labels: beside each line's end (in the gutter) and each lone point, or a legend box.
     let sample = |area: &DrawingArea<DB, Shift>, i: usize, at: (f64, f64)| -> Res<DB> {
         let s = &chart.series[i];
-        let c = RGBColor(s.color.0, s.color.1, s.color.2);
-        let (x0, y0) = at;
-        if s.bar_width.is_some() {
-            area.draw(&Rectangle::new(
-                [ipt((x0 + 4.0, y0 - 6.0)), ipt((x0 + 20.0, y0 + 6.0))],
-                c.filled(),
-            ))?;
-            return Ok(());
-        }
-        if s.line {
-            draw_polyline(
-                area,
-                &[(x0, y0), (x0 + 24.0, y0)],
-                styles[i].0,
-                c.stroke_width(sz.line),
-            )?;
-        }
-        if s.marked() {
-            draw_marker(area, (x0 + 12.0, y0), styles[i].1, sz.marker, c)?;
-        }
-        Ok(())
+        let drawn = Series {
+            dash: styles[i].0,
+            marker: styles[i].1,
+            points: Vec::new(),
+            ..s.clone()
+        };
+        sample_of(area, &drawn, s.marked(), at, sz.line, sz.marker)
     };
     if chart.direct_labels {
         let line_ends: Vec<(usize, (f64, f64))> = ends
@@ -1233,11 +1268,12 @@ mod tests {
 
     #[test]
     fn integer_axes_print_integers() {
-        // 0..=5 in steps of 1: eight ticks wanted, a step of 1 (never 0.5) given.
+        // 0..=5 wants steps of at least 5/8: 1 (on an integer axis never less than 1).
         let a = Axis::new(&[0.0, 5.0], false, true);
         assert_eq!(labels(&a), ["0", "1", "2", "3", "4", "5"]);
+        // 0..=2 wants steps of at least 0.25: 0.5.
         let a = Axis::new(&[0.0, 2.0], false, false);
-        assert_eq!(labels(&a)[..3], ["0.0", "0.2", "0.4"]);
+        assert_eq!(labels(&a), ["0.0", "0.5", "1.0", "1.5", "2.0"]);
     }
 
     #[test]

@@ -673,7 +673,7 @@ pub fn document(r: &StabilityReport) -> Vec<Block> {
         )),
         Block::Figure {
             stem: "overview".into(),
-            caption: "Pass (green) or fail (red) per path, over n (log) and theta.".into(),
+            caption: "Pass (light blue) or fail (vermillion) per path, over n (log) and theta; the dashed box is the first datapath's design range.".into(),
         },
         Block::Table {
             header: vec![
