@@ -399,7 +399,13 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             costs: &costs,
             sims: &sims,
         };
-        write_index(b, dir, &written, &results)
+        write_index(b, dir, &written, &results)?;
+        // Numbers in the page's text never break at their minus sign (U+2212 instead of -).
+        let page = String::from_utf8(std::mem::take(b)).map_err(std::io::Error::other)?;
+        let (head, body) = page.split_at(page.find("<body>").unwrap_or(0));
+        b.extend_from_slice(head.as_bytes());
+        b.extend_from_slice(specfx::report::doc::number_minus(body).as_bytes());
+        Ok(())
     })?);
 
     let n_claims = paper.forms.len() + 2;
