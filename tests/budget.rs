@@ -279,6 +279,8 @@ fn budget_command_writes_a_deterministic_self_contained_report() {
         "histogram_shape.svg",
         "error_vs_c.svg",
         "error_vs_n.png",
+        "output_error_vs_c.svg",
+        "output_error_vs_n.png",
     ];
     let mut runs = Vec::new();
     for tag in ["a", "b"] {
@@ -302,7 +304,7 @@ fn budget_command_writes_a_deterministic_self_contained_report() {
     }
     assert!(runs[0] == runs[1], "two runs wrote different bytes");
     let html = String::from_utf8(runs[0][1].clone()).unwrap();
-    assert_eq!(html.matches("<svg").count(), 4, "every chart inlined");
+    assert_eq!(html.matches("<svg").count(), 6, "every chart inlined");
     assert!(!html.contains("src=") && !html.contains(".svg\""));
     let md = String::from_utf8(runs[0][0].clone()).unwrap();
     assert!(md.contains("| t | s2.16 | RND |") && md.contains("**PASS**"));

@@ -613,6 +613,10 @@ pub struct PathMap {
     pub worst_c: f64,
     /// Every region, in [`Kind::ALL`] order.
     pub regions: Vec<Region>,
+    /// For a datapath, the exponents its configuration was designed for (its own `n`, which
+    /// the map replaces by the grid's), smallest and largest; its inputs are every code from
+    /// 0 to 1.0, theta 0..=90 degrees. `None` for a float path.
+    pub design_n: Option<(u32, u32)>,
     /// The heat map.
     #[serde(skip)]
     pub heat: HeatMap,
@@ -1013,6 +1017,7 @@ fn fixed_columns(plan: &FixedPlan, ns: &[u32], tol: f64, done: &(dyn Fn() + Sync
 /// What [`assemble`] needs to know of a path besides its accumulators.
 struct PathMeta {
     name: String,
+    design_n: Option<(u32, u32)>,
     precision: &'static str,
     c_bits: u32,
     stage_names: Vec<String>,
@@ -1022,6 +1027,7 @@ struct PathMeta {
 fn assemble(meta: PathMeta, ns: &[u32], accs: Vec<NAcc>, tol: f64) -> PathMap {
     let PathMeta {
         name,
+        design_n,
         precision,
         c_bits,
         stage_names,
@@ -1137,6 +1143,7 @@ fn assemble(meta: PathMeta, ns: &[u32], accs: Vec<NAcc>, tol: f64) -> PathMap {
         .collect();
     PathMap {
         path: name,
+        design_n,
         precision: precision.to_string(),
         c_bits,
         samples,
@@ -1245,6 +1252,7 @@ pub fn map(
         .map(|(p, accs)| {
             let meta = PathMeta {
                 name: p.name(),
+                design_n: None,
                 precision: p.precision(),
                 c_bits: grid.c_bits,
                 stage_names: Vec::new(),
@@ -1272,6 +1280,7 @@ pub fn map(
         let c_bits = config.c.format.frac_bits().max(0) as u32;
         let meta = PathMeta {
             name: config.name.clone(),
+            design_n: Some((config.n.min(), config.n.max())),
             precision: "fixed",
             c_bits,
             stage_names,

@@ -77,7 +77,7 @@ fn write_index(
             .join("/")
     };
     writeln!(w, "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>specfx report</title>")?;
-    writeln!(w, "<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto}}td,th{{padding:2px 8px;text-align:right}}img{{max-width:100%}}</style></head><body>")?;
+    writeln!(w, "<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em}}.table{{overflow-x:auto}}td,th{{padding:2px 8px;text-align:right;white-space:nowrap}}td:first-child,th:first-child{{text-align:left}}img{{max-width:100%;height:auto}}</style></head><body>")?;
     writeln!(w, "<h1>specfx report</h1>")?;
     // The verdict first: the numbers a designer acts on.
     let lsb8 = 1.0 / 256.0;
@@ -120,7 +120,7 @@ fn write_index(
         a.total.max_abs, a.total.max_ulp,
         if budget.formal.is_empty() { budget.formal_note.clone().unwrap_or_default() } else { format!("gappa proves bounds for {} exponents, at most {formal:.2} times the exhaustive maximum.", budget.formal.len()) })?;
     if !costs.is_empty() {
-        writeln!(w, "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>latency (cycles)</th><th>initiation interval</th><th>ROM LUTs (yosys)</th></tr>")?;
+        writeln!(w, "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><div class=\"table\"><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>latency (cycles)</th><th>initiation interval</th><th>ROM LUTs (yosys)</th></tr>")?;
         for c in costs {
             writeln!(
                 w,
@@ -135,9 +135,9 @@ fn write_index(
                 c.rom_yosys.as_ref().map_or(0, |r| r.luts)
             )?;
         }
-        writeln!(w, "</table>")?;
+        writeln!(w, "</table></div>")?;
     }
-    writeln!(w, "<h2>The cycle model</h2><p>20,000 cycles of each microarchitecture under seeded bubbles and stalls, every output checked against the functional model (<a href=\"sim_baseline.json\">sim_baseline.json</a>; a VCD of the first 300 cycles: <a href=\"sim_baseline_pipelined.vcd\">sim_baseline_pipelined.vcd</a>).</p><table><tr><th>architecture</th><th>outputs</th><th>results per cycle</th><th>latency (nominal)</th><th>latency seen</th><th>mismatches</th></tr>")?;
+    writeln!(w, "<h2>The cycle model</h2><p>20,000 cycles of each microarchitecture under seeded bubbles and stalls, every output checked against the functional model (<a href=\"sim_baseline.json\">sim_baseline.json</a>; a VCD of the first 300 cycles: <a href=\"sim_baseline_pipelined.vcd\">sim_baseline_pipelined.vcd</a>).</p><div class=\"table\"><table><tr><th>architecture</th><th>outputs</th><th>results per cycle</th><th>latency (nominal)</th><th>latency seen</th><th>mismatches</th></tr>")?;
     for st in sims {
         writeln!(
             w,
@@ -151,11 +151,12 @@ fn write_index(
             st.mismatches
         )?;
     }
-    writeln!(w, "</table>")?;
+    writeln!(w, "</table></div>")?;
+    writeln!(w, "<h2>Error against hardware cost</h2><p>Each fixed-point datapath of the trade-off (plain k = 4 at 8, 12 and 16 fraction bits; minimax k = 3..6) by its lobe error in lsb8 against the calibrated analytic cost on each target (<a href=\"tradeoff/tradeoff.csv\">tradeoff.csv</a>; the model and its calibration error: <code>docs/cost.md</code>).</p><img src=\"tradeoff/error_vs_luts_ice40.png\" alt=\"error against iCE40 LUTs\"><img src=\"tradeoff/error_vs_dsps_ice40.png\" alt=\"error against iCE40 DSPs\"><img src=\"tradeoff/error_vs_luts_xilinx.png\" alt=\"error against Xilinx LUTs\"><img src=\"tradeoff/error_vs_latency.png\" alt=\"error against latency\">")?;
     writeln!(w, "<h2>Speed against accuracy</h2><img src=\"tradeoff/speed_accuracy.png\" alt=\"speed against accuracy\"><img src=\"tradeoff/error_vs_n.png\" alt=\"error against n\">")?;
     writeln!(
         w,
-        "<table><tr><th>method</th><th>max |err|</th><th>mean |err|</th><th>Meval/s</th></tr>"
+        "<div class=\"table\"><table><tr><th>method</th><th>max |err|</th><th>mean |err|</th><th>Meval/s</th></tr>"
     )?;
     for f in figures {
         writeln!(
@@ -167,7 +168,7 @@ fn write_index(
             f.evals_per_s / 1e6
         )?;
     }
-    writeln!(w, "</table>")?;
+    writeln!(w, "</table></div>")?;
     let passing: Vec<&str> = stability
         .maps
         .iter()
@@ -323,6 +324,9 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     written.push(tradeoff_dir.join("tradeoff.csv"));
     written.push(tradeoff_dir.join("speed_accuracy.png"));
     written.push(tradeoff_dir.join("error_vs_n.png"));
+    for (_, stem) in specfx::report::tradeoff::CostAxis::CHARTS {
+        written.push(tradeoff_dir.join(format!("{stem}.png")));
+    }
 
     step("mapping where every method and datapath fails (n = 1..=4096, theta 0..90 degrees)");
     let stability_dir = dir.join("stability");
@@ -399,7 +403,13 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             costs: &costs,
             sims: &sims,
         };
-        write_index(b, dir, &written, &results)
+        write_index(b, dir, &written, &results)?;
+        // Numbers in the page's text never break at their minus sign (U+2212 instead of -).
+        let page = String::from_utf8(std::mem::take(b)).map_err(std::io::Error::other)?;
+        let (head, body) = page.split_at(page.find("<body>").unwrap_or(0));
+        b.extend_from_slice(head.as_bytes());
+        b.extend_from_slice(specfx::report::doc::number_minus(body).as_bytes());
+        Ok(())
     })?);
 
     let n_claims = paper.forms.len() + 2;

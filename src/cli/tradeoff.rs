@@ -16,7 +16,7 @@ use specfx::analysis::tradeoff::{
 use specfx::hdl::cost::Target;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
-use specfx::report::tradeoff::{per_n_chart, speed_chart};
+use specfx::report::tradeoff::{cost_chart, per_n_chart, speed_chart, CostAxis};
 
 /// Arguments of `specfx tradeoff`.
 #[derive(Debug, Args)]
@@ -121,6 +121,9 @@ pub fn tradeoff(
     let mut json = serde_json::to_vec_pretty(&figures)?;
     json.push(b'\n');
     write_atomic(&dir.join("tradeoff.json"), &json)?;
+    for (axis, stem) in CostAxis::CHARTS {
+        write_chart(dir, stem, &cost_chart(&figures, axis))?;
+    }
     write_chart(dir, "speed_accuracy", &speed_chart(&figures))?;
     write_chart(
         dir,

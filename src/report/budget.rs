@@ -1,9 +1,9 @@
 //! The error-budget report: its document (tables, prose) and its charts, from a
 //! [`BudgetReport`].
 
-use crate::analysis::budget::{BudgetReport, Histogram};
+use crate::analysis::budget::{BudgetReport, Histogram, PerN};
 use crate::analysis::check::Input;
-use crate::report::chart::{hue, Chart, Series};
+use crate::report::chart::{Chart, Dash, RefLine, Series};
 use crate::report::doc::Block;
 
 fn e(x: f64) -> String {
@@ -18,22 +18,42 @@ fn at(i: &Input) -> String {
     format!("n = {}, c = {:.6} (code {})", i.n, i.c, i.c_raw)
 }
 
-fn histogram_series(h: &Histogram, label: &str, color: (u8, u8, u8)) -> Series {
+/// One lsb8: a step of an 8-bit display at the lobe's peak (2^-8, as in `1 lsb8` budgets).
+const LSB8: f64 = 1.0 / 256.0;
+
+/// A histogram as bars, one per non-empty bin (an absent bar is an empty bin).
+fn histogram_series(h: &Histogram, label: &str, i: usize) -> Series {
     Series {
-        label: label.into(),
-        points: h
-            .counts
-            .iter()
-            .enumerate()
-            .filter(|&(_, &c)| c > 0)
-            .map(|(i, &c)| (h.lo + (i as f64 + 0.5) * h.bin_width, c as f64))
-            .collect(),
-        line: false,
-        color,
+        bar_width: Some(h.bin_width),
+        ..Series::styled(
+            label,
+            h.counts
+                .iter()
+                .enumerate()
+                .filter(|&(_, &c)| c > 0)
+                .map(|(i, &c)| (h.lo + (i as f64 + 0.5) * h.bin_width, c as f64))
+                .collect(),
+            false,
+            i,
+        )
     }
 }
 
-/// The report's charts, each with the file stem it is written under.
+/// The "1 lsb8" reference line.
+fn one_lsb8() -> Vec<RefLine> {
+    vec![RefLine {
+        at: 1.0,
+        label: "1 lsb8".into(),
+    }]
+}
+
+/// Bin widths as text: `16`, `0.0625`.
+fn width(w: f64) -> String {
+    format!("{w}")
+}
+
+/// The report's charts, each with the file stem it is written under. Lobe errors are in
+/// lsb8 (2^-8) with the 1 lsb8 line drawn; output errors in output LSBs.
 ///
 /// # Examples
 /// ```
@@ -44,90 +64,142 @@ fn histogram_series(h: &Histogram, label: &str, color: (u8, u8, u8)) -> Series {
 /// cfg.n = "32".parse().unwrap();
 /// let r = analyse(&Datapath::new(cfg).unwrap(), None).unwrap();
 /// let stems: Vec<String> = charts(&r).into_iter().map(|(s, _)| s).collect();
-/// assert_eq!(stems, ["histogram_out", "histogram_shape", "error_vs_c", "error_vs_n"]);
+/// assert_eq!(
+///     stems,
+///     ["histogram_out", "histogram_shape", "error_vs_c", "error_vs_n", "output_error_vs_c", "output_error_vs_n"]
+/// );
 /// ```
 pub fn charts(r: &BudgetReport) -> Vec<(String, Chart)> {
     let h_out = Chart {
         title: format!("{}: output error against the f64 model", r.config),
-        x_label: "fixed output - f64 output (output LSBs)".into(),
-        y_label: "evaluations (count)".into(),
-        log_x: false,
+        x_label: format!(
+            "fixed output \u{2212} f64 output (output LSBs; bins of {})",
+            width(r.histogram_out.bin_width)
+        ),
+        y_label: "evaluations (count, log scale)".into(),
         log_y: true,
-        series: vec![histogram_series(
-            &r.histogram_out,
-            &format!("bins of {} LSB", r.histogram_out.bin_width),
-            hue(0, 3),
-        )],
+        x_integer: r.histogram_out.bin_width.fract() == 0.0,
+        y_integer: true,
+        series: vec![histogram_series(&r.histogram_out, "output error", 5)],
+        ..Chart::default()
     };
     let h_shape = Chart {
         title: format!("{}: lobe error against cos^n", r.config),
-        x_label: "fixed lobe - cos^n (units of 2^-8)".into(),
-        y_label: "evaluations (count)".into(),
-        log_x: false,
+        x_label: format!(
+            "fixed lobe \u{2212} cos^n (lsb8 = 2^-8; bins of {})",
+            width(r.histogram_shape.bin_width)
+        ),
+        y_label: "evaluations (count, log scale)".into(),
         log_y: true,
-        series: vec![histogram_series(
-            &r.histogram_shape,
-            &format!("bins of {} x 2^-8", r.histogram_shape.bin_width),
-            hue(1, 3),
-        )],
+        x_integer: r.histogram_shape.bin_width.fract() == 0.0,
+        y_integer: true,
+        series: vec![histogram_series(&r.histogram_shape, "lobe error", 1)],
+        x_ref_lines: vec![
+            RefLine {
+                at: -1.0,
+                label: "\u{2212}1 lsb8".into(),
+            },
+            RefLine {
+                at: 1.0,
+                label: "1 lsb8".into(),
+            },
+        ],
+        ..Chart::default()
     };
     let mid = |lo: f64, hi: f64| 0.5 * (lo + hi);
     let vs_c = Chart {
         title: format!(
-            "{}: largest error per interval of c, over every n",
+            "{}: largest lobe error per interval of c, over every n",
             r.config
         ),
         x_label: "c = cos(theta) (interval midpoint)".into(),
-        y_label: "max error (output LSBs; lobe in 2^-8)".into(),
-        log_x: false,
-        log_y: false,
-        series: vec![
-            Series {
-                label: "output vs f64 model (output LSBs)".into(),
-                points: r
-                    .per_c
-                    .iter()
-                    .map(|p| (mid(p.c_lo, p.c_hi), p.out_quant_max_ulp))
-                    .collect(),
-                line: true,
-                color: hue(0, 3),
-            },
-            Series {
-                label: "lobe vs cos^n (2^-8)".into(),
-                points: r
-                    .per_c
-                    .iter()
-                    .map(|p| (mid(p.c_lo, p.c_hi), p.shape_total_max_abs * 256.0))
-                    .collect(),
-                line: true,
-                color: hue(1, 3),
-            },
-        ],
+        y_label: "max |fixed lobe \u{2212} cos^n| (lsb8, log scale)".into(),
+        log_y: true,
+        series: vec![Series::styled(
+            "lobe vs cos^n",
+            r.per_c
+                .iter()
+                .map(|p| (mid(p.c_lo, p.c_hi), p.shape_total_max_abs / LSB8))
+                .collect(),
+            true,
+            0,
+        )],
+        ref_lines: one_lsb8(),
+        direct_labels: true,
+        ..Chart::default()
     };
-    let per_n = |label: &str, i: usize, f: &dyn Fn(&crate::analysis::budget::PerN) -> f64| Series {
-        label: label.into(),
-        points: r.per_n.iter().map(|p| (f64::from(p.n), f(p))).collect(),
-        line: true,
-        color: hue(i, 4),
+    let per_n = |label: &str, i: usize, dash: Dash, f: &dyn Fn(&PerN) -> f64| Series {
+        dash,
+        ..Series::styled(
+            label,
+            r.per_n.iter().map(|p| (f64::from(p.n), f(p))).collect(),
+            true,
+            i,
+        )
     };
     let vs_n = Chart {
-        title: format!("{}: largest error per exponent", r.config),
+        title: format!("{}: largest lobe error per exponent", r.config),
         x_label: "exponent n".into(),
-        y_label: "max |error| (absolute)".into(),
-        log_x: false,
+        y_label: "max |error| over c (lsb8, log scale)".into(),
         log_y: true,
+        x_integer: true,
         series: vec![
-            per_n("lobe vs cos^n (total)", 0, &|p| p.shape_total_max_abs),
-            per_n("lobe: approximation", 1, &|p| p.shape_approx_max_abs),
-            per_n("lobe: quantization", 2, &|p| p.shape_quant_max_abs),
-            per_n("output: quantization", 3, &|p| p.out_quant_max_abs),
+            per_n("total: fixed lobe vs cos^n", 0, Dash::Solid, &|p| {
+                p.shape_total_max_abs / LSB8
+            }),
+            per_n("approximation: f64 lobe vs cos^n", 1, Dash::Dashed, &|p| {
+                p.shape_approx_max_abs / LSB8
+            }),
+            per_n("quantization: fixed vs f64 lobe", 2, Dash::Dotted, &|p| {
+                p.shape_quant_max_abs / LSB8
+            }),
         ],
+        ref_lines: one_lsb8(),
+        direct_labels: true,
+        ..Chart::default()
+    };
+    let out_c = Chart {
+        title: format!(
+            "{}: largest output quantization error per interval of c, over every n",
+            r.config
+        ),
+        x_label: "c = cos(theta) (interval midpoint)".into(),
+        y_label: "max |fixed output \u{2212} f64 model| (output LSBs, log scale)".into(),
+        log_y: true,
+        series: vec![Series::styled(
+            "output vs f64 model",
+            r.per_c
+                .iter()
+                .map(|p| (mid(p.c_lo, p.c_hi), p.out_quant_max_ulp))
+                .collect(),
+            true,
+            5,
+        )],
+        direct_labels: true,
+        ..Chart::default()
+    };
+    let out_n = Chart {
+        title: format!(
+            "{}: largest output quantization error per exponent",
+            r.config
+        ),
+        x_label: "exponent n".into(),
+        y_label: "max |fixed output \u{2212} f64 model| over c (output LSBs, log scale)".into(),
+        log_y: true,
+        x_integer: true,
+        series: vec![per_n("output vs f64 model", 5, Dash::Solid, &|p| {
+            p.out_quant_max_ulp
+        })],
+        direct_labels: true,
+        ..Chart::default()
     };
     vec![
         ("histogram_out".into(), h_out),
         ("histogram_shape".into(), h_shape),
         ("error_vs_c".into(), vs_c),
         ("error_vs_n".into(), vs_n),
+        ("output_error_vs_c".into(), out_c),
+        ("output_error_vs_n".into(), out_n),
     ]
 }
 

@@ -100,7 +100,42 @@ pub fn html_escape(s: &str) -> String {
     out
 }
 
-/// Escapes text and turns `code` spans into `<code>` elements.
+/// Writes the minus signs of numbers as U+2212 (a browser never breaks a line after it): a
+/// `-` before a digit or a point, at the start, after a space or an opening bracket, after
+/// `=`, or in an exponent (`1.5e-3`). Hyphens and spaced binary minus signs stay.
+///
+/// # Examples
+/// ```
+/// use specfx::report::doc::number_minus;
+/// assert_eq!(number_minus("-1.5e-3 (n = -2)"), "\u{2212}1.5e\u{2212}3 (n = \u{2212}2)");
+/// assert_eq!(number_minus("fixed - f64, cs16-paper, x-1"), "fixed - f64, cs16-paper, x-1");
+/// ```
+pub fn number_minus(s: &str) -> String {
+    let chars: Vec<char> = s.chars().collect();
+    let mut out = String::with_capacity(s.len());
+    for (i, &ch) in chars.iter().enumerate() {
+        let next_is_number = chars
+            .get(i + 1)
+            .is_some_and(|c| c.is_ascii_digit() || *c == '.');
+        let prev = if i > 0 { Some(chars[i - 1]) } else { None };
+        let exponent = matches!(prev, Some('e' | 'E'))
+            && i >= 2
+            && (chars[i - 2].is_ascii_digit() || chars[i - 2] == '.');
+        let opens = match prev {
+            None => true,
+            Some(p) => p.is_whitespace() || matches!(p, '(' | '[' | '=' | ',' | ';' | ':'),
+        };
+        if ch == '-' && next_is_number && (opens || exponent) {
+            out.push('\u{2212}');
+        } else {
+            out.push(ch);
+        }
+    }
+    out
+}
+
+/// Escapes text and turns `code` spans into `<code>` elements; numbers outside code get
+/// U+2212 minus signs ([`number_minus`]).
 fn html_text(s: &str) -> String {
     let mut out = String::new();
     for (i, part) in s.split('`').enumerate() {
@@ -109,16 +144,30 @@ fn html_text(s: &str) -> String {
             out.push_str(&html_escape(part));
             out.push_str("</code>");
         } else {
-            out.push_str(&html_escape(part));
+            out.push_str(&html_escape(&number_minus(part)));
         }
     }
     out
 }
 
-const STYLE: &str = "body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}\
-table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}\
-th{background:#eee}td:first-child,th:first-child{text-align:left}figure{margin:1em 0}\
-figcaption{font-size:90%;color:#555}svg{max-width:100%;height:auto}code{background:#f3f3f3;padding:0 3px}";
+/// Whether a table cell holds a number (or a short figure such as `12.5%`, `< 1e-11`,
+/// `16..=1024`) that must stay on one line.
+fn numeric_cell(s: &str) -> bool {
+    let t = s.trim();
+    let starts = t
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_digit() || matches!(c, '-' | '+' | '.' | '<' | '>' | '±'));
+    starts && t.chars().count() <= 32
+}
+
+const STYLE: &str =
+    "body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}\
+.table{overflow-x:auto;margin:1em 0}table{border-collapse:collapse;font-size:90%}\
+td,th{border:1px solid #bbb;padding:3px 5px;text-align:left;vertical-align:top}\
+td.num{white-space:nowrap;text-align:right}th{background:#eee}\
+figure{margin:1em 0}figcaption{font-size:90%;color:#555}svg,img{max-width:100%;height:auto}\
+code{background:#f3f3f3;padding:0 3px}";
 
 /// Renders a document as one self-contained HTML page: every figure's SVG is inlined, found
 /// by its stem through `svg_of`.
@@ -152,7 +201,8 @@ pub fn write_html(
             }
             Block::Paragraph(text) => writeln!(w, "<p>{}</p>", html_text(text))?,
             Block::Table { header, rows } => {
-                writeln!(w, "<table>")?;
+                // A wide table scrolls inside its box; the page never does.
+                writeln!(w, "<div class=\"table\"><table>")?;
                 let cells: String = header
                     .iter()
                     .map(|c| format!("<th>{}</th>", html_text(c)))
@@ -161,11 +211,18 @@ pub fn write_html(
                 for row in rows {
                     let cells: String = row
                         .iter()
-                        .map(|c| format!("<td>{}</td>", html_text(c)))
+                        .map(|c| {
+                            let class = if numeric_cell(c) {
+                                " class=\"num\""
+                            } else {
+                                ""
+                            };
+                            format!("<td{class}>{}</td>", html_text(c))
+                        })
                         .collect();
                     writeln!(w, "<tr>{cells}</tr>")?;
                 }
-                writeln!(w, "</table>")?;
+                writeln!(w, "</table></div>")?;
             }
             Block::Figure { stem, caption } => {
                 writeln!(w, "<figure>")?;
@@ -183,7 +240,7 @@ pub fn write_html(
             Block::Image { src, caption } => {
                 writeln!(
                     w,
-                    "<figure><img src=\"{}\" alt=\"{}\" style=\"max-width:100%\"><figcaption>{}</figcaption></figure>",
+                    "<figure><img src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
                     html_escape(src),
                     html_escape(caption),
                     html_text(caption)

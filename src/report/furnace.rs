@@ -9,7 +9,10 @@ use plotters::prelude::*;
 
 use crate::analysis::furnace::{Curve, FormSummary, FurnacePath, FurnaceReport};
 use crate::error::Error;
-use crate::report::chart::{encode_png, register_font, render_error};
+use crate::report::chart::{
+    draw_chart, draw_sample, encode_png, register_font, render_error, Chart, Dash, Marker, RefLine,
+    Series, OKABE_ITO,
+};
 use crate::report::doc::Block;
 
 /// The file stem of a form's chart: `furnace_<form>`.
@@ -213,7 +216,7 @@ pub fn document(r: &FurnaceReport) -> Vec<Block> {
         doc.push(Block::Figure {
             stem: chart_stem(f.form),
             caption: format!(
-                "{}: reflectance against incident angle, one panel per exponent, one line per path; red dots exceed 1",
+                "{}: reflectance against incident angle, one panel per exponent, one line per path (each its own dash pattern); vermillion triangles exceed 1",
                 f.form.name()
             ),
         });
@@ -255,23 +258,26 @@ pub fn summary_text(summary: &[FormSummary]) -> String {
     s
 }
 
-/// The colour of each path in the charts.
-fn path_colour(p: FurnacePath) -> RGBColor {
+/// How each path is drawn: an Okabe-Ito colour and a dash pattern of its own, so that lines
+/// on top of each other stay visible.
+fn path_style(p: FurnacePath) -> ((u8, u8, u8), Dash) {
     match p {
-        FurnacePath::F64CosN => RGBColor(40, 40, 40),
-        FurnacePath::F64CsMPaper => RGBColor(230, 130, 0),
-        FurnacePath::F64CsMExact => RGBColor(30, 100, 220),
-        FurnacePath::Datapath => RGBColor(20, 170, 90),
+        FurnacePath::F64CosN => (OKABE_ITO[0], Dash::Solid),
+        FurnacePath::F64CsMPaper => (OKABE_ITO[1], Dash::Dashed),
+        FurnacePath::F64CsMExact => (OKABE_ITO[5], Dash::Dotted),
+        FurnacePath::Datapath => (OKABE_ITO[3], Dash::DashDot),
     }
 }
 
-/// Line widths: the first paths drawn widest, so that lines on top of each other stay visible.
-fn path_width(p: FurnacePath) -> u32 {
-    match p {
-        FurnacePath::F64CosN => 5,
-        FurnacePath::F64CsMPaper => 3,
-        FurnacePath::F64CsMExact => 2,
-        FurnacePath::Datapath => 1,
+/// Reflectance values above 1 (plus the tolerance): vermillion triangles.
+fn flagged_series(points: Vec<(f64, f64)>) -> Series {
+    Series {
+        label: "> 1".into(),
+        points,
+        line: false,
+        color: OKABE_ITO[6],
+        marker: Marker::TriangleUp,
+        ..Series::default()
     }
 }
 
@@ -281,6 +287,56 @@ fn chart_size(n_panels: usize) -> (u32, u32) {
     let cols = n_panels.clamp(1, PANEL_COLS) as u32;
     let rows = n_panels.div_ceil(PANEL_COLS).max(1) as u32;
     (60 + 300 * cols, 90 + 280 * rows)
+}
+
+/// The panel of one exponent: a line per path, the flagged values, the line rho = 1.
+fn panel(r: &FurnaceReport, f: &crate::analysis::furnace::FormFurnace, n: u32) -> Chart {
+    let curves: Vec<&Curve> = f.curves.iter().filter(|c| c.n == n).collect();
+    let mut series: Vec<Series> = curves
+        .iter()
+        .map(|c| {
+            let (color, dash) = path_style(c.path);
+            Series {
+                label: c.path.label().into(),
+                points: r
+                    .angles_deg
+                    .iter()
+                    .copied()
+                    .zip(c.rho.iter().copied())
+                    .collect(),
+                line: true,
+                color,
+                dash,
+                marker: Marker::None,
+                bar_width: None,
+            }
+        })
+        .collect();
+    let flagged: Vec<(f64, f64)> = curves
+        .iter()
+        .flat_map(|c| {
+            r.angles_deg
+                .iter()
+                .copied()
+                .zip(c.rho.iter().copied())
+                .filter(|&(_, v)| v > 1.0 + r.flag_tolerance)
+        })
+        .collect();
+    if !flagged.is_empty() {
+        series.push(flagged_series(flagged));
+    }
+    Chart {
+        title: format!("n = {n}"),
+        x_label: "theta_i (deg)".into(),
+        y_label: "rho".into(),
+        x_integer: r.angles_deg.iter().all(|a| a.fract() == 0.0),
+        series,
+        ref_lines: vec![RefLine {
+            at: 1.0,
+            label: "1".into(),
+        }],
+        ..Chart::default()
+    }
 }
 
 fn draw_form<DB: DrawingBackend>(
@@ -302,98 +358,40 @@ fn draw_form<DB: DrawingBackend>(
         ("sans-serif", 20),
     ))
     .map_err(err)?;
+    // The key, shared by every panel.
     let mut x = 16;
-    for p in FurnacePath::ALL {
-        let c = path_colour(p);
-        top.draw(&PathElement::new(
-            vec![(x, 50), (x + 28, 50)],
-            c.stroke_width(path_width(p).max(2)),
+    let mut key: Vec<Series> = FurnacePath::ALL
+        .iter()
+        .map(|&p| {
+            let (color, dash) = path_style(p);
+            Series {
+                label: p.label().into(),
+                line: true,
+                color,
+                dash,
+                marker: Marker::None,
+                ..Series::default()
+            }
+        })
+        .collect();
+    key.push(flagged_series(Vec::new()));
+    for s in &key {
+        draw_sample(&top, s, (x, 50))?;
+        top.draw(&Text::new(
+            s.label.clone(),
+            (x + 30, 42),
+            ("sans-serif", 14),
         ))
         .map_err(err)?;
-        top.draw(&Text::new(p.label(), (x + 34, 42), ("sans-serif", 14)))
-            .map_err(err)?;
-        x += 210;
+        x += 220;
     }
-    top.draw(&Circle::new((x + 6, 50), 4, RED.filled()))
-        .map_err(err)?;
-    top.draw(&Text::new("> 1", (x + 16, 42), ("sans-serif", 14)))
-        .map_err(err)?;
 
     let n_panels = r.ns.len();
     let cols = n_panels.clamp(1, PANEL_COLS);
     let rows = n_panels.div_ceil(PANEL_COLS).max(1);
     let tiles = body.split_evenly((rows, cols));
-    let x_hi = r.angles_deg.last().copied().unwrap_or(90.0).max(1.0);
     for (tile, &n) in tiles.iter().zip(&r.ns) {
-        let curves: Vec<&Curve> = f.curves.iter().filter(|c| c.n == n).collect();
-        let (mut lo, mut hi) = (1.0f64, 1.0f64);
-        for c in &curves {
-            for &v in c.rho.iter().filter(|v| v.is_finite()) {
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-        }
-        let pad = 0.06 * (hi - lo).max(1e-3);
-        let (lo, hi) = (lo - pad, hi + pad);
-        let mut chart = ChartBuilder::on(tile)
-            .caption(format!("n = {n}"), ("sans-serif", 15))
-            .margin(8)
-            .x_label_area_size(34)
-            .y_label_area_size(58)
-            .build_cartesian_2d(0f64..x_hi, lo..hi)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("theta_i (deg)")
-            .y_desc("rho")
-            .x_labels(7)
-            .y_labels(6)
-            .x_label_formatter(&|x: &f64| format!("{x:.0}"))
-            .y_label_formatter(&|y: &f64| format!("{y:.3}"))
-            .label_style(("sans-serif", 12))
-            .axis_desc_style(("sans-serif", 12))
-            .draw()
-            .map_err(err)?;
-        chart
-            .draw_series(DashedLineSeries::new(
-                vec![(0.0, 1.0), (x_hi, 1.0)],
-                6,
-                4,
-                RGBColor(150, 150, 150).stroke_width(1),
-            ))
-            .map_err(err)?;
-        for c in &curves {
-            let pts: Vec<(f64, f64)> = r
-                .angles_deg
-                .iter()
-                .copied()
-                .zip(c.rho.iter().copied())
-                .filter(|p| p.1.is_finite())
-                .collect();
-            let colour = path_colour(c.path);
-            chart
-                .draw_series(LineSeries::new(
-                    pts.clone(),
-                    colour.stroke_width(path_width(c.path)),
-                ))
-                .map_err(err)?;
-            if pts.len() == 1 {
-                chart
-                    .draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-                    .map_err(err)?;
-            }
-        }
-        for c in &curves {
-            let flagged = r
-                .angles_deg
-                .iter()
-                .copied()
-                .zip(c.rho.iter().copied())
-                .filter(|&(_, v)| v > 1.0 + r.flag_tolerance);
-            chart
-                .draw_series(flagged.map(|p| Circle::new(p, 2, RED.filled())))
-                .map_err(err)?;
-        }
+        draw_chart(tile, &panel(r, f, n), true)?;
     }
     root.present().map_err(err)
 }

@@ -11,8 +11,9 @@ use plotters::prelude::*;
 use crate::analysis::stability::{
     Kind, PathMap, StabilityReport, HEAT_ROWS, OVERSHOOT_J_MAX, SPECIAL_N,
 };
-use crate::report::chart::{hue, register_font, Chart, Series};
+use crate::report::chart::{lsb8, register_font, style, Chart, Dash, Series};
 use crate::report::doc::Block;
+use plotters::element::DashedPathElement;
 
 /// Heat-map size in pixels (the SVG uses the same user units).
 pub const HEAT_SIZE: (u32, u32) = (960, 600);
@@ -91,25 +92,35 @@ impl Shade {
         }
     }
 
-    /// The RGB colour.
+    /// The RGB colour: blues within the tolerance, oranges to dark brown beyond it (a pair
+    /// every kind of colour vision tells apart), white where exact.
     pub fn rgb(self) -> (u8, u8, u8) {
         match self {
             Shade::Empty => (250, 250, 250),
             Shade::Unrepresentable => (170, 170, 170),
             Shade::NonFinite => (0, 0, 0),
             Shade::Exact => (255, 255, 255),
-            Shade::Within(0) => (224, 243, 219),
-            Shade::Within(1) => (168, 221, 181),
-            Shade::Within(2) => (102, 194, 164),
-            Shade::Within(_) => (35, 139, 69),
-            Shade::Beyond(0) => (254, 196, 79),
+            Shade::Within(0) => (222, 235, 247),
+            Shade::Within(1) => (158, 202, 225),
+            Shade::Within(2) => (66, 146, 198),
+            Shade::Within(_) => (8, 81, 156),
+            Shade::Beyond(0) => (254, 217, 142),
             Shade::Beyond(1) => (254, 153, 41),
-            Shade::Beyond(2) => (236, 92, 32),
-            Shade::Beyond(_) => (153, 0, 13),
+            Shade::Beyond(2) => (217, 95, 14),
+            Shade::Beyond(_) => (127, 39, 4),
         }
     }
 
-    /// The legend label for a tolerance.
+    /// The legend label for a tolerance, in lsb8 (2^-8).
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::report::stability::Shade;
+    /// let tol = 1.0 / 256.0;
+    /// assert_eq!(Shade::Within(0).label(tol), "\u{2264} 0.001 lsb8");
+    /// assert_eq!(Shade::Beyond(1).label(tol), "\u{2264} 16 lsb8");
+    /// assert_eq!(Shade::Beyond(3).label(tol), "> 64 lsb8");
+    /// ```
     pub fn label(self, tol: f64) -> String {
         match self {
             Shade::Empty => "no sample".into(),
@@ -117,13 +128,13 @@ impl Shade {
             Shade::NonFinite => "NaN or infinite".into(),
             Shade::Exact => "exact".into(),
             Shade::Within(l) => format!(
-                "<= {:.1e}",
-                tol / [1000.0, 100.0, 10.0, 1.0][usize::from(l.min(3))]
+                "\u{2264} {}",
+                lsb8(tol / [1000.0, 100.0, 10.0, 1.0][usize::from(l.min(3))])
             ),
             Shade::Beyond(l) if l < 3 => {
-                format!("<= {:.1e}", tol * [4.0, 16.0, 64.0][usize::from(l)])
+                format!("\u{2264} {}", lsb8(tol * [4.0, 16.0, 64.0][usize::from(l)]))
             }
-            Shade::Beyond(_) => format!("> {:.1e}", 64.0 * tol),
+            Shade::Beyond(_) => format!("> {}", lsb8(64.0 * tol)),
         }
     }
 }
@@ -182,8 +193,8 @@ fn draw_heatmap<DB: DrawingBackend>(
     let x_lo = f64::from(cols[0].0);
     let x_hi = f64::from(cols[cols.len() - 1].1) + 1.0;
     let worst = format!(
-        "max |err| {:.2e} at n = {}, theta = {:.2} deg",
-        m.max_abs_err,
+        "max |err| {} at n = {}, theta = {:.2} deg",
+        lsb8(m.max_abs_err),
         m.worst_n,
         m.worst_c.clamp(-1.0, 1.0).acos().to_degrees()
     );
@@ -201,6 +212,7 @@ fn draw_heatmap<DB: DrawingBackend>(
         .configure_mesh()
         .disable_mesh()
         .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| format!("{y:.0}"))
         .x_desc("specular exponent n (log scale)")
         .y_desc("theta = arccos(c) (degrees)")
         .label_style(("sans-serif", 14))
@@ -238,15 +250,20 @@ fn draw_heatmap<DB: DrawingBackend>(
         .draw_series(
             mark(Kind::Underflow.bit())
                 .into_iter()
-                .map(|p| Circle::new(p, 1, RGBColor(40, 70, 200).filled())),
+                .map(|p| Circle::new(p, 1, BLACK.filled())),
         )
         .map_err(err)?;
+    if let Some((lo, hi)) = m.design_n {
+        chart
+            .draw_series(std::iter::once(design_box(lo, hi)))
+            .map_err(err)?;
+    }
     // The legend, drawn by hand beside the plot.
     let font = ("sans-serif", 13).into_font();
     let mut y = 40;
     legend
         .draw(&Text::new(
-            format!("|err|, tol = {tol:.2e}"),
+            format!("|err|, tol = {}", lsb8(tol)),
             (6, y),
             font.clone(),
         ))
@@ -283,13 +300,45 @@ fn draw_heatmap<DB: DrawingBackend>(
         .map_err(err)?;
     y += 40;
     legend
-        .draw(&Circle::new((15, y + 7), 2, RGBColor(40, 70, 200).filled()))
+        .draw(&Circle::new((15, y + 7), 2, BLACK.filled()))
         .map_err(err)?;
     legend
-        .draw(&Text::new("underflow", (30, y), font))
+        .draw(&Text::new("underflow", (30, y), font.clone()))
         .map_err(err)?;
+    if let Some((lo, hi)) = m.design_n {
+        y += 30;
+        legend
+            .draw(&DashedPathElement::new(
+                vec![(6, y + 7), (24, y + 7)],
+                5,
+                3,
+                BLACK.stroke_width(2),
+            ))
+            .map_err(err)?;
+        legend
+            .draw(&Text::new("design range", (30, y), font.clone()))
+            .map_err(err)?;
+        legend
+            .draw(&Text::new(format!("n = {lo}..={hi}"), (30, y + 16), font))
+            .map_err(err)?;
+    }
     root.present().map_err(err)
 }
+
+/// The dashed outline of a datapath's design range on a map: its exponents, every angle.
+fn design_box(lo: u32, hi: u32) -> DashedPathElement<std::vec::IntoIter<(f64, f64)>, i32> {
+    let (x0, x1) = (f64::from(lo), f64::from(hi) + 1.0);
+    DashedPathElement::new(
+        vec![(x0, 0.0), (x0, 90.0), (x1, 90.0), (x1, 0.0), (x0, 0.0)],
+        6,
+        4,
+        BLACK.stroke_width(2),
+    )
+}
+
+/// Pass and fail on the overview: light blue and vermillion.
+const PASS: (u8, u8, u8) = (158, 202, 225);
+const FAIL: (u8, u8, u8) = (213, 94, 0);
 
 fn draw_overview<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
@@ -298,15 +347,71 @@ fn draw_overview<DB: DrawingBackend>(
 ) -> Result<(), Error> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| render_error(e.to_string());
     root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(
-            &format!("Where each path stays within {tol:.2e} of cos^n (green) and where it fails (red); x: n = {}..{} (log), y: theta 0..90 deg", maps.first().map_or(1, |m| m.heat.columns[0].0), maps.first().map_or(1, |m| m.heat.columns[m.heat.columns.len() - 1].1)),
-            ("sans-serif", 18),
+    let n_range = maps.first().map_or((1, 1), |m| {
+        (
+            m.heat.columns[0].0,
+            m.heat.columns[m.heat.columns.len() - 1].1,
         )
+    });
+    // The design range marked on every tile: the first datapath's (the baseline's in the
+    // default map), so each path is judged where that hardware is meant to work.
+    let design = maps
+        .iter()
+        .find_map(|m| m.design_n.map(|d| (m.path.clone(), d)));
+    let (top, body) = root.split_vertically(OVERVIEW_HEADER);
+    let font = ("sans-serif", 16).into_font();
+    top.draw(&Text::new(
+        format!(
+            "Where each path stays within {} of cos^n and where it fails; x: n = {}..={} (log), y: theta 0..90 deg",
+            lsb8(tol),
+            n_range.0,
+            n_range.1
+        ),
+        (10, 8),
+        font.clone(),
+    ))
+    .map_err(err)?;
+    let mut x = 10;
+    for (rgb, label) in [(PASS, "within tolerance"), (FAIL, "fails")] {
+        top.draw(&Rectangle::new(
+            [(x, 34), (x + 18, 48)],
+            RGBColor(rgb.0, rgb.1, rgb.2).filled(),
+        ))
         .map_err(err)?;
+        top.draw(&Text::new(label, (x + 24, 33), font.clone()))
+            .map_err(err)?;
+        x += 170;
+    }
+    top.draw(&Rectangle::new(
+        [(x, 34), (x + 18, 48)],
+        RGBColor(170, 170, 170).filled(),
+    ))
+    .map_err(err)?;
+    top.draw(&Text::new(
+        "n's constants do not fit",
+        (x + 24, 33),
+        font.clone(),
+    ))
+    .map_err(err)?;
+    x += 230;
+    if let Some((path, (lo, hi))) = &design {
+        top.draw(&DashedPathElement::new(
+            vec![(x, 41), (x + 22, 41)],
+            6,
+            4,
+            BLACK.stroke_width(2),
+        ))
+        .map_err(err)?;
+        top.draw(&Text::new(
+            format!("{path}'s design range: n = {lo}..={hi}, every input code (theta 0..90)"),
+            (x + 28, 33),
+            font,
+        ))
+        .map_err(err)?;
+    }
     let n_cols = 6;
     let n_rows = maps.len().div_ceil(n_cols).max(1);
-    let tiles = root.split_evenly((n_rows, n_cols));
+    let tiles = body.split_evenly((n_rows, n_cols));
     for (tile, m) in tiles.iter().zip(maps) {
         let cols = &m.heat.columns;
         let x_lo = f64::from(cols[0].0);
@@ -326,18 +431,26 @@ fn draw_overview<DB: DrawingBackend>(
             } else if c.samples == 0 {
                 (250, 250, 250)
             } else if structural {
-                (215, 48, 39)
+                FAIL
             } else {
-                (120, 198, 121)
+                PASS
             }
         };
         let rects = row_runs(m, class)
             .into_iter()
             .map(|(corners, k)| Rectangle::new(corners, RGBColor(k.0, k.1, k.2).filled()));
         chart.draw_series(rects).map_err(err)?;
+        if let Some((_, (lo, hi))) = design {
+            chart
+                .draw_series(std::iter::once(design_box(lo, hi)))
+                .map_err(err)?;
+        }
     }
     root.present().map_err(err)
 }
+
+/// Height of the overview's title and key.
+const OVERVIEW_HEADER: u32 = 60;
 
 /// Renders into an SVG string with a drawing function.
 fn svg_with(
@@ -350,8 +463,10 @@ fn svg_with(
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
         draw(root)?;
     }
-    text.push('\n');
-    Ok(text)
+    // Rectangles meet edge to edge: no anti-aliased seams between them when the browser
+    // scales the picture.
+    let text = text.replacen("<svg ", "<svg shape-rendering=\"crispEdges\" ", 1);
+    Ok(text + "\n")
 }
 
 /// Renders into PNG bytes with a drawing function.
@@ -381,7 +496,7 @@ pub fn heatmap_png(m: &PathMap, tol: f64) -> Result<Vec<u8>, Error> {
 
 fn overview_size(n_maps: usize) -> (u32, u32) {
     let rows = n_maps.div_ceil(6).max(1) as u32;
-    (1200, 40 + 150 * rows)
+    (1200, OVERVIEW_HEADER + 150 * rows)
 }
 
 /// The pass/fail overview of every path as SVG text.
@@ -399,6 +514,8 @@ pub fn overview_png(maps: &[PathMap], tol: f64) -> Result<Vec<u8>, Error> {
 }
 
 /// The overshoot chart: the smallest f32-ulp excess over 1 that makes each path overshoot.
+/// The paths' lines lie nearly on top of each other, so each has its own dash pattern and a
+/// label at its end.
 pub fn overshoot_chart(r: &StabilityReport) -> Chart {
     let shown: Vec<_> = r
         .overshoot
@@ -418,27 +535,37 @@ pub fn overshoot_chart(r: &StabilityReport) -> Chart {
         .collect();
     Chart {
         title: format!(
-            "Inputs above 1: smallest excess (f32 ulps) that lifts the lobe more than {:.2e}",
-            r.grid.tol.value
+            "Inputs above 1: smallest excess that lifts the lobe more than {}",
+            lsb8(r.grid.tol.value)
         ),
         x_label: "specular exponent n (log scale)".into(),
-        y_label: "c - 1 at the first overshoot (units of 2^-23)".into(),
+        y_label: "c \u{2212} 1 at the first overshoot (f32 ulps of 1 = 2^-23, log scale)".into(),
         log_x: true,
         log_y: true,
+        x_integer: true,
+        y_integer: true,
         series: shown
             .iter()
             .enumerate()
-            .map(|(i, o)| Series {
-                label: o.path.clone(),
-                points: o
-                    .per_n
-                    .iter()
-                    .filter_map(|&(n, j)| j.map(|j| (f64::from(n), f64::from(j))))
-                    .collect(),
-                line: true,
-                color: hue(i, shown.len()),
+            .map(|(i, o)| {
+                let (color, _, marker) = style(i);
+                Series {
+                    label: o.path.clone(),
+                    points: o
+                        .per_n
+                        .iter()
+                        .filter_map(|&(n, j)| j.map(|j| (f64::from(n), f64::from(j))))
+                        .collect(),
+                    line: true,
+                    color,
+                    dash: Dash::ALL[i % Dash::ALL.len()],
+                    marker,
+                    bar_width: None,
+                }
             })
             .collect(),
+        direct_labels: true,
+        ..Chart::default()
     }
 }
 
@@ -548,7 +675,7 @@ pub fn document(r: &StabilityReport) -> Vec<Block> {
         )),
         Block::Figure {
             stem: "overview".into(),
-            caption: "Pass (green) or fail (red) per path, over n (log) and theta.".into(),
+            caption: "Pass (light blue) or fail (vermillion) per path, over n (log) and theta; the dashed box is the first datapath's design range.".into(),
         },
         Block::Table {
             header: vec![

@@ -1,12 +1,12 @@
 //! The sweep's chart: lobe error in lsb8 against the analytic cost on the space's target,
-//! points grouped by k and variant, the Pareto front and a line at 1 lsb8.
+//! points grouped by k and variant, the Pareto front and the 1 lsb8 line.
 
 use std::collections::BTreeMap;
 
 use crate::analysis::sweep::PointResult;
 use crate::analysis::LSB8;
 use crate::hdl::cost::Target;
-use crate::report::chart::{Chart, Series, PALETTE};
+use crate::report::chart::{Chart, Dash, Marker, RefLine, Series};
 
 /// The value of `key` in a point's `key=value;..` axis values.
 fn axis<'a>(p: &'a PointResult, key: &str) -> Option<&'a str> {
@@ -36,42 +36,30 @@ pub fn chart(points: &[PointResult], target: Target) -> Chart {
             groups.entry(name).or_default().push(pt);
         }
     }
+    // Colour 0 (black) is the front's.
     let mut series: Vec<Series> = groups
         .into_iter()
         .enumerate()
-        .map(|(i, (name, pts))| Series {
-            label: if name.is_empty() {
+        .map(|(i, (name, pts))| {
+            let label = if name.is_empty() {
                 format!("{} points", pts.len())
             } else {
                 format!("{name} ({} points)", pts.len())
-            },
-            points: pts,
-            line: false,
-            color: PALETTE[(i + 1) % PALETTE.len()],
+            };
+            Series::styled(&label, pts, false, i + 1)
         })
         .collect();
     let mut front: Vec<(f64, f64)> = points.iter().filter(|p| p.pareto).filter_map(xy).collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (lo, hi) = points
-        .iter()
-        .filter_map(xy)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), (x, _)| {
-            (l.min(x), h.max(x))
-        });
     series.push(Series {
         label: format!("Pareto front ({} points)", front.len()),
         points: front,
         line: true,
-        color: PALETTE[0],
+        color: (0, 0, 0),
+        dash: Dash::default(),
+        marker: Marker::None,
+        ..Series::default()
     });
-    if lo.is_finite() {
-        series.push(Series {
-            label: "1 lsb8 (2^-8, one 8-bit display step)".into(),
-            points: vec![(lo, 1.0), (hi, 1.0)],
-            line: true,
-            color: PALETTE[6],
-        });
-    }
     Chart {
         title: format!(
             "Sweep: lobe error against cos^n versus analytic cost on {}",
@@ -85,6 +73,12 @@ pub fn chart(points: &[PointResult], target: Target) -> Chart {
         y_label: "max |fixed lobe - cos^n| (lsb8 = 2^-8, log scale)".into(),
         log_x: false,
         log_y: true,
+        x_integer: true,
+        ref_lines: vec![RefLine {
+            at: 1.0,
+            label: "1 lsb8".into(),
+        }],
         series,
+        ..Chart::default()
     }
 }

@@ -1,7 +1,117 @@
-//! The trade-off charts: accuracy against software speed, and the error against n.
+//! The trade-off charts: error against each target's hardware cost (the hardware question),
+//! accuracy against software speed, and the error against n.
 
 use crate::analysis::tradeoff::MethodFigures;
-use crate::report::chart::{hue, Chart, Series};
+use crate::analysis::LSB8;
+use crate::hdl::cost::{CostFigures, Target};
+use crate::report::chart::{Chart, Dash, Marker, RefLine, Series};
+
+/// A hardware cost axis of the trade-off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CostAxis {
+    /// Logic cells on a target (LUTs; gates for generic).
+    Logic(Target),
+    /// DSP blocks on a target.
+    Dsps(Target),
+    /// Flip-flops on a target.
+    Ffs(Target),
+    /// Latency in cycles (pipelined).
+    Latency,
+}
+
+impl CostAxis {
+    /// The cost charts the trade-off draws, and their file stems.
+    pub const CHARTS: [(CostAxis, &'static str); 6] = [
+        (CostAxis::Logic(Target::Ice40), "error_vs_luts_ice40"),
+        (CostAxis::Dsps(Target::Ice40), "error_vs_dsps_ice40"),
+        (CostAxis::Logic(Target::Xilinx), "error_vs_luts_xilinx"),
+        (CostAxis::Logic(Target::Generic), "error_vs_gates_generic"),
+        (CostAxis::Ffs(Target::Ice40), "error_vs_ffs_ice40"),
+        (CostAxis::Latency, "error_vs_latency"),
+    ];
+
+    fn of(self, f: &MethodFigures) -> Option<f64> {
+        let on =
+            |t: Target| -> Option<CostFigures> { f.costs.iter().find(|c| c.target == t).copied() };
+        match self {
+            CostAxis::Logic(t) => on(t).map(|c| c.luts as f64),
+            CostAxis::Dsps(t) => on(t).map(|c| c.dsps as f64),
+            CostAxis::Ffs(t) => on(t).map(|c| c.ffs as f64),
+            CostAxis::Latency => f.latency.map(|l| l as f64),
+        }
+    }
+
+    fn label(self) -> String {
+        match self {
+            CostAxis::Logic(t) => format!(
+                "analytic {} on {} (calibrated against yosys)",
+                t.logic_unit(),
+                t.name()
+            ),
+            CostAxis::Dsps(t) => format!("DSP blocks on {}", t.name()),
+            CostAxis::Ffs(t) => format!("analytic flip-flops on {}", t.name()),
+            CostAxis::Latency => "latency (cycles, pipelined)".into(),
+        }
+    }
+}
+
+/// Chart of error (lsb8, log) against one hardware cost: one labelled point per fixed-point
+/// datapath, the Pareto front (no datapath both cheaper and more accurate) as a line, and the
+/// 1 lsb8 line.
+pub fn cost_chart(figures: &[MethodFigures], axis: CostAxis) -> Chart {
+    let pts: Vec<(&str, f64, f64)> = figures
+        .iter()
+        .filter_map(|f| {
+            axis.of(f)
+                .map(|x| (f.method.as_str(), x, f.max_abs_err / LSB8))
+        })
+        .collect();
+    let mut front: Vec<(f64, f64)> = pts
+        .iter()
+        .filter(|&&(_, x, y)| {
+            !pts.iter()
+                .any(|&(_, x2, y2)| x2 <= x && y2 <= y && (x2 < x || y2 < y))
+        })
+        .map(|&(_, x, y)| (x, y))
+        .collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
+    front.dedup();
+    let mut series: Vec<Series> = pts
+        .iter()
+        .enumerate()
+        .map(|(i, &(name, x, y))| Series::styled(name, vec![(x, y)], false, i + 1))
+        .collect();
+    series.push(Series {
+        label: "Pareto front".into(),
+        points: front,
+        line: true,
+        color: (0, 0, 0),
+        dash: Dash::Dashed,
+        marker: Marker::None,
+        ..Series::default()
+    });
+    Chart {
+        title: format!("Error against {}", axis.label()),
+        x_label: axis.label(),
+        y_label: "max |fixed lobe - cos^n| over n = 16..1024 (lsb8 = 2^-8, log scale)".into(),
+        log_y: true,
+        x_integer: true,
+        direct_labels: true,
+        ref_lines: vec![RefLine {
+            at: 1.0,
+            label: "1 lsb8".into(),
+        }],
+        x_ref_lines: match axis {
+            CostAxis::Dsps(Target::Ice40) => vec![RefLine {
+                at: 8.0,
+                label: "iCE40 UP5K has 8".into(),
+            }],
+            _ => Vec::new(),
+        },
+        series,
+        ..Chart::default()
+    }
+}
 
 /// Chart of accuracy against speed: one point per method.
 pub fn speed_chart(figures: &[MethodFigures]) -> Chart {
@@ -12,7 +122,7 @@ pub fn speed_chart(figures: &[MethodFigures]) -> Chart {
     Chart {
         title: "Speed against accuracy, n = 16..1024".into(),
         x_label: "software speed (million evaluations per second, one core)".into(),
-        y_label: "max |method - cos^n| (absolute, log scale)".into(),
+        y_label: "max |method - cos^n| (absolute, log scale); the hardware cost is in the error_vs_* charts".into(),
         log_x: false,
         log_y: true,
         series: shown
@@ -22,9 +132,11 @@ pub fn speed_chart(figures: &[MethodFigures]) -> Chart {
                 label: f.method.clone(),
                 points: vec![(f.evals_per_s / 1e6, f.max_abs_err.max(1e-17))],
                 line: false,
-                color: hue(i, shown.len()),
+                color: crate::report::chart::color(i),
+                ..Series::default()
             })
             .collect(),
+        ..Chart::default()
     }
 }
 
@@ -57,7 +169,9 @@ pub fn per_n_chart(figures: &[MethodFigures], ns: &[u32], names: &[&str]) -> Cha
                     .collect(),
                 line: true,
                 color: colors[i % colors.len()],
+                ..Series::default()
             })
             .collect(),
+        ..Chart::default()
     }
 }
