@@ -946,9 +946,10 @@ pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, E
             .iter()
             .map(|bound| {
                 let value = metric_value(&report.output_figures(), dp, b.arch, bound.metric);
-                let pass = match bound.metric {
-                    Metric::Correct => value >= bound.limit,
-                    _ => value <= bound.limit,
+                let pass = if bound.metric.is_floor() {
+                    value >= bound.limit
+                } else {
+                    value <= bound.limit
                 };
                 BoundResult {
                     metric: bound.metric,

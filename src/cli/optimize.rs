@@ -283,10 +283,8 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         paper_check.shape_total_max_abs,
         paper_check.shape_total_max_abs / specfx::analysis::LSB8
     );
-    println!(
-        "  analytic cost, {arch} (the model `specfx cost` prints): {:>28} {:>28}",
-        "this", "paper's"
-    );
+    println!("  analytic cost, {arch} (the model `specfx cost --analytic-only` prints):");
+    println!("    {:<8} {:>28} {:>28}", "target", "this", "paper's");
     for target in specfx::hdl::cost::REPORTED_TARGETS {
         let a = analytic_cost(&dp, arch, target);
         let p = analytic_cost(&paper, arch, target);
