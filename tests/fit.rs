@@ -7,6 +7,7 @@ use common::{specfx, srgb8};
 
 use std::path::{Path, PathBuf};
 
+use specfx::hdl::cost::Target;
 use specfx::nset::NSet;
 use specfx::pipeline::{Config, Datapath};
 use specfx::scene::fit::{fit_search, floors, objective, ImageBudget, SceneJudge};
@@ -281,7 +282,16 @@ fn the_fitted_datapath_meets_its_budget_by_the_oracle_and_is_cheaper() {
         .unwrap();
     let fl = floors(&judge, base.config(), &budget, 20);
     assert_eq!(fl.len(), 14);
-    let found = fit_search(&judge, base.config(), &budget, &fl, 20, &|_| {}).unwrap();
+    let found = fit_search(
+        &judge,
+        base.config(),
+        &budget,
+        &fl,
+        20,
+        Target::Ice40,
+        &|_| {},
+    )
+    .unwrap();
     let best = found.best.expect("the budget is met");
     let fitted = Datapath::new(best.config.clone()).unwrap();
     let reference = oracle_image(&frags, &oracle_cos_n(&scene));
@@ -296,8 +306,8 @@ fn the_fitted_datapath_meets_its_budget_by_the_oracle_and_is_cheaper() {
     };
     assert!(meets(&fitted), "{}", best.config.to_toml());
     let generic = Datapath::new(Config::baseline()).unwrap();
-    assert!(objective(&fitted) < objective(&generic));
-    assert_eq!(best.cost, objective(&fitted) as f64);
+    assert!(objective(&fitted, Target::Ice40) < objective(&generic, Target::Ice40));
+    assert_eq!(best.cost, objective(&fitted, Target::Ice40) as f64);
     // Only the scene's exponents are served.
     assert_eq!(best.config.n.values(), &[32, 512]);
     let t_line = found
@@ -324,7 +334,16 @@ fn an_impossible_budget_has_no_fit_and_the_floors_say_why() {
     let judge = SceneJudge::new(&scene, &frags, base.config().coef.form);
     let budget: ImageBudget = "max_lsb <= 0 and differing <= 0".parse().unwrap();
     let fl = floors(&judge, base.config(), &budget, 20);
-    let found = fit_search(&judge, base.config(), &budget, &fl, 20, &|_| {}).unwrap();
+    let found = fit_search(
+        &judge,
+        base.config(),
+        &budget,
+        &fl,
+        20,
+        Target::Ice40,
+        &|_| {},
+    )
+    .unwrap();
     // cs_m differs from cos^n visibly somewhere for every algorithm at n = 512 unless the
     // image hides it; whatever the floors say, the answer must agree with them.
     if fl.iter().all(|f| !f.meets) {

@@ -447,16 +447,11 @@ pub fn fit_space(k: u32, variant: Variant, start_frac: i32) -> Space {
     }
 }
 
-/// The search's objective: the generic analytic LUTs of the pipelined datapath (multipliers
-/// as logic) plus its constant ROM's.
-pub fn objective(dp: &Datapath) -> u64 {
-    crate::hdl::cost::analytic_cost(
-        dp,
-        crate::cycle::Arch::Pipelined,
-        crate::hdl::cost::Target::Generic,
-    )
-    .luts
-        + crate::hdl::rom::constant_rom(dp, crate::hdl::cost::Target::Generic).luts
+/// The search's objective: the analytic LUTs of the pipelined datapath on `target` plus its
+/// constant ROM's (the figures `fit` reports).
+pub fn objective(dp: &Datapath, target: crate::hdl::cost::Target) -> u64 {
+    crate::hdl::cost::analytic_cost(dp, crate::cycle::Arch::Pipelined, target).luts
+        + crate::hdl::rom::constant_rom(dp, target).luts
 }
 
 /// What the fit's search found.
@@ -486,6 +481,7 @@ pub fn fit_search(
     budget: &ImageBudget,
     floors: &[Floor],
     start_frac: i32,
+    target: crate::hdl::cost::Target,
     progress: &(dyn Fn(&str) + Sync),
 ) -> Result<FitSearch, Error> {
     use rayon::prelude::*;
@@ -496,7 +492,8 @@ pub fn fit_search(
         .map(|f| {
             let name = format!("k = {}, {}", f.k, f.variant.name());
             let space = fit_space(f.k, f.variant, start_frac);
-            let mut cost = |dp: &Datapath| -> Result<f64, Error> { Ok(objective(dp) as f64) };
+            let mut cost =
+                |dp: &Datapath| -> Result<f64, Error> { Ok(objective(dp, target) as f64) };
             let mut lines = |line: &str| progress(&format!("{name}: {line}"));
             let run = |b: &ImageBudget,
                        cost: &mut dyn FnMut(&Datapath) -> Result<f64, Error>,
@@ -553,7 +550,7 @@ pub fn fit_search(
     let dp = Datapath::new(base.clone())?;
     let v = judge.verdict(&judge.datapath_image(&dp), budget);
     out.n_evaluations += 1;
-    let cost = objective(&dp) as f64;
+    let cost = objective(&dp, target) as f64;
     if v.feasible && out.best.as_ref().is_none_or(|b| cost < b.cost) {
         out.minimality = vec![
             "the base datapath restricted to the scene's exponents: no searched point was cheaper"
