@@ -20,6 +20,9 @@ struct Slow {
     quant: f64,
     approx: f64,
     total: f64,
+    norm_abs: f64,
+    norm_rel: f64,
+    norm_approx_rel: f64,
     n_cut: u64,
     n_violations: u64,
     count: u64,
@@ -45,6 +48,9 @@ fn slow_check(dp: &Datapath) -> Slow {
         quant: -1.0,
         approx: -1.0,
         total: -1.0,
+        norm_abs: -1.0,
+        norm_rel: -1.0,
+        norm_approx_rel: -1.0,
         n_cut: 0,
         n_violations: 0,
         count: 0,
@@ -97,6 +103,16 @@ fn slow_check(dp: &Datapath) -> Slow {
             s.quant = s.quant.max((fixed_lobe - r[last_sq]).abs());
             s.approx = s.approx.max((r[last_sq] - cos_n).abs());
             s.total = s.total.max((fixed_lobe - cos_n).abs());
+            // The normalised output against exact normalised cos^n: Phong's cos^n
+            // coefficient (n + 1) / (2 pi), by hand.
+            let peak = (f64::from(nc.n) + 1.0) / (2.0 * std::f64::consts::PI);
+            let out_value = p.values[dp.stage_out()] as f64 * lsb[dp.stage_out()];
+            let e = (out_value - peak * cos_n).abs();
+            s.norm_abs = s.norm_abs.max(e);
+            s.norm_rel = s.norm_rel.max(e / peak);
+            s.norm_approx_rel = s
+                .norm_approx_rel
+                .max((r[dp.stage_out()] - peak * cos_n).abs() / peak);
             s.n_cut += u64::from(p.cut);
             let out = p.values[dp.stage_out()];
             if prev_out.is_some_and(|prev| out < prev) {
@@ -111,6 +127,7 @@ fn slow_check(dp: &Datapath) -> Slow {
 
 fn compare(toml: &str) {
     let mut cfg = Config::from_toml(toml).unwrap();
+    assert_eq!(cfg.coef.form, specfx::reference::normalisation::Form::Phong);
     cfg.n = "16,17,40,100,333,1000,1024".parse().unwrap();
     let dp = Datapath::new(cfg).unwrap();
     let fast = check(&dp).unwrap();
@@ -160,6 +177,15 @@ fn compare(toml: &str) {
     assert!(
         (fast.shape_total_max_abs - slow.total).abs() <= 1e-15,
         "{toml} total"
+    );
+    assert_eq!(fast.norm_total_max_abs, slow.norm_abs, "{toml} norm");
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1e-300);
+    assert!(close(fast.norm_total_rel, slow.norm_rel), "{toml} norm rel");
+    assert!(
+        close(fast.norm_approx_rel, slow.norm_approx_rel),
+        "{toml} norm approx {} vs {}",
+        fast.norm_approx_rel,
+        slow.norm_approx_rel
     );
     assert_eq!(fast.n_cut, slow.n_cut, "{toml} cut");
     assert_eq!(

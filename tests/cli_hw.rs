@@ -106,7 +106,13 @@ fn cost_runs_yosys_and_the_analytic_model() {
     assert!(v["yosys_version"].as_str().unwrap().starts_with("Yosys"));
     assert!(v["yosys_script"].as_str().unwrap().contains("synth_ice40"));
     // Six multipliers: d x n, four squares, the output product.
-    assert_eq!(v["analytic"]["multipliers"].as_array().unwrap().len(), 6);
+    assert_eq!(
+        v["analytic"]["features"]["multipliers"]
+            .as_array()
+            .unwrap()
+            .len(),
+        6
+    );
     // The pipeline keeps at least every stage's value in registers: 8 stages, >= 8 * 16 bits.
     assert!(v["ffs"].as_u64().unwrap() >= 128);
     let v = json(&specfx(&[
@@ -117,7 +123,18 @@ fn cost_runs_yosys_and_the_analytic_model() {
         "--json",
     ]));
     assert!(v["yosys"].is_null());
-    assert_eq!(v["analytic"]["multipliers"].as_array().unwrap().len(), 1);
+    assert_eq!(
+        v["analytic"]["features"]["multipliers"]
+            .as_array()
+            .unwrap()
+            .len(),
+        1
+    );
+    // Figures named with target and unit, and checked against the device.
+    assert_eq!(v["analytic"]["target"], "ice40");
+    assert_eq!(v["analytic"]["logic_unit"], "LUTs");
+    assert_eq!(v["device"], "up5k");
+    assert_eq!(v["over_limit"].as_array().unwrap().len(), 0);
     // The fast generic mapping: gates and a transistor estimate, through abc -fast.
     let v = json(&specfx(&["cost", "--target", "generic-fast", "--json"]));
     assert!(v["yosys_script"]
@@ -125,4 +142,32 @@ fn cost_runs_yosys_and_the_analytic_model() {
         .unwrap()
         .contains("abc -fast -g cmos2"));
     assert!(v["yosys"]["transistors"].as_u64().unwrap() > 1000);
+}
+
+/// Seven squarings of 24 x 24 bits need four SB_MAC16 each on iCE40 (16 x 16 blocks: two
+/// slices per operand): far more than the UP5K's eight DSP blocks, which `cost` flags.
+#[test]
+fn cost_flags_what_exceeds_the_device() {
+    let dir = std::env::temp_dir().join(format!("specfx-hw-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = dir.join("wide.toml");
+    std::fs::write(
+        &cfg,
+        "k = 7\n[b]\nformat = \"u1.23\"\n[square]\nformat = \"u1.23\"\n",
+    )
+    .unwrap();
+    let v = json(&specfx(&[
+        "cost",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--analytic-only",
+        "--json",
+    ]));
+    let dsps = v["analytic"]["dsps"].as_u64().unwrap();
+    assert!(dsps >= 7 * 4, "{dsps}");
+    let flags = v["over_limit"].as_array().unwrap();
+    assert!(
+        flags.iter().any(|f| f.as_str().unwrap().contains("DSP")),
+        "{flags:?}"
+    );
 }

@@ -282,7 +282,7 @@ fn cost_ceilings_bound_the_answer() {
         "--n",
         "64",
         "--budget",
-        "shape_total <= 1 lsb8 and luts <= 1500 on generic",
+        "shape_total <= 1 lsb8 and luts <= 100",
         "--out",
         out.to_str().unwrap(),
     ]);
@@ -292,12 +292,13 @@ fn cost_ceilings_bound_the_answer() {
         "--config",
         out.to_str().unwrap(),
         "--target",
-        "generic",
+        "ice40",
         "--analytic-only",
         "--json",
     ]);
     let v: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
-    assert!(v["analytic"]["luts"].as_u64().unwrap() <= 1500, "{v}");
+    // A ceiling without `on` is on ice40, the target `cost` prices by default.
+    assert!(v["analytic"]["luts"].as_u64().unwrap() <= 100, "{v}");
 
     for bad in ["shape_total <= 1 lsb8 on ice40", "dsps <= 8 on fpga"] {
         let o = specfx(&["optimize", "--budget", bad, "--out", "/tmp/x.toml"]);
@@ -307,4 +308,47 @@ fn cost_ceilings_bound_the_answer() {
             "{bad}"
         );
     }
+}
+
+/// Budgets on the normalised output against exact normalised cos^n: the answer the optimiser
+/// proves is confirmed by `specfx check`, and an impossible number of effective bits is
+/// refused by every algorithm's f64 floor.
+#[test]
+fn effective_bits_budget_of_the_normalised_output() {
+    let out = temp("effective.toml");
+    let o = specfx(&[
+        "optimize",
+        "--n",
+        "64",
+        "--budget",
+        "effective_bits >= 6",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let c = specfx(&["check", "--config", out.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+    let rel = v["norm_total_rel"].as_f64().unwrap();
+    assert!(-rel.log2() >= 6.0, "{rel}");
+
+    // Baseline's normalised output at n = 1024, c = 1: its exact cs16 coefficient
+    // (m + 1)/m n/(2 pi) = 17 n/(32 pi) against cos^n's (n + 1)/(2 pi): relative error
+    // (17 n/16 - n - 1)/(n + 1), the algorithm's own floor (no width removes it).
+    let c = specfx(&["check", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+    let n = 1024.0;
+    let floor = (17.0 * n / 16.0 - n - 1.0) / (n + 1.0);
+    let got = v["norm_approx_rel"].as_f64().unwrap();
+    assert!((got - floor).abs() < 1e-9, "{got} vs {floor}");
+
+    let o = specfx(&[
+        "optimize",
+        "--budget",
+        "effective_bits >= 30",
+        "--out",
+        temp("never-bits.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("beyond the budget"), "{stdout}");
 }

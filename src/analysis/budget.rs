@@ -430,6 +430,10 @@ pub struct Headroom {
     pub int_bits_needed: i32,
     /// `int_bits - int_bits_needed`: integer bits that were never used (0 when saturating).
     pub spare_int_bits: i32,
+    /// Fraction bits that carry only noise: floor(log2) of the stage's worst error in its own
+    /// LSBs (vs the same algorithm in f64), at most its fraction bits; `None` when the stage
+    /// overflowed, whose error then says nothing about rounding noise.
+    pub wasted_frac_bits: Option<i32>,
     /// Quantizations that wrapped.
     pub wrapped: u64,
     /// Quantizations that saturated.
@@ -935,6 +939,13 @@ pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, E
                 int_bits: f.int_bits(),
                 int_bits_needed: needed,
                 spare_int_bits: f.int_bits() - needed,
+                wasted_frac_bits: (s.wrapped + s.saturated + s.zeroed == 0).then(|| {
+                    if s.max_ulp >= 2.0 {
+                        (s.max_ulp.log2().floor() as i32).min(f.frac_bits().max(0))
+                    } else {
+                        0
+                    }
+                }),
                 wrapped: s.wrapped,
                 saturated: s.saturated,
                 zeroed: s.zeroed,

@@ -115,8 +115,9 @@ pub struct Budget {
 impl FromStr for Budget {
     type Err = Error;
     /// Parses `shape_total <= 1 lsb8`, `shape_quant <= 0.5 lsb8`, `out <= 1 ulp`,
-    /// `correct >= 99%` (or `0.99`), and cost ceilings `luts <= 800 on ice40`, `dsps <= 8 on
-    /// ice40`, `ffs <= 400 on xilinx` (analytic; target generic when `on` is left out),
+    /// `correct >= 99%` (or `0.99`), the normalised output against exact normalised cos^n
+    /// `out_total <= 4 ulp`, `out_rel <= 1%`, `effective_bits >= 8`, and cost ceilings `luts <= 800 on ice40`, `dsps <= 8 on
+    /// ice40`, `ffs <= 400 on xilinx` (analytic; target ice40 when `on` is left out),
     /// several joined by `,` or `and`. `lsbN` is 2^-N.
     fn from_str(s: &str) -> Result<Self, Error> {
         let bad = |part: &str, why: &str| {
@@ -143,7 +144,7 @@ impl FromStr for Budget {
                         .parse::<Target>()
                         .map_err(|e| bad(part, &e.to_string()))?,
                 ),
-                None => (rhs, Target::Generic),
+                None => (rhs, Target::Ice40),
             };
             let metric = match lhs.trim() {
                 "luts" => Metric::Luts(target),

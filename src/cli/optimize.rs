@@ -142,15 +142,23 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     let Some(best) = &r.best else {
         println!("no configuration in the space meets the budget");
         println!("the f64 floor of each algorithm (its own error against cos^n before any quantization):");
+        let normalised = r.budget.bounds.iter().any(|b| b.metric.is_normalised());
         for f in &r.floors {
             let a = f.algorithm;
             match (f.shape_total, &f.reason) {
                 (Some(x), _) => println!(
-                    "  k = {} {:<8} shape_total floor {:.3e} ({:.2} lsb8){}",
+                    "  k = {} {:<8} shape_total floor {:.3e} ({:.2} lsb8){}{}",
                     a.k,
                     a.variant.name(),
                     x,
-                    x * 256.0,
+                    x / specfx::analysis::LSB8,
+                    match f.norm_rel {
+                        Some(r) if normalised => format!(
+                            ", out_rel floor {r:.3e} ({:.1} effective bits)",
+                            specfx::analysis::check::effective_bits(r)
+                        ),
+                        _ => String::new(),
+                    },
                     if f.reachable {
                         ""
                     } else {

@@ -120,11 +120,11 @@ fn write_index(
         a.total.max_abs, a.total.max_ulp,
         if budget.formal.is_empty() { budget.formal_note.clone().unwrap_or_default() } else { format!("gappa proves bounds for {} exponents, at most {formal:.2} times the exhaustive maximum.", budget.formal.len()) })?;
     if !costs.is_empty() {
-        writeln!(w, "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><div class=\"table\"><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>latency (cycles)</th><th>initiation interval</th><th>ROM LUTs (yosys)</th></tr>")?;
+        writeln!(w, "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><div class=\"table\"><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>latency (cycles)</th><th>initiation interval</th><th>ROM LUTs (yosys)</th><th>Fmax on UP5K (nextpnr)</th><th>latency (ns)</th><th>throughput (Msamples/s)</th></tr>")?;
         for c in costs {
             writeln!(
                 w,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 c.arch,
                 c.luts.unwrap_or(0),
                 c.analytic.luts,
@@ -132,10 +132,31 @@ fn write_index(
                 c.ffs.unwrap_or(0),
                 c.analytic.latency,
                 c.analytic.initiation_interval,
-                c.rom_yosys.as_ref().map_or(0, |r| r.luts)
+                c.rom_yosys.as_ref().map_or(0, |r| r.luts),
+                c.timing
+                    .as_ref()
+                    .and_then(|t| t.fmax_mhz.map(|f| format!(
+                        "{}{f:.1} MHz",
+                        if t.fmax_is_upper_bound { "&le; " } else { "" }
+                    )))
+                    .unwrap_or_else(|| "-".into()),
+                c.timing
+                    .as_ref()
+                    .and_then(|t| t.latency_ns)
+                    .map_or("-".into(), |l| format!("{l:.0}")),
+                c.timing
+                    .as_ref()
+                    .and_then(|t| t.throughput_samples_per_s)
+                    .map_or("-".into(), |x| format!("{:.1}", x / 1e6)),
             )?;
         }
         writeln!(w, "</table></div>")?;
+        if costs.iter().any(|c| c.timing.is_some()) {
+            writeln!(w, "<p>Fmax is register to register inside a serial harness, placed and routed by nextpnr on an iCE40 UP5K; it is an upper bound because nextpnr does not time the delay through the SB_MAC16 DSP blocks (<code>specfx timing</code>, <code>hdl_ref/README.md</code>). The analytic figures are the calibrated model's (<code>docs/cost.md</code>).</p>")?;
+        }
+        for flag in costs.iter().flat_map(|c| &c.over_limit) {
+            writeln!(w, "<p><b>Exceeds the UP5K:</b> {flag}</p>")?;
+        }
     }
     writeln!(w, "<h2>The cycle model</h2><p>20,000 cycles of each microarchitecture under seeded bubbles and stalls, every output checked against the functional model (<a href=\"sim_baseline.json\">sim_baseline.json</a>; a VCD of the first 300 cycles: <a href=\"sim_baseline_pipelined.vcd\">sim_baseline_pipelined.vcd</a>).</p><div class=\"table\"><table><tr><th>architecture</th><th>outputs</th><th>results per cycle</th><th>latency (nominal)</th><th>latency seen</th><th>mismatches</th></tr>")?;
     for st in sims {
@@ -287,14 +308,32 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     if yosys_present {
         step("synthesising baseline with yosys (ice40, both architectures)");
         let hdl = super::cost::hdl_ref_dir(None);
+        let nextpnr_present = std::process::Command::new("nextpnr-ice40")
+            .arg("--version")
+            .output()
+            .is_ok_and(|o| o.status.success());
         for arch in specfx::cycle::Arch::ALL {
-            costs.push(super::cost::cost_report(
-                &dp,
-                arch,
-                specfx::hdl::cost::Target::Ice40,
-                &hdl,
-                false,
-            )?);
+            let mut c =
+                super::cost::cost_report(&dp, arch, specfx::hdl::cost::Target::Ice40, &hdl, false)?;
+            c.device = Some(specfx::hdl::pnr::Device::Up5k);
+            c.over_limit = specfx::hdl::pnr::device_check(
+                c.dsps.unwrap_or(0),
+                c.luts.unwrap_or(0),
+                c.ffs.unwrap_or(0),
+                specfx::hdl::pnr::Device::Up5k,
+            );
+            if nextpnr_present {
+                step(&format!(
+                    "placing and routing baseline ({arch}) on an iCE40 UP5K with nextpnr"
+                ));
+                c.timing = Some(super::pnr::run_timing(
+                    &dp,
+                    arch,
+                    specfx::hdl::pnr::Device::Up5k,
+                    &hdl,
+                )?);
+            }
+            costs.push(c);
         }
         written.push(emit(dir, "cost_baseline.txt", |b| {
             for c in &costs {

@@ -378,7 +378,7 @@ pub fn document(r: &BudgetReport) -> Vec<Block> {
 
     doc.push(Block::Heading(2, "Headroom and overflow".into()));
     doc.push(Block::Paragraph(
-        "The range each stage's values took against its format's range. Spare integer bits could be removed without changing any result; a stage that saturates or wraps has none."
+        "The range each stage's values took against its format's range. Spare integer bits could be removed without changing any result; a stage that saturates or wraps has none. Noise fraction bits are the low fraction bits below the stage's worst error against the same algorithm in f64 (floor of log2 of its max error in its own LSBs): they carry only the rounding noise of the stages before, so narrowing them costs little accuracy (not measured where the stage overflowed)."
             .into(),
     ));
     doc.push(Block::Table {
@@ -391,6 +391,7 @@ pub fn document(r: &BudgetReport) -> Vec<Block> {
             s("int bits"),
             s("needed"),
             s("spare"),
+            s("noise frac bits"),
             s("wrapped"),
             s("saturated"),
             s("zeroed"),
@@ -408,6 +409,8 @@ pub fn document(r: &BudgetReport) -> Vec<Block> {
                     h.int_bits.to_string(),
                     h.int_bits_needed.to_string(),
                     h.spare_int_bits.to_string(),
+                    h.wasted_frac_bits
+                        .map_or("- (overflowed)".to_string(), |b| b.to_string()),
                     h.wrapped.to_string(),
                     h.saturated.to_string(),
                     h.zeroed.to_string(),

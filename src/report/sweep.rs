@@ -49,17 +49,45 @@ pub fn chart(points: &[PointResult], target: Target) -> Chart {
             Series::styled(&label, pts, false, i + 1)
         })
         .collect();
-    let mut front: Vec<(f64, f64)> = points.iter().filter(|p| p.pareto).filter_map(xy).collect();
-    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // The front is over logic cells, DSP blocks and error: drawn as a line through the points
+    // that also lead in logic cells and error alone, the others (fewer DSPs) as crosses.
+    let front: Vec<(f64, f64)> = points.iter().filter(|p| p.pareto).filter_map(xy).collect();
+    let mut line: Vec<(f64, f64)> = front
+        .iter()
+        .copied()
+        .filter(|&(x, y)| {
+            !front
+                .iter()
+                .any(|&(x2, y2)| x2 <= x && y2 <= y && (x2 < x || y2 < y))
+        })
+        .collect();
+    line.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
+    line.dedup();
+    let by_dsps: Vec<(f64, f64)> = front
+        .iter()
+        .copied()
+        .filter(|p| !line.contains(p))
+        .collect();
     series.push(Series {
-        label: format!("Pareto front ({} points)", front.len()),
-        points: front,
+        label: format!("Pareto front in {} and error", target.logic_unit()),
+        points: line,
         line: true,
         color: (0, 0, 0),
         dash: Dash::default(),
         marker: Marker::None,
         ..Series::default()
     });
+    if !by_dsps.is_empty() {
+        series.push(Series {
+            label: format!("on the front by fewer DSPs ({} points)", by_dsps.len()),
+            points: by_dsps,
+            line: false,
+            color: (0, 0, 0),
+            dash: Dash::default(),
+            marker: Marker::Cross,
+            ..Series::default()
+        });
+    }
     Chart {
         title: format!(
             "Sweep: lobe error against cos^n versus analytic cost on {}",
