@@ -120,33 +120,36 @@ fn write_index(
         a.total.max_abs, a.total.max_ulp,
         if budget.formal.is_empty() { budget.formal_note.clone().unwrap_or_default() } else { format!("gappa proves bounds for {} exponents, at most {formal:.2} times the exhaustive maximum.", budget.formal.len()) })?;
     if !costs.is_empty() {
-        writeln!(w, "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><div class=\"table\"><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>latency (cycles)</th><th>initiation interval</th><th>ROM LUTs (yosys)</th><th>Fmax on UP5K (nextpnr)</th><th>latency (ns)</th><th>throughput (Msamples/s)</th></tr>")?;
+        writeln!(w, "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the calibrated analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><div class=\"table\"><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>ROM LUTs (yosys)</th></tr>")?;
         for c in costs {
             writeln!(
                 w,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 c.arch,
                 c.luts.unwrap_or(0),
                 c.analytic.luts,
                 c.dsps.unwrap_or(0),
                 c.ffs.unwrap_or(0),
+                c.rom_yosys.as_ref().map_or(0, |r| r.luts),
+            )?;
+        }
+        writeln!(w, "</table></div><div class=\"table\"><table><tr><th>architecture</th><th>latency (cycles)</th><th>initiation interval</th><th>Fmax on UP5K (nextpnr)</th><th>latency (ns)</th><th>throughput (Msamples/s)</th></tr>")?;
+        for c in costs {
+            let t = c.timing.as_ref();
+            writeln!(
+                w,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                c.arch,
                 c.analytic.latency,
                 c.analytic.initiation_interval,
-                c.rom_yosys.as_ref().map_or(0, |r| r.luts),
-                c.timing
-                    .as_ref()
-                    .and_then(|t| t.fmax_mhz.map(|f| format!(
-                        "{}{f:.1} MHz",
-                        if t.fmax_is_upper_bound { "&le; " } else { "" }
-                    )))
-                    .unwrap_or_else(|| "-".into()),
-                c.timing
-                    .as_ref()
-                    .and_then(|t| t.latency_ns)
+                t.and_then(|t| t.fmax_mhz.map(|f| format!(
+                    "{}{f:.1} MHz",
+                    if t.fmax_is_upper_bound { "&le; " } else { "" }
+                )))
+                .unwrap_or_else(|| "-".into()),
+                t.and_then(|t| t.latency_ns)
                     .map_or("-".into(), |l| format!("{l:.0}")),
-                c.timing
-                    .as_ref()
-                    .and_then(|t| t.throughput_samples_per_s)
+                t.and_then(|t| t.throughput_samples_per_s)
                     .map_or("-".into(), |x| format!("{:.1}", x / 1e6)),
             )?;
         }
