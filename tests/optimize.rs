@@ -352,3 +352,59 @@ fn effective_bits_budget_of_the_normalised_output() {
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(stdout.contains("beyond the budget"), "{stdout}");
 }
+
+/// yosys ceilings: the answer's own synthesis meets `yosys_luts`, which `specfx cost` (yosys)
+/// confirms; a DSP ceiling below one DSP per product is refused with yosys's count; `budget`
+/// leaves yosys ceilings to `optimize`.
+#[test]
+fn yosys_ceilings_are_measured_by_synthesis() {
+    let out = temp("yosys.toml");
+    let o = specfx(&[
+        "optimize",
+        "--n",
+        "64",
+        "--budget",
+        "shape_total <= 1 lsb8 and yosys_luts <= 100 on ice40",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let c = specfx(&["cost", "--config", out.to_str().unwrap(), "--json"]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+    assert!(v["luts"].as_u64().unwrap() <= 100, "{v}");
+
+    let o = specfx(&[
+        "optimize",
+        "--n",
+        "64",
+        "--k",
+        "5",
+        "--variants",
+        "minimax",
+        "--budget",
+        "shape_total <= 1 lsb8 and yosys_dsps <= 6 on ice40",
+        "--out",
+        temp("never-yosys.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    // k = 5 minimax: seven products, at least one SB_MAC16 each.
+    let dsps: f64 = stdout
+        .split("its yosys_dsps on ice40: ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(dsps >= 7.0, "{stdout}");
+
+    let o = specfx(&[
+        "budget",
+        "--budget",
+        "yosys_luts <= 100 on ice40",
+        "--out",
+        temp("never-budget").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("yosys ceiling"));
+}

@@ -52,7 +52,18 @@ pub enum Metric {
     Dsps(Target),
     /// Analytic register bits on a target (`ffs <= 400 on ice40`).
     Ffs(Target),
+    /// yosys's LUTs (gates for generic) on a target (`yosys_luts <= 800 on ice40`).
+    YosysLuts(Target),
+    /// yosys's DSP blocks on a target (`yosys_dsps <= 8 on ice40`).
+    YosysDsps(Target),
+    /// yosys's flip-flops on a target (`yosys_ffs <= 400 on ice40`).
+    YosysFfs(Target),
 }
+
+/// Synthesises a datapath on a target and returns yosys's figures: the command supplies it
+/// (the library starts no process) for budgets with yosys ceilings.
+pub type Synthesise<'a> =
+    &'a (dyn Fn(&Datapath, Arch, Target) -> Result<crate::hdl::cost::CostFigures, Error> + Sync);
 
 impl fmt::Display for Metric {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -67,6 +78,9 @@ impl fmt::Display for Metric {
             Metric::Luts(t) => write!(f, "luts on {}", t.name()),
             Metric::Dsps(t) => write!(f, "dsps on {}", t.name()),
             Metric::Ffs(t) => write!(f, "ffs on {}", t.name()),
+            Metric::YosysLuts(t) => write!(f, "yosys_luts on {}", t.name()),
+            Metric::YosysDsps(t) => write!(f, "yosys_dsps on {}", t.name()),
+            Metric::YosysFfs(t) => write!(f, "yosys_ffs on {}", t.name()),
         }
     }
 }
@@ -74,7 +88,15 @@ impl fmt::Display for Metric {
 impl Metric {
     /// Whether the metric is a cost ceiling (evaluated from the formats, no check needed).
     pub fn is_cost(self) -> bool {
-        matches!(self, Metric::Luts(_) | Metric::Dsps(_) | Metric::Ffs(_))
+        matches!(self, Metric::Luts(_) | Metric::Dsps(_) | Metric::Ffs(_)) || self.is_yosys()
+    }
+
+    /// Whether the metric is a yosys ceiling (measured by synthesis, not the model).
+    pub fn is_yosys(self) -> bool {
+        matches!(
+            self,
+            Metric::YosysLuts(_) | Metric::YosysDsps(_) | Metric::YosysFfs(_)
+        )
     }
 
     /// Whether the bound is a floor (`>=`: `correct`, `effective_bits`) rather than a ceiling.
@@ -150,6 +172,9 @@ impl FromStr for Budget {
                 "luts" => Metric::Luts(target),
                 "dsps" => Metric::Dsps(target),
                 "ffs" => Metric::Ffs(target),
+                "yosys_luts" => Metric::YosysLuts(target),
+                "yosys_dsps" => Metric::YosysDsps(target),
+                "yosys_ffs" => Metric::YosysFfs(target),
                 "shape_total" => Metric::ShapeTotal,
                 "shape_quant" => Metric::ShapeQuant,
                 "out" => Metric::Out,
@@ -160,7 +185,10 @@ impl FromStr for Budget {
                 other => return Err(bad(part, &format!("unknown metric '{other}'"))),
             };
             if on.is_some() && !metric.is_cost() {
-                return Err(bad(part, "only luts, dsps and ffs take 'on TARGET'"));
+                return Err(bad(
+                    part,
+                    "only luts, dsps, ffs and their yosys_ forms take 'on TARGET'",
+                ));
             }
             let want_op = if metric.is_floor() { ">=" } else { "<=" };
             if op != want_op {
@@ -213,7 +241,9 @@ impl fmt::Display for Budget {
 }
 
 /// The value of a metric: from a check's output figures, or for a cost ceiling the analytic
-/// cost of the datapath on `arch` and the metric's target.
+/// cost of the datapath on `arch` and the metric's target. A yosys ceiling is measured by
+/// synthesis ([`Budget::cost_verdict`] with a [`Synthesise`]): here it is NaN, which meets no
+/// bound.
 pub fn metric_value(r: &OutputFigures, dp: &Datapath, arch: Arch, metric: Metric) -> f64 {
     match metric {
         Metric::ShapeTotal => r.shape_total_max_abs,
@@ -224,6 +254,7 @@ pub fn metric_value(r: &OutputFigures, dp: &Datapath, arch: Arch, metric: Metric
         Metric::OutRel => r.norm_total_rel,
         Metric::EffectiveBits => r.effective_bits(),
         Metric::Luts(_) | Metric::Dsps(_) | Metric::Ffs(_) => cost_value(dp, arch, metric),
+        Metric::YosysLuts(_) | Metric::YosysDsps(_) | Metric::YosysFfs(_) => f64::NAN,
     }
 }
 
@@ -257,18 +288,21 @@ impl Budget {
         }
     }
 
-    /// Whether a datapath and its check meet every bound.
+    /// Whether a datapath and its check meet every bound but the yosys ceilings (which
+    /// [`Budget::cost_verdict`] measures by synthesis).
     pub fn met_by(&self, r: &OutputFigures, dp: &Datapath) -> bool {
         self.bounds
             .iter()
+            .filter(|b| !b.metric.is_yosys())
             .all(|b| Self::holds(b, metric_value(r, dp, self.arch, b.metric)))
     }
 
-    /// How far a datapath and its check are from the budget: the largest ratio; at most 1 when
-    /// met.
+    /// How far a datapath and its check are from the budget (yosys ceilings aside): the
+    /// largest ratio; at most 1 when met.
     pub fn excess(&self, r: &OutputFigures, dp: &Datapath) -> f64 {
         self.bounds
             .iter()
+            .filter(|b| !b.metric.is_yosys())
             .map(|b| Self::ratio(b, metric_value(r, dp, self.arch, b.metric)))
             .fold(0.0, f64::max)
     }
@@ -287,21 +321,45 @@ impl Budget {
         }
     }
 
-    /// The cost ceilings alone: whether they hold, and their largest ratio (no check needed).
-    pub fn cost_verdict(&self, dp: &Datapath) -> Verdict {
-        let costs: Vec<(&Bound, f64)> = self
-            .bounds
-            .iter()
-            .filter(|b| b.metric.is_cost())
-            .map(|b| (b, cost_value(dp, self.arch, b.metric)))
-            .collect();
-        Verdict {
+    /// The cost ceilings alone: whether they hold, and their largest ratio (no check needed);
+    /// yosys ceilings are measured with `synth` (one synthesis per target), and are an error
+    /// without it.
+    pub fn cost_verdict(&self, dp: &Datapath, synth: Option<Synthesise>) -> Result<Verdict, Error> {
+        let mut synthesised: Vec<(Target, crate::hdl::cost::CostFigures)> = Vec::new();
+        let mut costs: Vec<(&Bound, f64)> = Vec::new();
+        for b in self.bounds.iter().filter(|b| b.metric.is_cost()) {
+            let v = match b.metric {
+                Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t) => {
+                    let synth = synth.ok_or_else(|| Error::Tool {
+                        tool: "yosys",
+                        message: format!("the budget's {} needs synthesis", b.metric),
+                    })?;
+                    let figures = match synthesised.iter().find(|(x, _)| *x == t) {
+                        Some((_, f)) => *f,
+                        None => {
+                            let f = synth(dp, self.arch, t)?;
+                            synthesised.push((t, f));
+                            f
+                        }
+                    };
+                    let count = match b.metric {
+                        Metric::YosysLuts(_) => figures.luts,
+                        Metric::YosysDsps(_) => figures.dsps,
+                        _ => figures.ffs,
+                    };
+                    count as f64
+                }
+                m => cost_value(dp, self.arch, m),
+            };
+            costs.push((b, v));
+        }
+        Ok(Verdict {
             feasible: costs.iter().all(|&(b, v)| Self::holds(b, v)),
             excess: costs
                 .iter()
                 .map(|&(b, v)| Self::ratio(b, v))
                 .fold(0.0, f64::max),
-        }
+        })
     }
 }
 
@@ -957,6 +1015,7 @@ pub fn optimize_all(
     floors: Vec<AlgorithmFloor>,
     start_frac: i32,
     cost: &(dyn Fn(&Datapath) -> Result<f64, Error> + Sync),
+    synth: Option<Synthesise>,
     done: &(dyn Fn(Algorithm, &SearchResult) + Sync),
 ) -> Result<OptimizeAll, Error> {
     use rayon::prelude::*;
@@ -970,7 +1029,7 @@ pub fn optimize_all(
             let mut r = search(base, &space, &mut judge, &mut cost, &mut |_| {})?;
             // The cheapest point meeting the error bounds must meet the cost ceilings too.
             if let Some(b) = r.best.take() {
-                let v = budget.cost_verdict(&Datapath::new(b.config.clone())?);
+                let v = budget.cost_verdict(&Datapath::new(b.config.clone())?, synth)?;
                 if v.feasible {
                     r.best = Some(b);
                 } else {

@@ -215,6 +215,16 @@ pub fn budget(
 
 /// Runs `specfx budget`. Exit code 1 when the budget is not met.
 pub fn run(args: &BudgetArgs) -> Result<Outcome> {
+    if let Some(b) = args
+        .budget
+        .as_ref()
+        .and_then(|b| b.bounds.iter().find(|b| b.metric.is_yosys()))
+    {
+        return Err(anyhow!(
+            "--budget: {} is a yosys ceiling, judged by `specfx optimize` (use `specfx cost` for yosys's figures of one configuration)",
+            b.metric
+        ));
+    }
     let dp = super::datapath::load(&args.config, args.n.as_ref())?;
     let ns: Vec<u32> = dp.constants().iter().map(|c| c.n).collect();
     let gappa_n = match &args.gappa_n {

@@ -11,7 +11,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::output::write_atomic;
 use super::Outcome;
 use specfx::analysis::check::check;
-use specfx::analysis::optimize::{algorithm_floors, optimize_all, Algorithm, Budget, SearchResult};
+use specfx::analysis::optimize::{
+    algorithm_floors, optimize_all, Algorithm, Budget, Metric, SearchResult,
+};
 use specfx::cycle::Arch;
 use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;
@@ -130,8 +132,32 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             None => eprintln!("{line}"),
         }
     };
-    let r = optimize_all(&base, &budget, floors, args.start_frac, &cost, &done)
-        .map_err(anyhow::Error::msg)?;
+    let synth = |dp: &Datapath,
+                 arch: Arch,
+                 target: Target|
+     -> Result<specfx::hdl::cost::CostFigures, specfx::Error> {
+        super::cost::run_yosys(dp, arch, target, &hdl)
+            .map(|(c, _, _)| specfx::hdl::cost::CostFigures {
+                target,
+                luts: c.luts,
+                dsps: c.dsps,
+                ffs: c.ffs,
+            })
+            .map_err(|e| specfx::Error::Tool {
+                tool: "yosys",
+                message: format!("{e:#}"),
+            })
+    };
+    let r = optimize_all(
+        &base,
+        &budget,
+        floors,
+        args.start_frac,
+        &cost,
+        Some(&synth),
+        &done,
+    )
+    .map_err(anyhow::Error::msg)?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -201,17 +227,25 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                 c.excess
             );
             for b in r.budget.bounds.iter().filter(|b| b.metric.is_cost()) {
-                println!(
-                    "  its analytic {}: {} (limit {})",
-                    b.metric,
-                    specfx::analysis::optimize::metric_value(
+                let value = match b.metric {
+                    Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t) => {
+                        let f = synth(&dp, arch, t)?;
+                        let count = match b.metric {
+                            Metric::YosysLuts(_) => f.luts,
+                            Metric::YosysDsps(_) => f.dsps,
+                            _ => f.ffs,
+                        };
+                        count as f64
+                    }
+                    m => specfx::analysis::optimize::metric_value(
                         &chk.output_figures(),
                         &dp,
                         arch,
-                        b.metric
+                        m,
                     ),
-                    b.limit
-                );
+                };
+                let kind = if b.metric.is_yosys() { "" } else { "analytic " };
+                println!("  its {kind}{}: {value} (limit {})", b.metric, b.limit);
             }
         }
         return Ok(Outcome::CheckFailed);
@@ -221,8 +255,26 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     config.name = "optimized".into();
     let dp = Datapath::new(config.clone())?;
     let proof = check(&dp).map_err(anyhow::Error::msg)?;
-    if !r.budget.met_by(&proof.output_figures(), &dp) {
+    if !r.budget.met_by(&proof.output_figures(), &dp)
+        || !r.budget.cost_verdict(&dp, Some(&synth))?.feasible
+    {
         bail!("the configuration found does not meet the budget on re-check: this is a bug");
+    }
+    for b in r.budget.bounds.iter().filter(|b| b.metric.is_yosys()) {
+        let (Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t)) = b.metric else {
+            continue;
+        };
+        let f = synth(&dp, arch, t)?;
+        println!(
+            "yosys on {}: {} {}, {} DSPs, {} flip-flops (the budget's {} <= {})",
+            t.name(),
+            f.luts,
+            t.logic_unit(),
+            f.dsps,
+            f.ffs,
+            b.metric,
+            b.limit
+        );
     }
     let header = format!(
         "# specfx optimize: cheapest configuration found for the budget '{}'\n# cost {:.0} {unit} ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
