@@ -2,6 +2,9 @@
 //! the committed yosys records, the stated fit error is the error on them, and the DSP count
 //! (yosys's mul2dsp rules, not fitted) matches yosys on the records.
 
+mod common;
+
+use common::specfx;
 use specfx::hdl::calibrate::{calibration, fit, read_records, sample};
 use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::pipeline::Datapath;
@@ -101,5 +104,35 @@ fn dsp_count_follows_yosys() {
             "{target}: DSP count exact on {exact} of {}",
             recs.len()
         );
+    }
+}
+
+#[test]
+fn calibrate_with_its_defaults_refits_the_committed_records() {
+    // The committed sample is complete: the defaults synthesise nothing and print the fit,
+    // equal to the committed coefficients.
+    let o = specfx(&[
+        "calibrate",
+        "--data",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/data/calibration"),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let fits = v.as_array().unwrap();
+    assert_eq!(fits.len(), 3);
+    for f in fits {
+        let (a, b) = (
+            &f["fitted"]["coefficients"],
+            &f["committed"]["coefficients"],
+        );
+        for (x, y) in a["logic"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(b["logic"].as_array().unwrap())
+        {
+            assert!(close(x.as_f64().unwrap(), y.as_f64().unwrap()), "{f}");
+        }
     }
 }

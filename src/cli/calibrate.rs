@@ -27,9 +27,10 @@ pub struct CalibrateArgs {
         default_value = "ice40,xilinx,generic-fast"
     )]
     targets: Vec<Target>,
-    /// Number of sampled configurations per target.
-    #[arg(long, default_value_t = 240)]
-    count: u64,
+    /// Number of sampled configurations per target (default: the committed sample's, 240
+    /// for ice40 and 120 for the slower xilinx and generic-fast mappings).
+    #[arg(long)]
+    count: Option<u64>,
     /// Seed of the sample.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -87,7 +88,11 @@ fn collect(args: &CalibrateArgs, target: Target, hdl_ref: &Path) -> Result<()> {
         );
     }
     let have: std::collections::BTreeSet<u64> = records.iter().map(|r| r.index).collect();
-    let todo: Vec<u64> = (0..args.count).filter(|i| !have.contains(i)).collect();
+    let count = args.count.unwrap_or(match target {
+        Target::Ice40 => 240,
+        _ => 120,
+    });
+    let todo: Vec<u64> = (0..count).filter(|i| !have.contains(i)).collect();
     if todo.is_empty() && records.windows(2).all(|w| w[0].index < w[1].index) {
         return Ok(());
     }
