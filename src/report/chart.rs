@@ -33,6 +33,30 @@ pub const OKABE_ITO: [(u8, u8, u8); 8] = [
 /// white, comes last.
 const COLOR_ORDER: [usize; 8] = [0, 1, 2, 3, 5, 6, 7, 4];
 
+/// The points no other point beats in both x and y (lower is better in both), sorted by x,
+/// duplicates once: the line a Pareto front is drawn as.
+///
+/// # Examples
+/// ```
+/// use specfx::report::chart::front_2d;
+/// let pts = [(10.0, 0.5), (20.0, 0.2), (20.0, 0.3), (5.0, 0.9), (10.0, 0.5)];
+/// assert_eq!(front_2d(&pts), vec![(5.0, 0.9), (10.0, 0.5), (20.0, 0.2)]);
+/// ```
+pub fn front_2d(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut front: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|&(x, y)| {
+            !points
+                .iter()
+                .any(|&(x2, y2)| x2 <= x && y2 <= y && (x2 < x || y2 < y))
+        })
+        .collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
+    front.dedup();
+    front
+}
+
 /// The colour of series `i`: the Okabe-Ito palette, yellow last, repeating after eight.
 ///
 /// # Examples

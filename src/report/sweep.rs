@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use crate::analysis::sweep::PointResult;
 use crate::analysis::LSB8;
 use crate::hdl::cost::Target;
-use crate::report::chart::{Chart, Dash, Marker, RefLine, Series};
+use crate::report::chart::{front_2d, Chart, Dash, Marker, RefLine, Series};
 
 /// The value of `key` in a point's `key=value;..` axis values.
 fn axis<'a>(p: &'a PointResult, key: &str) -> Option<&'a str> {
@@ -52,17 +52,7 @@ pub fn chart(points: &[PointResult], target: Target) -> Chart {
     // The front is over logic cells, DSP blocks and error: drawn as a line through the points
     // that also lead in logic cells and error alone, the others (fewer DSPs) as crosses.
     let front: Vec<(f64, f64)> = points.iter().filter(|p| p.pareto).filter_map(xy).collect();
-    let mut line: Vec<(f64, f64)> = front
-        .iter()
-        .copied()
-        .filter(|&(x, y)| {
-            !front
-                .iter()
-                .any(|&(x2, y2)| x2 <= x && y2 <= y && (x2 < x || y2 < y))
-        })
-        .collect();
-    line.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
-    line.dedup();
+    let line = front_2d(&front);
     let by_dsps: Vec<(f64, f64)> = front
         .iter()
         .copied()

@@ -4,7 +4,7 @@
 use crate::analysis::tradeoff::MethodFigures;
 use crate::analysis::LSB8;
 use crate::hdl::cost::{CostFigures, Target};
-use crate::report::chart::{Chart, Dash, Marker, RefLine, Series};
+use crate::report::chart::{front_2d, Chart, Dash, Marker, RefLine, Series};
 
 /// A hardware cost axis of the trade-off.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -66,16 +66,7 @@ pub fn cost_chart(figures: &[MethodFigures], axis: CostAxis) -> Chart {
                 .map(|x| (f.method.as_str(), x, f.max_abs_err / LSB8))
         })
         .collect();
-    let mut front: Vec<(f64, f64)> = pts
-        .iter()
-        .filter(|&&(_, x, y)| {
-            !pts.iter()
-                .any(|&(_, x2, y2)| x2 <= x && y2 <= y && (x2 < x || y2 < y))
-        })
-        .map(|&(_, x, y)| (x, y))
-        .collect();
-    front.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
-    front.dedup();
+    let front = front_2d(&pts.iter().map(|&(_, x, y)| (x, y)).collect::<Vec<_>>());
     let mut series: Vec<Series> = pts
         .iter()
         .enumerate()
