@@ -173,6 +173,8 @@ fn rtl_is_lint_clean_for_every_test_configuration() {
         config_path("conv_sym_k5.toml"),
         config_path("minimax_folded.toml"),
         config_path("pow2_shift.toml"),
+        config_path("lint_bus64.toml"),
+        config_path("lint_bus32.toml"),
     ];
     for config in &configs {
         for arch in ["pipelined", "folded"] {

@@ -160,11 +160,18 @@ module specfx_pipelined #(
     ) u_add_b (
         .t(t_2), .offset(offset_2), .c_clamped(c_cl_2), .threshold(threshold_2), .b(b_2)
     );
+    // Each register's output goes to wires of its own, assigned into the buses: a port
+    // connected to slices of two buses at once makes Verilator 5.006 report MULTIDRIVEN when
+    // the buses' widths are 16, 32 or 64 bits (a false positive, but a failed lint).
+    wire [COEF_W-1:0] coef_b;
+    wire [B_W-1:0]    b_q;
     specfx_delay #(.W(B_W + COEF_W), .LAT(LAT_ADD)) r_add_b (
         .clk(clk), .rst(rst), .en(advance),
         .d({coef_2, b_2}),
-        .q({coefs[0 +: COEF_W], chain[0 +: B_W]})
+        .q({coef_b, b_q})
     );
+    assign coefs[0 +: COEF_W] = coef_b;
+    assign chain[0 +: B_W] = b_q;
 
     // ---- square_i, i = 1..K: sq_i = Q_i(sq_{i-1}^2). ----
     genvar i;
@@ -173,6 +180,8 @@ module specfx_pipelined #(
             localparam integer X_W = chain_w(i - 1);
             localparam integer Y_W = chain_w(i);
             wire [Y_W-1:0] y;
+            wire [Y_W-1:0] y_q;
+            wire [COEF_W-1:0] coef_q;
             specfx_square #(
                 .X_W(X_W), .X_F(chain_f(i - 1)), .X_S(chain_s(i - 1)),
                 .Y_W(Y_W), .Y_F(chain_f(i)), .Y_S(chain_s(i)),
@@ -183,8 +192,10 @@ module specfx_pipelined #(
             specfx_delay #(.W(Y_W + COEF_W), .LAT(LAT_MUL)) r_square (
                 .clk(clk), .rst(rst), .en(advance),
                 .d({coefs[(i-1)*COEF_W +: COEF_W], y}),
-                .q({coefs[i*COEF_W +: COEF_W], chain[chain_off(i) +: Y_W]})
+                .q({coef_q, y_q})
             );
+            assign coefs[i*COEF_W +: COEF_W] = coef_q;
+            assign chain[chain_off(i) +: Y_W] = y_q;
         end
     endgenerate
 
