@@ -27,6 +27,16 @@ fn spec_of(c: &mut Config, stage: usize) -> &mut StageSpec {
     }
 }
 
+/// The number printed right after `prefix` in a command's output.
+fn value_after(stdout: &str, prefix: &str) -> f64 {
+    stdout
+        .split(prefix)
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no number after '{prefix}' in {stdout}"))
+}
+
 #[test]
 fn the_answer_passes_check_against_its_budget_and_is_locally_minimal() {
     let out = temp("best.toml");
@@ -267,13 +277,8 @@ fn cost_ceilings_bound_the_answer() {
     assert_eq!(o.status.code(), Some(1));
     let stdout = String::from_utf8_lossy(&o.stdout);
     // At least one DSP per product: 7 or more (wide products take several).
-    let dsps: u64 = stdout
-        .split("its analytic dsps on ice40: ")
-        .nth(1)
-        .and_then(|rest| rest.split(' ').next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("{stdout}"));
-    assert!(dsps >= 7, "{stdout}");
+    let dsps = value_after(&stdout, "its analytic dsps on ice40: ");
+    assert!(dsps >= 7.0, "{stdout}");
     assert!(stdout.contains("(limit 6)"), "{stdout}");
 
     let out = temp("luts.toml");
@@ -390,12 +395,7 @@ fn yosys_ceilings_are_measured_by_synthesis() {
     assert_eq!(o.status.code(), Some(1));
     let stdout = String::from_utf8_lossy(&o.stdout);
     // k = 5 minimax: seven products, at least one SB_MAC16 each.
-    let dsps: f64 = stdout
-        .split("its yosys_dsps on ice40: ")
-        .nth(1)
-        .and_then(|rest| rest.split(' ').next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("{stdout}"));
+    let dsps = value_after(&stdout, "its yosys_dsps on ice40: ");
     assert!(dsps >= 7.0, "{stdout}");
 
     let o = specfx(&[
