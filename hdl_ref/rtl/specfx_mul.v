@@ -4,6 +4,7 @@
 // the low P_W bits of the product (specfx_folded, where each step reads only the bits of its
 // own exact product). The fraction bits of the product are the sum of the operands' (the
 // caller knows them). Rust: the `i128` products of src/pipeline/datapath.rs `eval`.
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_mul #(

@@ -6,6 +6,7 @@
 pub mod budget;
 mod calibrate;
 mod check;
+mod cosim;
 pub mod cost;
 mod datapath;
 pub mod fit;
@@ -51,6 +52,9 @@ enum Command {
     Sim(sim::SimArgs),
     /// Reference Verilog helpers: parameter headers and co-simulation stimulus.
     Hdl(hdl::HdlArgs),
+    /// Co-simulates the reference Verilog against golden vectors and the cycle model's output
+    /// cycles, in Icarus Verilog or Verilator (bit and cycle exact, under bubbles and stalls).
+    Cosim(cosim::CosimArgs),
     /// Synthesis cost of a configuration: yosys on the reference Verilog, and the analytic model.
     Cost(cost::CostArgs),
     /// Calibrates the analytic cost model against yosys: a seeded sample synthesised, the
@@ -119,6 +123,7 @@ pub fn main() -> ExitCode {
         Command::Minimax(args) => reference::run_minimax(&args),
         Command::Vectors(args) => vectors::run(&args),
         Command::Sim(args) => sim::run(&args),
+        Command::Cosim(args) => cosim::run(&args),
         Command::Cost(args) => cost::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Timing(args) => pnr::run(&args),
