@@ -12,6 +12,7 @@ mod datapath;
 pub mod fit;
 pub mod furnace;
 mod hdl;
+mod input;
 mod optimize;
 mod output;
 mod paper;
