@@ -157,68 +157,6 @@ fn a_corrupted_expected_value_fails() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-#[test]
-fn rtl_is_lint_clean_for_every_test_configuration() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut files: Vec<PathBuf> = std::fs::read_dir(root.join("hdl_ref/rtl"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "v"))
-        .collect();
-    files.sort();
-    files.push(root.join("hdl_ref/specfx_dut.v"));
-    let configs = [
-        "baseline".to_string(),
-        config_path("narrow_trn_wrap.toml"),
-        config_path("conv_sym_k5.toml"),
-        config_path("minimax_folded.toml"),
-        config_path("pow2_shift.toml"),
-        config_path("lint_bus64.toml"),
-        config_path("lint_bus32.toml"),
-    ];
-    for config in &configs {
-        for arch in ["pipelined", "folded"] {
-            let dir = temp_dir(&format!("lint-{arch}"));
-            std::fs::create_dir_all(&dir).unwrap();
-            let header = dir.join("specfx_params.vh");
-            let o = specfx(&[
-                "hdl",
-                "params",
-                "--config",
-                config,
-                "--arch",
-                arch,
-                "--out",
-                header.to_str().unwrap(),
-            ]);
-            assert!(o.status.success());
-            let lint = Command::new("verilator")
-                .args(["--lint-only", "-Wall", "--top-module", "specfx_dut"])
-                .arg(format!("-I{}", dir.display()))
-                .args(&files)
-                .output()
-                .expect("verilator is installed (./scripts/test installs it)");
-            assert!(
-                lint.status.success() && lint.stderr.is_empty(),
-                "{config} {arch}: {}",
-                String::from_utf8_lossy(&lint.stderr)
-            );
-            let icarus = Command::new("iverilog")
-                .args(["-g2005", "-o", "/dev/null"])
-                .arg(format!("-I{}", dir.display()))
-                .args(&files)
-                .output()
-                .expect("iverilog is installed (./scripts/test installs it)");
-            assert!(
-                icarus.status.success(),
-                "{config} {arch}: {}",
-                String::from_utf8_lossy(&icarus.stderr)
-            );
-            std::fs::remove_dir_all(&dir).unwrap();
-        }
-    }
-}
-
 /// `specfx cosim` with no argument co-simulates the baseline on vectors it writes itself.
 #[test]
 fn cosim_defaults_lead_to_an_answer() {
