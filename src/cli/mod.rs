@@ -278,6 +278,7 @@ pub enum Outcome {
 
 /// Parses the arguments, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
+    output::install_interrupt_handler();
     let cli = match command()
         .try_get_matches()
         .and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m))
