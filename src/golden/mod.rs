@@ -7,7 +7,6 @@
 pub mod cases;
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 use std::io::{self, Write};
 
 use serde::Serialize;
@@ -208,20 +207,43 @@ pub fn csv_header(dp: &Datapath) -> String {
 /// assert_eq!(hex_word(5, 16), "0005");
 /// ```
 pub fn hex_word(raw: i64, width: u32) -> String {
-    let mut s = String::new();
+    let mut s = Vec::new();
     push_hex_word(&mut s, raw, width);
-    s
+    String::from_utf8(s).expect("hex digits are ASCII")
 }
 
-/// Appends [`hex_word`]`(raw, width)` to `s`.
-fn push_hex_word(s: &mut String, raw: i64, width: u32) {
+/// Appends [`hex_word`]`(raw, width)` to `buf` (the writer's fast path: no formatter).
+fn push_hex_word(buf: &mut Vec<u8>, raw: i64, width: u32) {
+    const DIGITS: &[u8; 16] = b"0123456789abcdef";
     let mask = if width >= 64 {
         u64::MAX
     } else {
         (1u64 << width) - 1
     };
-    let digits = width.div_ceil(4) as usize;
-    write!(s, "{:0digits$x}", (raw as u64) & mask).expect("write to String");
+    let word = (raw as u64) & mask;
+    let digits = width.div_ceil(4);
+    for i in (0..digits).rev() {
+        buf.push(DIGITS[((word >> (4 * i)) & 0xf) as usize]);
+    }
+}
+
+/// Appends `v` in decimal to `buf`, as `{v}` would write it (the writer's fast path).
+fn push_decimal(buf: &mut Vec<u8>, v: i64) {
+    if v < 0 {
+        buf.push(b'-');
+    }
+    let mut x = v.unsigned_abs();
+    let mut tmp = [0u8; 20];
+    let mut i = tmp.len();
+    loop {
+        i -= 1;
+        tmp[i] = b'0' + (x % 10) as u8;
+        x /= 10;
+        if x == 0 {
+            break;
+        }
+    }
+    buf.extend_from_slice(&tmp[i..]);
 }
 
 /// Rows evaluated and written together by [`write_vectors`].
@@ -269,8 +291,9 @@ pub fn write_vectors(
     let n_stages = dp.stages().len();
     let mut cols = ProbeColumns::default();
     let mut written = 0u64;
-    let mut line = String::new();
-    let mut word = String::new();
+    // The chunk's text: the CSV rows, and each port's words.
+    let mut csv_text: Vec<u8> = Vec::new();
+    let mut hex_text: Vec<Vec<u8>> = vec![Vec::new(); ports.len()];
     // values[i * n_stages + stage_idx]: the chunk's probes, in the order of the chunk.
     let mut values: Vec<i64> = Vec::new();
     let mut by_n: Vec<usize> = Vec::new();
@@ -296,14 +319,17 @@ pub fn write_vectors(
                 }
             }
         }
+        csv_text.clear();
+        for text in &mut hex_text {
+            text.clear();
+        }
         for (i, &(n, c)) in chunk.iter().enumerate() {
             let nc = dp
                 .constants_for(n)
                 .expect("cases are drawn from the configuration's n set");
             let row = &values[i * n_stages..(i + 1) * n_stages];
             coverage.add_row(n, row);
-            line.clear();
-            for (port, w) in ports.iter().zip(hex.iter_mut()) {
+            for (port_idx, (port, text)) in ports.iter().zip(&mut hex_text).enumerate() {
                 let raw = match port.source {
                     Source::C => c,
                     Source::N => i64::from(n),
@@ -313,17 +339,18 @@ pub fn write_vectors(
                     Source::Threshold => nc.threshold.unwrap_or(0),
                     Source::Stage(stage_idx) => row[stage_idx],
                 };
-                if !line.is_empty() {
-                    line.push(',');
+                if port_idx > 0 {
+                    csv_text.push(b',');
                 }
-                write!(line, "{raw}").expect("write to String");
-                word.clear();
-                push_hex_word(&mut word, raw, port.width);
-                word.push('\n');
-                w.write_all(word.as_bytes())?;
+                push_decimal(&mut csv_text, raw);
+                push_hex_word(text, raw, port.width);
+                text.push(b'\n');
             }
-            line.push('\n');
-            csv.write_all(line.as_bytes())?;
+            csv_text.push(b'\n');
+        }
+        csv.write_all(&csv_text)?;
+        for (text, w) in hex_text.iter().zip(hex.iter_mut()) {
+            w.write_all(text)?;
         }
         written += chunk.len() as u64;
         progress(written);
@@ -633,4 +660,49 @@ pub struct Manifest {
     pub coverage: Coverage,
     /// sha256 of every other file, by name.
     pub sha256: BTreeMap<String, String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimal_and_hex_words_match_the_formatter() {
+        let values = [
+            0,
+            1,
+            -1,
+            9,
+            10,
+            -10,
+            99_999,
+            i64::MIN,
+            i64::MAX,
+            -(1 << 17),
+            (1 << 17) - 1,
+        ];
+        for v in values {
+            let mut buf = Vec::new();
+            push_decimal(&mut buf, v);
+            assert_eq!(String::from_utf8(buf).unwrap(), format!("{v}"));
+            for width in [1, 4, 5, 16, 18, 63, 64] {
+                let mask = if width == 64 {
+                    u64::MAX
+                } else {
+                    (1u64 << width) - 1
+                };
+                let want = format!("{:0w$x}", (v as u64) & mask, w = width.div_ceil(4) as usize);
+                assert_eq!(hex_word(v, width), want, "{v} in {width} bits");
+            }
+        }
+    }
+
+    #[test]
+    fn hex_words_at_the_edges() {
+        // Hand-written: the most negative s2.16 code, -1 in one bit, the widest code.
+        assert_eq!(hex_word(-(1 << 17), 18), "20000");
+        assert_eq!(hex_word(-1, 1), "1");
+        assert_eq!(hex_word(i64::MIN, 64), "8000000000000000");
+        assert_eq!(hex_word(0, 17), "00000");
+    }
 }
