@@ -685,7 +685,7 @@ mod tests {
             let mut buf = Vec::new();
             push_decimal(&mut buf, v);
             assert_eq!(String::from_utf8(buf).unwrap(), format!("{v}"));
-            for width in [1, 4, 5, 16, 18, 63, 64] {
+            for width in [1u32, 4, 5, 16, 18, 63, 64] {
                 let mask = if width == 64 {
                     u64::MAX
                 } else {
