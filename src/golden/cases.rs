@@ -67,7 +67,9 @@ pub const ORDER_STREAM: u64 = 1;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct CaseSelection {
     /// Corner cases: c = 0, 1.0, codes above 1.0, the ends of the code range and the cutoff
-    /// boundary +-1 code, for every n. They are always included; naming them is optional.
+    /// boundary +-1 code, for every n. They are always included, as are up to
+    /// [`LIVE_CODES`] codes with a non-zero output per n ([`live_codes`]); naming them is
+    /// optional.
     pub corner: bool,
     /// Every input code for every n.
     pub exhaustive: bool,
