@@ -236,10 +236,11 @@ const LIVE_CHUNK: i64 = 4096;
 ///    from `top` in batches of 4096 until it holds [`LIVE_CODES`] non-zero codes, reaches
 ///    `start`, or has scanned [`MAX_LIVE_SCAN`] codes.
 ///
-/// So where `start..=top` holds at most [`MAX_LIVE_SCAN`] codes (every input format with up to
-/// 16 fraction bits), the result holds `min(4, the number of codes with a non-zero output)`
-/// codes: none only when every input code gives 0. Wider inputs rely on the candidates and the
-/// scan near 1.0. The result does not depend on any seed.
+/// So where `start..=top` holds at most [`MAX_LIVE_SCAN`] codes (every unsigned input format
+/// with at most 15 fraction bits, such as baseline's `u1.15`, and wider ones where the cut
+/// prefix leaves that few), the result holds `min(4, the number of codes with a non-zero
+/// output)` codes: none only when every input code gives 0. Elsewhere it relies on the
+/// candidates and the scan near 1.0. The result does not depend on any seed.
 ///
 /// # Examples
 /// ```
