@@ -189,27 +189,35 @@ fn vectors_are_complete_correct_deterministic_and_not_overwritten() {
     // CSV: header, then one row per vector, each agreeing with the specification.
     let csv = std::fs::read_to_string(dir.join("vectors.csv")).unwrap();
     let mut lines = csv.lines();
+    // The ports of the hex files, in their order, with baseline's formats (docs/arithmetic.md):
+    // in_n is u11.0 (1024 needs 11 bits), the slope n with k = 4 fraction bits.
     assert_eq!(
         lines.next().unwrap(),
-        "n,c_raw,d_raw,t_raw,b_raw,sq1_raw,sq2_raw,sq3_raw,sq4_raw,coef_raw,out_raw"
+        "in_c:u1.15,in_n:u11.0,in_slope:u7.4,in_offset:u1.0,in_threshold:u1.15,in_coef:u8.16,\
+         probe_d:s1.15,probe_t:s2.16,probe_b:u1.16,probe_sq1:u1.16,probe_sq2:u1.16,\
+         probe_sq3:u1.16,probe_sq4:u1.16,expected_out:u8.16"
     );
+    assert_eq!(manifest["order"], "interleaved");
     let rows: Vec<Vec<i64>> = lines
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();
     assert_eq!(rows.len() as u64, n_vectors);
+    let (c, n, out) = (0, 1, 13);
     for r in &rows {
-        assert_eq!(r[10], baseline_out(r[1], r[0]), "row {r:?}");
+        assert_eq!(r[out], baseline_out(r[c], r[n]), "row {r:?}");
+        // The constants: slope n, offset 1, threshold 0 (clamp cutoff).
+        assert_eq!((r[2], r[3], r[4]), (r[n], 1, 0), "row {r:?}");
     }
     // Corner cases are there: c = 0, 1.0, above 1.0 and the last code, for every n.
     for n in [16, 100, 1024] {
         for c in [0, 32767, 32768, 32769, 65535] {
-            assert!(rows.iter().any(|r| r[0] == n && r[1] == c), "n={n} c={c}");
+            assert!(rows.iter().any(|r| r[1] == n && r[0] == c), "n={n} c={c}");
         }
         // The cutoff boundary: the first code with a non-zero base, and the one before.
         let first_live = (0..=32768).find(|&c| baseline_out_base(c, n) > 0).unwrap();
         for c in [first_live - 1, first_live] {
             assert!(
-                rows.iter().any(|r| r[0] == n && r[1] == c),
+                rows.iter().any(|r| r[1] == n && r[0] == c),
                 "n={n} boundary c={c}"
             );
         }
@@ -221,14 +229,14 @@ fn vectors_are_complete_correct_deterministic_and_not_overwritten() {
     assert_eq!(words.len() as u64, n_vectors);
     assert!(words.iter().all(|w| w.len() == 6)); // u8.16: 24 bits
     for (w, r) in words.iter().zip(&rows) {
-        assert_eq!(i64::from_str_radix(w, 16).unwrap(), r[10]);
+        assert_eq!(i64::from_str_radix(w, 16).unwrap(), r[out]);
     }
     let t_hex = std::fs::read_to_string(dir.join("probe_t.hex")).unwrap();
     for (w, r) in t_hex.lines().zip(&rows) {
         // s2.16 is 18 bits: two's complement in 5 hex digits.
         let v = i64::from_str_radix(w, 16).unwrap();
         let v = if v >= 1 << 17 { v - (1 << 18) } else { v };
-        assert_eq!(v, r[3]);
+        assert_eq!(v, r[7]);
     }
 
     // The same command again is refused, and changes nothing.

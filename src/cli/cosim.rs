@@ -17,7 +17,7 @@ use super::hdl::write_stimulus;
 use super::sim::parse_probability;
 use super::Outcome;
 use specfx::cycle::Arch;
-use specfx::golden::CaseSelection;
+use specfx::golden::{CaseSelection, Order};
 use specfx::hdl::{render_parameters, ParamsFormat};
 use specfx::nset::NSet;
 
@@ -75,6 +75,10 @@ pub struct CosimArgs {
     /// Which cases to write (with --config): corner, exhaustive, random:N, comma-separated.
     #[arg(long, default_value = "corner,random:1000")]
     cases: CaseSelection,
+    /// Row order of the vectors written for --config: interleaved (n changes almost every
+    /// vector, seeded) or sorted by n then c.
+    #[arg(long, default_value = "interleaved", conflicts_with = "vectors")]
+    order: Order,
     /// The simulator: icarus or verilator. Default: icarus when installed, else verilator.
     #[arg(long)]
     sim: Option<Simulator>,
@@ -154,7 +158,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         None => {
             let dp = super::datapath::load(&args.config, args.n.as_ref())?;
             let dir = wd.join("vectors");
-            super::vectors::write_dir(&dp, &dir, &args.cases, args.seed, false)?;
+            super::vectors::write_dir(&dp, &dir, &args.cases, args.order, args.seed, false)?;
             dir
         }
     };

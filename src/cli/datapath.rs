@@ -63,25 +63,47 @@ pub fn config_from_manifest(path: &Path) -> Result<Config> {
     })
 }
 
-/// The (n, c_raw) pairs of a vector directory, in file order, from its `vectors.csv`.
+/// The (n, c_raw) pairs of a vector directory, in file order, from its `vectors.csv`: the
+/// columns of the ports `in_n` and `in_c`, found by name in the header (cells
+/// `<port>:<format>`), wherever they are.
 pub fn vector_inputs(dir: &Path) -> Result<Vec<(u32, i64)>> {
     let file = dir.join("vectors.csv");
     let text = std::fs::read_to_string(&file)
         .with_context(|| format!("cannot read {}", file.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines
+        .next()
+        .unwrap_or("")
+        .split(',')
+        .map(|cell| cell.split_once(':').map_or(cell, |(name, _)| name))
+        .collect();
+    let column = |port: &str| -> Result<usize> {
+        header.iter().position(|&h| h == port).with_context(|| {
+            format!(
+                "{}: no column '{port}' in the header (cells <port>:<format>; written by an older specfx? write the vectors again)",
+                file.display()
+            )
+        })
+    };
+    let (i_n, i_c) = (column("in_n")?, column("in_c")?);
     let mut rows = Vec::new();
-    for (i, line) in text.lines().enumerate().skip(1) {
-        let mut fields = line.split(',');
-        let parse = |f: Option<&str>| -> Result<i64> {
-            f.and_then(|x| x.parse::<i64>().ok()).with_context(|| {
-                format!(
-                    "{} line {}: expected n,c_raw,... as integers, got '{line}'",
-                    file.display(),
-                    i + 1
-                )
-            })
+    for (i, line) in lines.enumerate() {
+        let fields: Vec<&str> = line.split(',').collect();
+        let parse = |j: usize, port: &str| -> Result<i64> {
+            fields
+                .get(j)
+                .and_then(|x| x.parse::<i64>().ok())
+                .with_context(|| {
+                    format!(
+                        "{} line {}: expected an integer {port} in column {}, got '{line}'",
+                        file.display(),
+                        i + 2,
+                        j + 1
+                    )
+                })
         };
-        let n = parse(fields.next())?;
-        let c = parse(fields.next())?;
+        let n = parse(i_n, "in_n")?;
+        let c = parse(i_c, "in_c")?;
         rows.push((u32::try_from(n).unwrap_or(0), c));
     }
     Ok(rows)

@@ -267,7 +267,14 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     step("writing baseline's golden vectors (corner cases and 1000 random)");
     let vectors_dir = dir.join("vectors_baseline");
     let selection: specfx::golden::CaseSelection = "corner,random:1000".parse()?;
-    let n_vectors = super::vectors::write_dir(&dp, &vectors_dir, &selection, 1, true)?;
+    let (n_vectors, _) = super::vectors::write_dir(
+        &dp,
+        &vectors_dir,
+        &selection,
+        specfx::golden::Order::Interleaved,
+        1,
+        true,
+    )?;
     written.push(vectors_dir.clone());
 
     step("simulating baseline's cycle-level model (both architectures, 20000 cycles)");

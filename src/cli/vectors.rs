@@ -11,7 +11,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::Outcome;
 use specfx::golden::{
-    cases, csv_columns, ports, write_vectors, CaseSelection, CsvInfo, HashingWriter, Manifest,
+    cases, csv_columns, ports, write_vectors, CaseSelection, Coverage, CsvInfo, HashingWriter,
+    Manifest, Order,
 };
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
@@ -31,9 +32,13 @@ pub struct VectorsArgs {
     /// Which cases: corner, exhaustive, random:N, comma-separated.
     #[arg(long, default_value = "corner,random:1000")]
     cases: CaseSelection,
-    /// Seed of the random cases.
+    /// Seed of the random cases and of the interleaved order.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Row order: interleaved (a seeded random permutation, so n changes on most rows) or
+    /// sorted (by n, then c).
+    #[arg(long, default_value = "interleaved")]
+    order: Order,
     /// Replace an existing directory.
     #[arg(long)]
     force: bool,
@@ -42,28 +47,39 @@ pub struct VectorsArgs {
 /// Runs `specfx vectors`.
 pub fn run(args: &VectorsArgs) -> Result<Outcome> {
     let dp = super::datapath::load(&args.config, args.n.as_ref())?;
-    let n = write_dir(&dp, &args.out, &args.cases, args.seed, args.force)?;
+    let (n, coverage) = write_dir(
+        &dp,
+        &args.out,
+        &args.cases,
+        args.order,
+        args.seed,
+        args.force,
+    )?;
     println!(
-        "wrote {n} vectors ({}, seed {}) to {}",
+        "wrote {n} vectors ({}, {} order, seed {}) to {}",
         args.cases,
+        args.order,
         args.seed,
         args.out.display()
     );
+    println!("{}", coverage.summary());
     Ok(Outcome::Ok)
 }
 
 /// Writes a vector directory: everything goes to `<out>.partial` first, which is renamed to
 /// `out` only once complete, so an interrupted run never leaves a half-written vector file
-/// under `out`. Returns the number of vectors.
+/// under `out`. Returns the number of vectors and their coverage.
 pub fn write_dir(
     dp: &Datapath,
     out: &Path,
     selection: &CaseSelection,
+    order: Order,
     seed: u64,
     force: bool,
-) -> Result<u64> {
-    let cases = cases::select(dp, selection, seed)
+) -> Result<(u64, Coverage)> {
+    let mut cases = cases::select(dp, selection, seed)
         .with_context(|| format!("config {}", dp.config().name))?;
+    cases::order(&mut cases, order, seed);
     if out.exists() && !force {
         bail!(
             "{} already exists: pass --force to replace it",
@@ -98,7 +114,7 @@ pub fn write_dir(
         );
         b
     });
-    {
+    let coverage = {
         let mut writers: Vec<&mut dyn Write> =
             hex.iter_mut().map(|w| w as &mut dyn Write).collect();
         let mut progress = |done: u64| {
@@ -107,8 +123,8 @@ pub fn write_dir(
             }
         };
         write_vectors(dp, &cases, &mut csv, &mut writers, &mut progress)
-            .with_context(|| format!("cannot write vectors to {}", partial.display()))?;
-    }
+            .with_context(|| format!("cannot write vectors to {}", partial.display()))?
+    };
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -130,8 +146,10 @@ pub fn write_dir(
             columns: csv_columns(dp),
         },
         cases: selection.to_string(),
+        order,
         seed,
         n_vectors: cases.len() as u64,
+        coverage: coverage.clone(),
         sha256,
     };
     let mut json = serde_json::to_vec_pretty(&manifest)?;
@@ -143,5 +161,5 @@ pub fn write_dir(
     }
     fs::rename(&partial, out)
         .with_context(|| format!("cannot rename {} to {}", partial.display(), out.display()))?;
-    Ok(cases.len() as u64)
+    Ok((cases.len() as u64, coverage))
 }

@@ -1,4 +1,5 @@
-//! Which (n, c) inputs a vector set holds: corner cases, every code, or seeded random draws.
+//! Which (n, c) inputs a vector set holds (corner cases, codes with a non-zero output, every
+//! code, or seeded random draws) and in which order they are written.
 
 use std::collections::BTreeSet;
 use std::fmt;
@@ -11,6 +12,47 @@ use serde::Serialize;
 use crate::error::Error;
 use crate::pipeline::datapath::CutStructure;
 use crate::pipeline::{Datapath, ProbeColumns};
+
+/// The order the selected cases are written in.
+///
+/// # Examples
+/// ```
+/// use specfx::golden::cases::Order;
+/// let o: Order = "sorted".parse().unwrap();
+/// assert_eq!(o, Order::Sorted);
+/// assert_eq!(Order::default().to_string(), "interleaved");
+/// assert!("shuffled".parse::<Order>().is_err());
+/// ```
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Order {
+    /// A seeded random permutation of the cases (see [`order`]), so that n changes on most
+    /// rows and the per-n constants' routing is exercised on every vector, not only where n
+    /// changes.
+    #[default]
+    Interleaved,
+    /// Sorted by n, then by input code.
+    Sorted,
+}
+
+impl Order {
+    /// Both orders.
+    pub const ALL: [Order; 2] = [Order::Interleaved, Order::Sorted];
+
+    /// The name on the command line and in the manifest.
+    pub fn name(self) -> &'static str {
+        match self {
+            Order::Interleaved => "interleaved",
+            Order::Sorted => "sorted",
+        }
+    }
+}
+
+crate::names::named_enum!(Order, "vector order", "interleaved or sorted");
+
+/// The ChaCha8 stream of the interleaving permutation: the random cases are drawn from stream
+/// 0 of the same seed, so the permutation never changes which cases are drawn.
+pub const ORDER_STREAM: u64 = 1;
 
 /// A selection of cases, written `corner`, `exhaustive`, `random:N` or a comma list of them.
 ///
@@ -25,7 +67,9 @@ use crate::pipeline::{Datapath, ProbeColumns};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct CaseSelection {
     /// Corner cases: c = 0, 1.0, codes above 1.0, the ends of the code range and the cutoff
-    /// boundary +-1 code, for every n. They are always included; naming them is optional.
+    /// boundary +-1 code, for every n. They are always included, as are up to
+    /// [`LIVE_CODES`] codes with a non-zero output per n ([`live_codes`]); naming them is
+    /// optional.
     pub corner: bool,
     /// Every input code for every n.
     pub exhaustive: bool,
@@ -161,8 +205,156 @@ pub fn corner_codes(
     Ok(set)
 }
 
-/// The (n, c_raw) pairs of a selection, sorted by n then c, without duplicates. Corner cases
-/// are always included (`corner` only says so explicitly).
+/// The most codes [`live_codes`] scans per exponent, down from 1.0, when its candidates hold
+/// fewer than [`LIVE_CODES`] non-zero outputs.
+pub const MAX_LIVE_SCAN: u64 = 1 << 16;
+
+/// How many codes with a non-zero output [`live_codes`] keeps per exponent.
+pub const LIVE_CODES: usize = 4;
+
+/// The evenly spaced candidate codes [`live_codes`] evaluates first.
+const LIVE_CANDIDATES: i64 = 64;
+
+/// The codes just below 1.0 (1.0 included) [`live_codes`] always evaluates.
+const LIVE_NEAR_ONE: i64 = 16;
+
+/// Codes per batch of the scan of [`live_codes`].
+const LIVE_CHUNK: i64 = 4096;
+
+/// Up to [`LIVE_CODES`] input codes of one n whose datapath output is non-zero, spread over
+/// the codes found: the smallest, the largest and two between (in the order of the codes
+/// found). Empty when the search finds none.
+///
+/// The search looks at codes from `start` to `top = min(1.0, max code)` (codes above 1.0 are
+/// clamped to 1.0 and give its output), where `start` is the first live code where the cut
+/// codes are proven to be a prefix ([`Datapath::first_live_code`]: every code below it is cut
+/// and gives 0) and the smallest input code otherwise:
+///
+/// 1. it evaluates 64 evenly spaced codes from `start` to `top` and the 16 codes up to and
+///    including `top`;
+/// 2. when fewer than [`LIVE_CODES`] of them give a non-zero output, it scans every code down
+///    from `top` in batches of 4096 until it holds [`LIVE_CODES`] non-zero codes, reaches
+///    `start`, or has scanned [`MAX_LIVE_SCAN`] codes.
+///
+/// So where `start..=top` holds at most [`MAX_LIVE_SCAN`] codes (every unsigned input format
+/// with at most 15 fraction bits, such as baseline's `u1.15`, and wider ones where the cut
+/// prefix leaves that few), the result holds `min(4, the number of codes with a non-zero
+/// output)` codes: none only when every input code gives 0. Elsewhere it relies on the
+/// candidates and the scan near 1.0. The result does not depend on any seed.
+///
+/// # Examples
+/// ```
+/// use specfx::golden::cases::live_codes;
+/// use specfx::pipeline::{Config, Datapath, ProbeColumns};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let nc = dp.constants_for(1024).unwrap();
+/// let live = live_codes(&dp, 1024, &mut ProbeColumns::default());
+/// assert_eq!(live.len(), 4);
+/// assert!(live.iter().all(|&c| dp.eval(c, nc).values[dp.stage_out()] != 0));
+/// assert_eq!(*live.last().unwrap(), dp.one_code());
+/// ```
+pub fn live_codes(dp: &Datapath, n: u32, cols: &mut ProbeColumns) -> Vec<i64> {
+    let Some(nc) = dp.constants_for(n) else {
+        return Vec::new();
+    };
+    let codes = dp.input_codes();
+    let (lo, hi) = (*codes.start(), *codes.end());
+    let top = hi.min(dp.one_code());
+    let start = match dp.cut_structure() {
+        CutStructure::Prefix => dp.first_live_code(nc, lo..top + 1),
+        CutStructure::Never | CutStructure::Scan => lo,
+    };
+    if start > top {
+        return Vec::new();
+    }
+    let out_idx = dp.stage_out();
+    let mut found = BTreeSet::new();
+    let mut look = |codes: &[i64], found: &mut BTreeSet<i64>| {
+        dp.eval_batch(nc, codes, cols);
+        let out = &cols.values[out_idx];
+        found.extend(
+            codes
+                .iter()
+                .zip(out)
+                .filter(|&(_, &o)| o != 0)
+                .map(|(&c, _)| c),
+        );
+    };
+    let span = i128::from(top) - i128::from(start);
+    let mut candidates = BTreeSet::new();
+    for i in 0..LIVE_CANDIDATES {
+        let c = i128::from(start) + span * i128::from(i) / i128::from(LIVE_CANDIDATES - 1);
+        candidates.insert(i64::try_from(c).expect("between two codes"));
+    }
+    for j in 0..LIVE_NEAR_ONE {
+        if i128::from(top) - i128::from(j) >= i128::from(start) {
+            candidates.insert(top - j);
+        }
+    }
+    let candidates: Vec<i64> = candidates.into_iter().collect();
+    look(&candidates, &mut found);
+    let mut scanned = 0u64;
+    let mut end = top;
+    while found.len() < LIVE_CODES && scanned < MAX_LIVE_SCAN {
+        let room = i128::from((MAX_LIVE_SCAN - scanned).min(LIVE_CHUNK as u64));
+        let begin = (i128::from(end) - room + 1).max(i128::from(start));
+        let begin = i64::try_from(begin).expect("between two codes");
+        let chunk: Vec<i64> = (begin..=end).collect();
+        look(&chunk, &mut found);
+        scanned += chunk.len() as u64;
+        if begin == start {
+            break;
+        }
+        end = begin - 1;
+    }
+    spread(&found.into_iter().collect::<Vec<_>>())
+}
+
+/// Up to [`LIVE_CODES`] of the sorted `codes`: the first, the last and two between.
+fn spread(codes: &[i64]) -> Vec<i64> {
+    if codes.len() <= LIVE_CODES {
+        return codes.to_vec();
+    }
+    let last = codes.len() - 1;
+    vec![codes[0], codes[last / 3], codes[2 * last / 3], codes[last]]
+}
+
+/// Puts cases in the given order. [`Order::Sorted`] sorts them by n, then code.
+/// [`Order::Interleaved`] sorts them, then applies a Fisher-Yates shuffle driven by ChaCha8
+/// seeded with `seed` on stream [`ORDER_STREAM`] (the random cases use stream 0): for `i` from
+/// the last index down to 1, swap element `i` with element `j`, `j` drawn uniformly from
+/// `0..=i` (as a `u64`). The result depends only on the set of cases and the seed, the same on
+/// every machine.
+///
+/// # Examples
+/// ```
+/// use specfx::golden::cases::{order, Order};
+/// let sorted: Vec<(u32, i64)> = (0..40).map(|i| (16 + (i % 4) as u32, i / 4)).collect();
+/// let mut a = sorted.clone();
+/// order(&mut a, Order::Interleaved, 7);
+/// assert_ne!(a, sorted);
+/// let mut b = a.clone();
+/// b.sort();
+/// order(&mut a, Order::Sorted, 7);
+/// assert_eq!(a, b);
+/// ```
+pub fn order(cases: &mut [(u32, i64)], order: Order, seed: u64) {
+    cases.sort_unstable();
+    if order == Order::Sorted {
+        return;
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(ORDER_STREAM);
+    for i in (1..cases.len()).rev() {
+        let j = rng.gen_range(0..=i as u64) as usize;
+        cases.swap(i, j);
+    }
+}
+
+/// The (n, c_raw) pairs of a selection, sorted by n then c, without duplicates (put them in
+/// the written order with [`order`]). Unless the selection is exhaustive, every n gets its
+/// corner cases ([`corner_codes`]; `corner` only says so explicitly) and up to
+/// [`LIVE_CODES`] codes with a non-zero output ([`live_codes`]).
 ///
 /// Random pairs are drawn from ChaCha8 seeded with `seed`, uniformly over the n set and the
 /// input codes, until `random` pairs not already selected have been added (or every pair is
@@ -193,17 +385,20 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Vec<(u32,
             ),
         });
     }
-    let mut set: BTreeSet<(u32, i64)> = BTreeSet::new();
     if sel.exhaustive {
+        // Every pair: the random draws could add nothing.
+        let mut all = Vec::with_capacity(usize::try_from(exhaustive).unwrap_or(0));
         for &n in ns {
-            set.extend((lo..=hi).map(|c| (n, c)));
+            all.extend((lo..=hi).map(|c| (n, c)));
         }
-    } else {
-        // Corner cases are always included, whatever else is selected.
-        let mut cols = ProbeColumns::default();
-        for &n in ns {
-            set.extend(corner_codes(dp, n, &mut cols)?.into_iter().map(|c| (n, c)));
-        }
+        return Ok(all);
+    }
+    let mut set: BTreeSet<(u32, i64)> = BTreeSet::new();
+    // Corner cases and live codes are always included, whatever else is selected.
+    let mut cols = ProbeColumns::default();
+    for &n in ns {
+        set.extend(corner_codes(dp, n, &mut cols)?.into_iter().map(|c| (n, c)));
+        set.extend(live_codes(dp, n, &mut cols).into_iter().map(|c| (n, c)));
     }
     if sel.random > 0 {
         let total = ns.len() as u128 * (hi - lo + 1) as u128;
@@ -216,4 +411,112 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Vec<(u32,
         }
     }
     Ok(set.into_iter().collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::Config;
+
+    fn datapath(toml: &str) -> Datapath {
+        Datapath::new(Config::from_toml(toml).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn order_names_round_trip() {
+        for o in Order::ALL {
+            assert_eq!(o.to_string().parse::<Order>().unwrap(), o);
+        }
+        assert_eq!("SORTED".parse::<Order>().unwrap(), Order::Sorted);
+        assert_eq!(
+            "random".parse::<Order>().unwrap_err().to_string(),
+            "unknown vector order 'random': expected interleaved or sorted"
+        );
+    }
+
+    #[test]
+    fn spread_keeps_the_ends_and_two_between() {
+        // Ten codes: indexes 0, 9/3 = 3, 18/3 = 6 and 9.
+        let codes: Vec<i64> = (100..110).collect();
+        assert_eq!(spread(&codes), [100, 103, 106, 109]);
+        assert_eq!(spread(&[5, 7, 9]), [5, 7, 9]);
+        assert_eq!(spread(&[1, 2, 3, 4, 5]), [1, 2, 3, 5]);
+        assert!(spread(&[]).is_empty());
+    }
+
+    #[test]
+    fn order_is_a_seeded_permutation() {
+        let sorted: Vec<(u32, i64)> = (0..500).map(|i| (1 + (i % 7) as u32, i / 7)).collect();
+        let mut sorted_copy = sorted.clone();
+        sorted_copy.sort_unstable();
+        let mut by_order = sorted.clone();
+        by_order.reverse();
+        order(&mut by_order, Order::Sorted, 3);
+        assert_eq!(by_order, sorted_copy);
+        let shuffle = |seed: u64, start: &[(u32, i64)]| {
+            let mut v = start.to_vec();
+            order(&mut v, Order::Interleaved, seed);
+            v
+        };
+        let a = shuffle(3, &sorted);
+        // The input's order does not matter, only its set and the seed.
+        assert_eq!(
+            shuffle(3, &by_order.iter().rev().copied().collect::<Vec<_>>()),
+            a
+        );
+        assert_ne!(a, sorted_copy);
+        assert_ne!(shuffle(4, &sorted), a);
+        let mut back = a.clone();
+        back.sort_unstable();
+        assert_eq!(back, sorted_copy);
+    }
+
+    #[test]
+    fn the_permutation_is_not_the_random_draws_stream() {
+        // Stream 0 of the seed draws the random cases; the permutation uses stream 1, so its
+        // first draw differs from the first draw of stream 0.
+        let mut s0 = ChaCha8Rng::seed_from_u64(9);
+        let mut s1 = ChaCha8Rng::seed_from_u64(9);
+        s1.set_stream(ORDER_STREAM);
+        assert_ne!(s0.gen::<u64>(), s1.gen::<u64>());
+    }
+
+    #[test]
+    fn live_codes_equal_a_brute_force_search_on_narrow_inputs() {
+        // u1.10: every code up to 1.0 is within the scan limit, so the search is complete.
+        for toml in [
+            "n = \"1,2,300,1500\"\n[c]\nformat = \"u1.10\"\n[d]\nformat = \"s1.10\"\n[coef]\nformat = \"u9.8\"\n[out]\nformat = \"u4.-1\"\n",
+            "n = \"8,100\"\n[c]\nformat = \"u1.9\"\n[d]\nformat = \"s1.9\"\n[t]\nformat = \"s3.8\"\noverflow = \"WRAP\"\n",
+            "cutoff = \"paper\"\nn = \"40,1000\"\n",
+        ] {
+            let dp = datapath(toml);
+            let mut cols = ProbeColumns::default();
+            for nc in dp.constants() {
+                let live: Vec<i64> = (*dp.input_codes().start()..=dp.one_code())
+                    .filter(|&c| dp.eval(c, nc).values[dp.stage_out()] != 0)
+                    .collect();
+                let got = live_codes(&dp, nc.n, &mut cols);
+                assert_eq!(got.len(), live.len().min(LIVE_CODES), "{toml} n = {}", nc.n);
+                assert!(got.iter().all(|c| live.contains(c)), "{toml} n = {}", nc.n);
+                assert!(got.windows(2).all(|w| w[0] < w[1]));
+                if !live.is_empty() {
+                    // 1.0 is always a candidate, and in these configurations its output is
+                    // the largest non-zero code's.
+                    assert_eq!(got.last(), live.last(), "{toml} n = {}", nc.n);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn exhaustive_selects_every_pair_in_order() {
+        let dp = datapath("n = \"3,5\"\n[c]\nformat = \"u1.3\"\n[d]\nformat = \"s1.3\"\n");
+        let sel: CaseSelection = "exhaustive,random:5".parse().unwrap();
+        let got = select(&dp, &sel, 1).unwrap();
+        let want: Vec<(u32, i64)> = [3, 5]
+            .into_iter()
+            .flat_map(|n| (0..16).map(move |c| (n, c)))
+            .collect();
+        assert_eq!(got, want);
+    }
 }
