@@ -1,8 +1,8 @@
 // tb_specfx: co-simulation testbench of specfx_dut against the golden vectors of
 // `specfx vectors` and the stimulus of `specfx hdl stimulus` (docs/cycle.md).
 //
-// Reads from the current directory ($readmemh): in_c.hex, in_slope.hex, in_offset.hex,
-// in_threshold.hex, in_coef.hex, expected_out.hex (one word per vector), stim_valid.hex,
+// Reads from the current directory ($readmemh): in_c.hex, in_n.hex, in_slope.hex,
+// in_offset.hex, in_threshold.hex, in_coef.hex, expected_out.hex (one word per vector), stim_valid.hex,
 // stim_ready.hex (one bit per cycle) and expected_cycle.hex (one 32-bit word per vector).
 // Macros: specfx_params.vh (formats), SPECFX_NVEC (vectors) and SPECFX_NCYC (lines of the
 // stimulus files), given on the command line (-D).
@@ -14,6 +14,7 @@
 // timeout (the missing outputs count as failed). A change of out_data or a drop of out_valid
 // while out_valid is high and out_ready low (docs/cycle.md, rule 5) counts as one more
 // failure. Prints the first 10 mismatches, then exactly one line `N passed, N failed`.
+// With SPECFX_VCD defined, dumps every signal to rtl.vcd (Verilator: also --trace).
 `include "specfx_params.vh"
 `default_nettype none
 // A testbench: blocking counters in the clocked checker and a nonblocking reset release are
@@ -27,6 +28,7 @@ module tb_specfx;
     localparam integer NVEC_MEM = (NVEC > 0) ? NVEC : 1;
     localparam integer NCYC_MEM = (NCYC > 0) ? NCYC : 1;
     localparam integer C_W = `SPECFX_C_W;
+    localparam integer N_W = `SPECFX_N_W;
     localparam integer SLOPE_W = `SPECFX_SLOPE_W;
     localparam integer OFFSET_W = `SPECFX_OFFSET_W;
     localparam integer COEF_W = `SPECFX_COEF_W;
@@ -40,6 +42,7 @@ module tb_specfx;
 
     // ---- Files. ----
     reg [C_W-1:0]      mem_c         [0:NVEC_MEM-1];
+    reg [N_W-1:0]      mem_n         [0:NVEC_MEM-1];
     reg [SLOPE_W-1:0]  mem_slope     [0:NVEC_MEM-1];
     reg [OFFSET_W-1:0] mem_offset    [0:NVEC_MEM-1];
     reg [C_W-1:0]      mem_threshold [0:NVEC_MEM-1];
@@ -52,6 +55,7 @@ module tb_specfx;
     initial begin
         if (NVEC > 0) begin
             $readmemh("in_c.hex", mem_c);
+            $readmemh("in_n.hex", mem_n);
             $readmemh("in_slope.hex", mem_slope);
             $readmemh("in_offset.hex", mem_offset);
             $readmemh("in_threshold.hex", mem_threshold);
@@ -82,6 +86,7 @@ module tb_specfx;
     wire in_valid = !rst && (in_idx < NVEC) && offer;
     wire out_ready = !rst && ((cycle < NCYC) ? stim_ready[cycle] : 1'b1);
     wire [C_W-1:0]      in_c         = (in_idx < NVEC) ? mem_c[in_idx] : {C_W{1'b0}};
+    wire [N_W-1:0]      in_n         = (in_idx < NVEC) ? mem_n[in_idx] : {N_W{1'b0}};
     wire [SLOPE_W-1:0]  in_slope     = (in_idx < NVEC) ? mem_slope[in_idx] : {SLOPE_W{1'b0}};
     wire [OFFSET_W-1:0] in_offset    = (in_idx < NVEC) ? mem_offset[in_idx] : {OFFSET_W{1'b0}};
     wire [C_W-1:0]      in_threshold = (in_idx < NVEC) ? mem_threshold[in_idx] : {C_W{1'b0}};
@@ -97,6 +102,13 @@ module tb_specfx;
         .in_threshold(in_threshold), .in_coef(in_coef),
         .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)
     );
+
+`ifdef SPECFX_VCD
+    initial begin
+        $dumpfile("rtl.vcd");
+        $dumpvars(0, tb_specfx);
+    end
+`endif
 
     // ---- Check. ----
     integer n_passed = 0;

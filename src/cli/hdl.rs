@@ -11,6 +11,7 @@ use super::output::write_atomic;
 use super::sim::parse_probability;
 use super::Outcome;
 use specfx::cycle::sim::{simulate, Stimulus, Stop};
+use specfx::cycle::vcd::write_vcd;
 use specfx::cycle::Arch;
 use specfx::hdl::params_header;
 use specfx::hdl::rom::rom_verilog;
@@ -80,6 +81,10 @@ struct StimulusArgs {
     /// Directory for stim_valid.hex, stim_ready.hex, expected_cycle.hex and stim.json.
     #[arg(long)]
     out: PathBuf,
+    /// Also write the model's VCD trace of this run here (every cycle until the last output,
+    /// under the RTL's names), to compare with the testbench's dump (`specfx trace compare`).
+    #[arg(long)]
+    vcd: Option<PathBuf>,
 }
 
 /// Runs `specfx hdl ...`.
@@ -137,13 +142,14 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
         .collect::<Result<_>>()?;
     let mut stim = Stimulus::new(args.seed, args.bubble, args.stall);
     let limit = 1_000 + items.len() as u64 * 1_000;
+    let trace_cycles = if args.vcd.is_some() { u64::MAX } else { 0 };
     let result = simulate(
         &dp,
         args.arch,
         items.iter().copied(),
         &mut stim,
         Stop::Drained(limit),
-        0,
+        trace_cycles,
     );
     let s = &result.stats;
     if s.n_outputs != items.len() as u64 || s.mismatches != 0 || s.order_errors != 0 {
@@ -184,6 +190,11 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
     let mut json = serde_json::to_vec_pretty(&info)?;
     json.push(b'\n');
     write_atomic(&args.out.join("stim.json"), &json)?;
+    if let Some(path) = &args.vcd {
+        let mut buf = Vec::new();
+        write_vcd(&mut buf, &dp, args.arch, &result.trace)?;
+        write_atomic(path, &buf)?;
+    }
     println!(
         "{} vectors over {} cycles ({}, latency {}..{})",
         items.len(),

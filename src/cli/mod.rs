@@ -22,6 +22,7 @@ mod sim;
 pub mod stability;
 mod sweep;
 mod throughput;
+mod trace;
 pub mod tradeoff;
 pub mod vectors;
 
@@ -51,6 +52,8 @@ enum Command {
     Sim(sim::SimArgs),
     /// Reference Verilog helpers: parameter headers and co-simulation stimulus.
     Hdl(hdl::HdlArgs),
+    /// VCD traces: compares the model's trace with the RTL's, signal by signal.
+    Trace(trace::TraceArgs),
     /// Synthesis cost of a configuration: yosys on the reference Verilog, and the analytic model.
     Cost(cost::CostArgs),
     /// Calibrates the analytic cost model against yosys: a seeded sample synthesised, the
@@ -131,6 +134,7 @@ pub fn main() -> ExitCode {
         Command::Furnace(args) => furnace::run(&args),
         Command::Stability(args) => stability::run(&args),
         Command::Hdl(args) => hdl::run(&args),
+        Command::Trace(args) => trace::run(&args),
         Command::Throughput(args) => throughput::run(&args),
     };
     match result {

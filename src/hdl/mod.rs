@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 
 use crate::cycle::Arch;
 use crate::fixed::{Format, Overflow, Rounding};
-use crate::golden::constant_formats;
+use crate::golden::{constant_formats, n_format};
 use crate::pipeline::{Datapath, StageSpec};
 use crate::reference::lobe::Cutoff;
 
@@ -99,6 +99,7 @@ pub fn params_header(dp: &Datapath, arch: Arch) -> String {
     def("K", cfg.k.to_string());
     def("CUTOFF", cutoff_code(cfg.cutoff).to_string());
     fmt_defs(&mut def, "C", cfg.c.format);
+    def("N_W", n_format(cfg).width().to_string());
     def("D_W", cfg.d.format.width().to_string());
     def("D_F", cfg.d.format.frac_bits().to_string());
     fmt_defs(&mut def, "SLOPE", slope);
