@@ -128,6 +128,15 @@ fn write_comparison(
     if !c.only_first.is_empty() {
         writeln!(w, "  only in {}: {}", files[0], list(&c.only_first))?;
     }
+    if !c.never_known.is_empty() {
+        writeln!(
+            w,
+            "  {} signals never known in {} (x at every cycle, so not checked): {}",
+            c.never_known.len(),
+            files[0],
+            list(&c.never_known)
+        )?;
+    }
     if c.cycles_only_first + c.cycles_only_second > 0 {
         writeln!(
             w,

@@ -71,6 +71,9 @@ pub struct Comparison {
     pub cycles_only_first: u64,
     /// Cycles sampled only in the second file.
     pub cycles_only_second: u64,
+    /// Compared signals that are unknown (`x` or `z` in every bit) in the first file at every
+    /// cycle compared: nothing of them was checked.
+    pub never_known: Vec<String>,
     /// Signals that differ at some cycle.
     pub signals_differing: usize,
     /// The first cycle with a difference.
@@ -440,6 +443,7 @@ pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, 
     let mut seen_b = std::collections::HashSet::new();
     let (mut cycles_compared, mut cycles_only_second) = (0u64, 0u64);
     let mut first_cycle_of = vec![None::<u64>; compared.len()];
+    let mut known = vec![false; compared.len()];
     let mut first_difference: Option<Difference> = None;
     Reader::new(1, pb, &vb, &names).run(&layout, |cycle, b| {
         if !seen_b.insert(cycle) {
@@ -452,6 +456,10 @@ pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, 
         matched[ia] = true;
         cycles_compared += 1;
         let a = &samples_a[ia];
+        for (s, k) in known.iter_mut().enumerate() {
+            let (offset, width) = layout.fields[s];
+            *k = *k || (offset..offset + width as usize).any(|bit| a.get(bit).is_some());
+        }
         let differing: Vec<usize> = (0..compared.len())
             .filter(|&s| differs(a, &b, layout.fields[s].0, layout.fields[s].1))
             .collect();
@@ -484,6 +492,10 @@ pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, 
         cycles_compared,
         cycles_only_first: matched.iter().filter(|&&m| !m).count() as u64,
         cycles_only_second,
+        never_known: (0..compared.len())
+            .filter(|&s| !known[s])
+            .map(|s| names[s].to_string())
+            .collect(),
         signals_differing: first_cycle_of.iter().filter(|c| c.is_some()).count(),
         first_difference,
     })
