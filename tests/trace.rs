@@ -399,7 +399,7 @@ fn a_mutated_rounding_is_found_at_its_first_cycle_and_signal() {
 
     let sq1 = hex_words(&run.work.join("probe_sq1.hex"));
     let sq2 = hex_words(&run.work.join("probe_sq2.hex"));
-    let truncated: Vec<u64> = sq1.iter().map(|&s| s * s >> 16).collect();
+    let truncated: Vec<u64> = sq1.iter().map(|&s| (s * s) >> 16).collect();
     let j = (0..sq1.len())
         .find(|&j| truncated[j] != sq2[j])
         .expect("some square rounds up");

@@ -392,7 +392,7 @@ fn header<R: BufRead>(which: usize, p: &mut vcd::Parser<R>) -> Result<Vec<Var>, 
 /// let model = "$scope module tb_specfx $end $var reg 1 ! clk $end
 /// $var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end $enddefinitions $end
 /// #0 0! b0 \" bx #
-/// #5 1! #6 b1 \" b101 # #10 0! #15 1!";
+/// #5 1! #6 b1 \" b101 # #10 0! #15 1!\n";
 /// let rtl = model.replace("b101", "b100");
 /// let c = compare(model.as_bytes(), rtl.as_bytes()).unwrap();
 /// let d = c.first_difference.unwrap();
@@ -518,7 +518,7 @@ mod tests {
     fn hex_digits_show_unknown_nibbles() {
         let p = Packed {
             value: vec![0b1_0110_1010],
-            unknown: vec![0b0_0000_0000 | 1 << 9],
+            unknown: vec![1 << 9],
         };
         assert_eq!(hex(&p, 0, 9), "16a");
         assert_eq!(hex(&p, 0, 10), "x6a");
