@@ -86,7 +86,10 @@ module tb_specfx;
     wire in_valid = !rst && (in_idx < NVEC) && offer;
     wire out_ready = !rst && ((cycle < NCYC) ? stim_ready[cycle] : 1'b1);
     wire [C_W-1:0]      in_c         = (in_idx < NVEC) ? mem_c[in_idx] : {C_W{1'b0}};
+    // The vector's n, for traces only (the DUT takes the per-n constants, not n).
+    /* verilator lint_off UNUSEDSIGNAL */
     wire [N_W-1:0]      in_n         = (in_idx < NVEC) ? mem_n[in_idx] : {N_W{1'b0}};
+    /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOPE_W-1:0]  in_slope     = (in_idx < NVEC) ? mem_slope[in_idx] : {SLOPE_W{1'b0}};
     wire [OFFSET_W-1:0] in_offset    = (in_idx < NVEC) ? mem_offset[in_idx] : {OFFSET_W{1'b0}};
     wire [C_W-1:0]      in_threshold = (in_idx < NVEC) ? mem_threshold[in_idx] : {C_W{1'b0}};
