@@ -23,7 +23,8 @@ pub struct TraceArgs {
 #[derive(Debug, Subcommand)]
 enum TraceCommand {
     /// Compares two VCD traces of the testbench: the model's first (its `x` bits are
-    /// don't-care), then the RTL's. Exit code 0 when they agree, 1 when they differ.
+    /// don't-care), then the RTL's. Exit code 0 when they agree, 1 when they differ, 2 on bad
+    /// input.
     Compare(CompareArgs),
 }
 
