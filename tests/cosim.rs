@@ -157,64 +157,65 @@ fn a_corrupted_expected_value_fails() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `specfx cosim` with no argument co-simulates the baseline on vectors it writes itself.
 #[test]
-fn rtl_is_lint_clean_for_every_test_configuration() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut files: Vec<PathBuf> = std::fs::read_dir(root.join("hdl_ref/rtl"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "v"))
-        .collect();
-    files.sort();
-    files.push(root.join("hdl_ref/specfx_dut.v"));
-    let configs = [
-        "baseline".to_string(),
-        config_path("narrow_trn_wrap.toml"),
-        config_path("conv_sym_k5.toml"),
-        config_path("minimax_folded.toml"),
-        config_path("pow2_shift.toml"),
-        config_path("lint_bus64.toml"),
-        config_path("lint_bus32.toml"),
-    ];
-    for config in &configs {
-        for arch in ["pipelined", "folded"] {
-            let dir = temp_dir(&format!("lint-{arch}"));
-            std::fs::create_dir_all(&dir).unwrap();
-            let header = dir.join("specfx_params.vh");
-            let o = specfx(&[
-                "hdl",
-                "params",
-                "--config",
-                config,
-                "--arch",
-                arch,
-                "--out",
-                header.to_str().unwrap(),
-            ]);
-            assert!(o.status.success());
-            let lint = Command::new("verilator")
-                .args(["--lint-only", "-Wall", "--top-module", "specfx_dut"])
-                .arg(format!("-I{}", dir.display()))
-                .args(&files)
-                .output()
-                .expect("verilator is installed (./scripts/test installs it)");
-            assert!(
-                lint.status.success() && lint.stderr.is_empty(),
-                "{config} {arch}: {}",
-                String::from_utf8_lossy(&lint.stderr)
-            );
-            let icarus = Command::new("iverilog")
-                .args(["-g2005", "-o", "/dev/null"])
-                .arg(format!("-I{}", dir.display()))
-                .args(&files)
-                .output()
-                .expect("iverilog is installed (./scripts/test installs it)");
-            assert!(
-                icarus.status.success(),
-                "{config} {arch}: {}",
-                String::from_utf8_lossy(&icarus.stderr)
-            );
-            std::fs::remove_dir_all(&dir).unwrap();
-        }
+fn cosim_defaults_lead_to_an_answer() {
+    let o = specfx(&["cosim"]);
+    let (passed, failed) = summary(&o);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The default cases: every n of the baseline's 16..1024 has corner cases, plus 1000 random.
+    assert!(passed > 1009 + 1000 && failed == 0, "{passed} passed");
+}
+
+/// RESET_DATA = 1 (data registers cleared on reset) matches in both simulators and both
+/// architectures, with the top linted under its parameters first; the testbench then also
+/// checks out_data = 0 right after reset.
+#[test]
+fn reset_data_variant_matches_and_is_lint_clean() {
+    let (dir, n) = vectors(
+        &config_path("minimax_folded.toml"),
+        "reset",
+        "corner,random:100",
+    );
+    for (sim, arch) in [("icarus", "pipelined"), ("verilator", "folded")] {
+        let o = specfx(&[
+            "cosim",
+            "--vectors",
+            dir.to_str().unwrap(),
+            "--sim",
+            sim,
+            "--arch",
+            arch,
+            "--reset-data",
+            "--lint",
+        ]);
+        assert_eq!(summary(&o), (n, 0), "{sim} {arch}");
+        assert!(o.status.success());
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A simulator that is not installed is named with the package that has it: one line, exit 2.
+#[test]
+fn a_missing_simulator_is_named_with_its_package() {
+    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args(["cosim", "--sim", "icarus"])
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("iverilog and vvp not found on PATH")
+            && err.contains("apt-get install -y iverilog"),
+        "{err}"
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .arg("cosim")
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no Verilog simulator"));
 }

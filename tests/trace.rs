@@ -1,13 +1,13 @@
 //! Traces: the model's VCD (`specfx hdl stimulus --vcd`) against the testbench's dump of the
-//! same run in Icarus Verilog and Verilator, compared with `specfx trace compare` signal by
-//! signal; a mutated RTL found at its first differing cycle and signal; the comparison's rules
-//! on hand-written traces.
+//! same run in Icarus Verilog and Verilator (`specfx cosim --vcd`), compared with
+//! `specfx trace compare` signal by signal; a mutated RTL found at its first differing cycle
+//! and signal; the comparison's rules on hand-written traces.
 
 mod common;
 use common::specfx;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use specfx::cycle::compare::{compare, Comparison};
 
@@ -43,17 +43,9 @@ fn ok(o: &Output) {
     );
 }
 
-/// One co-simulation run prepared as `scripts/cosim` prepares it: the vectors, the header, the
-/// stimulus and the model's trace `model.vcd` in `work`.
-struct Run {
-    work: PathBuf,
-    n_vectors: u64,
-    n_cycles: u64,
-}
-
-/// Vectors of `config` (its first, a middle and its last exponent, so that the corner cases
-/// stay few), then everything else `scripts/cosim` writes.
-fn write_vectors(config: &str, cases: &str, out: &Path) {
+/// Vectors of `config` in `dir/vectors` (its first, a middle and its last exponent, so that
+/// the corner cases stay few); returns the directory and the number of vectors.
+fn write_vectors(config: &str, cases: &str, dir: &Path) -> (PathBuf, u64) {
     let dp = specfx::pipeline::Datapath::new(match config {
         "baseline" => specfx::pipeline::Config::baseline(),
         path => {
@@ -63,6 +55,7 @@ fn write_vectors(config: &str, cases: &str, out: &Path) {
     .unwrap();
     let ns = dp.config().n.values();
     let n = format!("{},{},{}", ns[0], ns[ns.len() / 2], ns[ns.len() - 1]);
+    let out = dir.join("vectors");
     ok(&specfx(&[
         "vectors",
         "--config",
@@ -76,88 +69,77 @@ fn write_vectors(config: &str, cases: &str, out: &Path) {
         "--out",
         out.to_str().unwrap(),
     ]));
+    let n_vectors = json(&out.join("manifest.json"))["n_vectors"]
+        .as_u64()
+        .unwrap();
+    (out, n_vectors)
 }
 
-fn prepare(config: &str, name: &str, arch: &str, cases: &str, bubble: &str, stall: &str) -> Run {
-    let work = temp_dir(name);
-    let vectors = work.join("vectors");
-    write_vectors(config, cases, &vectors);
-    let v = vectors.to_str().unwrap();
-    ok(&specfx(&[
-        "hdl",
-        "params",
-        "--vectors",
-        v,
-        "--arch",
-        arch,
-        "--out",
-        work.join("specfx_params.vh").to_str().unwrap(),
-    ]));
-    ok(&specfx(&[
-        "hdl",
-        "stimulus",
-        "--vectors",
-        v,
-        "--arch",
-        arch,
-        "--seed",
-        "7",
-        "--bubble",
-        bubble,
-        "--stall",
-        stall,
-        "--out",
-        work.to_str().unwrap(),
-        "--vcd",
-        work.join("model.vcd").to_str().unwrap(),
-    ]));
-    for entry in std::fs::read_dir(&vectors).unwrap() {
-        let p = entry.unwrap().path();
-        if p.extension().is_some_and(|e| e == "hex") {
-            std::fs::copy(&p, work.join(p.file_name().unwrap())).unwrap();
+/// One co-simulation with both traces: `specfx cosim --vcd dir/traces`.
+struct Cosim<'a> {
+    vectors: &'a Path,
+    sim: &'a str,
+    arch: &'a str,
+    bubble: &'a str,
+    stall: &'a str,
+    hdl_ref: Option<&'a Path>,
+    reset_data: bool,
+}
+
+impl Cosim<'_> {
+    fn run(&self, traces: &Path) -> Output {
+        let mut args = vec![
+            "cosim",
+            "--vectors",
+            self.vectors.to_str().unwrap(),
+            "--sim",
+            self.sim,
+            "--arch",
+            self.arch,
+            "--seed",
+            "7",
+            "--bubble",
+            self.bubble,
+            "--stall",
+            self.stall,
+            "--vcd",
+            traces.to_str().unwrap(),
+        ];
+        if let Some(h) = self.hdl_ref {
+            args.extend(["--hdl-ref", h.to_str().unwrap()]);
         }
+        if self.reset_data {
+            args.push("--reset-data");
+        }
+        specfx(&args)
     }
-    Run {
-        n_vectors: json(&vectors.join("manifest.json"))["n_vectors"]
-            .as_u64()
-            .unwrap(),
-        n_cycles: json(&work.join("stim.json"))["n_cycles"].as_u64().unwrap(),
-        work,
+
+    /// The number of cycles of the run, from `specfx hdl stimulus` with the same arguments
+    /// (whose model trace must be the one `cosim` wrote, byte for byte).
+    fn stimulus_cycles(&self, dir: &Path, model_vcd: &Path) -> u64 {
+        let out = dir.join("stimulus");
+        let vcd = dir.join("stimulus.vcd");
+        ok(&specfx(&[
+            "hdl",
+            "stimulus",
+            "--vectors",
+            self.vectors.to_str().unwrap(),
+            "--arch",
+            self.arch,
+            "--seed",
+            "7",
+            "--bubble",
+            self.bubble,
+            "--stall",
+            self.stall,
+            "--out",
+            out.to_str().unwrap(),
+            "--vcd",
+            vcd.to_str().unwrap(),
+        ]));
+        assert!(std::fs::read(&vcd).unwrap() == std::fs::read(model_vcd).unwrap());
+        json(&out.join("stim.json"))["n_cycles"].as_u64().unwrap()
     }
-}
-
-fn sources(hdl: &Path) -> Vec<PathBuf> {
-    let mut rtl: Vec<PathBuf> = std::fs::read_dir(hdl.join("rtl"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "v"))
-        .collect();
-    rtl.sort();
-    let mut v = vec![hdl.join("tb/tb_specfx.v"), hdl.join("specfx_dut.v")];
-    v.extend(rtl);
-    v
-}
-
-/// Runs the testbench of `hdl` in Icarus Verilog with the dump on; returns its output (the
-/// dump is `run.work/rtl.vcd`).
-fn icarus(run: &Run, hdl: &Path) -> String {
-    let o = Command::new("iverilog")
-        .args(["-g2005", "-s", "tb_specfx", "-DSPECFX_VCD", "-o"])
-        .arg(run.work.join("tb.vvp"))
-        .arg(format!("-I{}", run.work.display()))
-        .arg(format!("-DSPECFX_NVEC={}", run.n_vectors))
-        .arg(format!("-DSPECFX_NCYC={}", run.n_cycles))
-        .args(sources(hdl))
-        .output()
-        .expect("iverilog is installed (./scripts/test installs it)");
-    ok(&o);
-    let o = Command::new("vvp")
-        .args(["-n", "tb.vvp"])
-        .current_dir(&run.work)
-        .output()
-        .expect("vvp runs");
-    ok(&o);
-    String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
 fn compare_files(a: &Path, b: &Path) -> Comparison {
@@ -266,26 +248,48 @@ fn expected_registers(arch: &str, k: u32, lat: (u32, u32, u32)) -> Vec<String> {
     v
 }
 
-/// The model's trace and Icarus's dump of one run agree, through the binary and the library;
-/// every cycle of the run is compared, every signal of the model's trace is in the dump and
-/// known on some cycle, the model holds every register the RTL source declares and every
-/// register Icarus dumps under the core.
+/// The model's trace and Icarus's dump of one run agree, through `specfx cosim --vcd` and the
+/// library; every cycle of the run is compared, every signal of the model's trace is in the
+/// dump and known on some cycle, the model holds every register the RTL source declares and
+/// every register Icarus dumps under the core.
 fn check_agree(config: &str, name: &str, arch: &str, k: u32, lat: (u32, u32, u32)) {
-    let run = prepare(config, name, arch, "corner,random:150", "0.3", "0.3");
-    let summary = icarus(&run, &root().join("hdl_ref"));
-    assert!(
-        summary.contains(&format!("{} passed, 0 failed", run.n_vectors)),
-        "{summary}"
-    );
-    let (model, rtl) = (run.work.join("model.vcd"), run.work.join("rtl.vcd"));
-    let o = trace_compare(&model, &rtl);
+    check_agree_with(config, name, arch, k, lat, false)
+}
+
+fn check_agree_with(
+    config: &str,
+    name: &str,
+    arch: &str,
+    k: u32,
+    lat: (u32, u32, u32),
+    reset_data: bool,
+) {
+    let dir = temp_dir(name);
+    let (vectors, n_vectors) = write_vectors(config, "corner,random:150", &dir);
+    let cosim = Cosim {
+        vectors: &vectors,
+        sim: "icarus",
+        arch,
+        bubble: "0.3",
+        stall: "0.3",
+        hdl_ref: None,
+        reset_data,
+    };
+    let traces = dir.join("traces");
+    let o = cosim.run(&traces);
     ok(&o);
     let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.starts_with(&format!("{n_vectors} passed, 0 failed\ncompared ")),
+        "{text}"
+    );
     assert!(text.ends_with("traces agree\n"), "{text}");
+    let (model, rtl) = (traces.join("model.vcd"), traces.join("rtl.vcd"));
+    let n_cycles = cosim.stimulus_cycles(&dir, &model);
 
     let c = compare_files(&model, &rtl);
     assert!(c.agrees(), "{c:?}");
-    assert_eq!(c.cycles_compared, run.n_cycles, "every cycle of the run");
+    assert_eq!(c.cycles_compared, n_cycles, "every cycle of the run");
     assert_eq!((c.cycles_only_first, c.cycles_only_second), (0, 0));
     assert!(c.only_first.is_empty(), "{:?}", c.only_first);
     assert!(c.never_known.is_empty(), "{:?}", c.never_known);
@@ -304,8 +308,8 @@ fn check_agree(config: &str, name: &str, arch: &str, k: u32, lat: (u32, u32, u32
         assert!(model_vars.contains(&format!("tb_specfx.{tb}")));
     }
     // Every register Icarus dumps in the core (but the combinational `always @*` result of
-    // the folded step multiplexer and functions' variables) is in the model's trace.
-    let dumped: Vec<String> = variables(&rtl)
+    // the folded step multiplexer and functions' variables) is in the model's trace ...
+    let mut dumped: Vec<String> = variables(&rtl)
         .into_iter()
         .filter(|(n, t, in_function)| {
             n.starts_with(&core)
@@ -328,10 +332,9 @@ fn check_agree(config: &str, name: &str, arch: &str, k: u32, lat: (u32, u32, u32
         .map(|r| format!("{core}{r}"))
         .collect();
     want.sort();
-    let mut dumped = dumped;
     dumped.sort();
     assert_eq!(dumped, want, "{name}");
-    std::fs::remove_dir_all(&run.work).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -342,6 +345,13 @@ fn baseline_pipelined_traces_agree() {
 #[test]
 fn baseline_folded_traces_agree() {
     check_agree("baseline", "base-f", "folded", 4, (1, 1, 1));
+}
+
+/// With RESET_DATA = 1 the RTL's empty registers hold 0 instead of x: still don't-care.
+#[test]
+fn reset_data_traces_agree() {
+    check_agree_with("baseline", "reset-p", "pipelined", 4, (1, 1, 1), true);
+    check_agree_with("baseline", "reset-f", "folded", 4, (1, 1, 1), true);
 }
 
 /// Latencies above 1 (every register inside the delay lines), signed stages, the paper
@@ -377,15 +387,16 @@ fn hex_words(path: &Path) -> Vec<u64> {
 /// sub, mul_t, add_b, square 1, square 2) during cycle j + 5.
 #[test]
 fn a_mutated_rounding_is_found_at_its_first_cycle_and_signal() {
-    let run = prepare("baseline", "mutant", "pipelined", "random:300", "0", "0");
-    let hdl = run.work.join("hdl_ref");
-    let status = Command::new("cp")
-        .arg("-r")
-        .arg(root().join("hdl_ref"))
-        .arg(&hdl)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let dir = temp_dir("mutant");
+    let (vectors, _) = write_vectors("baseline", "random:300", &dir);
+    let hdl = dir.join("hdl_ref");
+    for sub in ["rtl", "tb"] {
+        std::fs::create_dir_all(hdl.join(sub)).unwrap();
+        for entry in std::fs::read_dir(root().join("hdl_ref").join(sub)).unwrap() {
+            let p = entry.unwrap().path();
+            std::fs::copy(&p, hdl.join(sub).join(p.file_name().unwrap())).unwrap();
+        }
+    }
     let path = hdl.join("rtl/specfx_pipelined.v");
     let text = std::fs::read_to_string(&path).unwrap();
     let original = ".Y_RND(sq_field(SQ_RND, i, 0))";
@@ -395,10 +406,21 @@ fn a_mutated_rounding_is_found_at_its_first_cycle_and_signal() {
         text.replace(original, ".Y_RND((i == 2) ? 0 : sq_field(SQ_RND, i, 0))"),
     )
     .unwrap();
-    icarus(&run, &hdl);
+    let traces = dir.join("traces");
+    let o = Cosim {
+        vectors: &vectors,
+        sim: "icarus",
+        arch: "pipelined",
+        bubble: "0",
+        stall: "0",
+        hdl_ref: Some(&hdl),
+        reset_data: false,
+    }
+    .run(&traces);
+    assert_eq!(o.status.code(), Some(1));
 
-    let sq1 = hex_words(&run.work.join("probe_sq1.hex"));
-    let sq2 = hex_words(&run.work.join("probe_sq2.hex"));
+    let sq1 = hex_words(&vectors.join("probe_sq1.hex"));
+    let sq2 = hex_words(&vectors.join("probe_sq2.hex"));
     let truncated: Vec<u64> = sq1.iter().map(|&s| (s * s) >> 16).collect();
     let j = (0..sq1.len())
         .find(|&j| truncated[j] != sq2[j])
@@ -407,7 +429,7 @@ fn a_mutated_rounding_is_found_at_its_first_cycle_and_signal() {
     assert!(j > 0);
     let cycle = j + 5;
     let signal = "tb_specfx.dut.g_pipelined.u_core.g_square[2].y_q";
-    let (model, rtl) = (run.work.join("model.vcd"), run.work.join("rtl.vcd"));
+    let (model, rtl) = (traces.join("model.vcd"), traces.join("rtl.vcd"));
     let o = trace_compare(&model, &rtl);
     assert_eq!(o.status.code(), Some(1));
     let out = String::from_utf8_lossy(&o.stdout);
@@ -421,12 +443,11 @@ fn a_mutated_rounding_is_found_at_its_first_cycle_and_signal() {
     assert!(out.starts_with(&want), "want {want}got {out}");
     assert!(out.contains("g_square[2].r_square.g_regs.g_stage[0].r"));
     assert!(out.ends_with("TRACES DIFFER\n"));
-    std::fs::remove_dir_all(&run.work).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// Verilator's dump (`--trace`, through `scripts/cosim --vcd`) agrees with the model's too.
-/// Verilator stops dumping before the edge that ends the last cycle, so that one cycle is
-/// sampled only in the model's trace.
+/// Verilator's dump (`--trace`) agrees with the model's too. Verilator stops dumping before
+/// the edge that ends the last cycle, so that one cycle is sampled only in the model's trace.
 #[test]
 fn verilator_traces_agree() {
     for (config, arch) in [
@@ -434,21 +455,20 @@ fn verilator_traces_agree() {
         (config_path("conv_sym_k5.toml"), "pipelined"),
     ] {
         let dir = temp_dir(&format!("verilator-{arch}"));
-        let vectors = dir.join("vectors");
-        write_vectors(&config, "random:120", &vectors);
+        let (vectors, n) = write_vectors(&config, "random:120", &dir);
         let traces = dir.join("traces");
-        let o = Command::new(root().join("scripts/cosim"))
-            .args(["--vectors", vectors.to_str().unwrap(), "--sim", "verilator"])
-            .args(["--arch", arch, "--bubble", "0.3", "--stall", "0.3"])
-            .args(["--vcd", traces.to_str().unwrap()])
-            .env("SPECFX", env!("CARGO_BIN_EXE_specfx"))
-            .output()
-            .expect("scripts/cosim runs");
+        let o = Cosim {
+            vectors: &vectors,
+            sim: "verilator",
+            arch,
+            bubble: "0.3",
+            stall: "0.3",
+            hdl_ref: None,
+            reset_data: false,
+        }
+        .run(&traces);
         ok(&o);
         let out = String::from_utf8_lossy(&o.stdout);
-        let n = json(&vectors.join("manifest.json"))["n_vectors"]
-            .as_u64()
-            .unwrap();
         assert!(out.contains(&format!("{n} passed, 0 failed")), "{out}");
         assert!(out.contains("traces agree"), "{out}");
         let c = compare_files(&traces.join("model.vcd"), &traces.join("rtl.vcd"));

@@ -3,6 +3,7 @@
 // it to 0: CUTOFF 0 (clamp) when the sum is negative; 1 (paper) when the clamped input is below
 // the per-n threshold code (c_clamped < threshold, both in c's format); 2 (none) never.
 // The result is quantized to B with B_RND and B_OVF. Combinational.
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_add_b #(

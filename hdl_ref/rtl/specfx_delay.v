@@ -4,6 +4,7 @@
 // the synchronous, active-high `rst` (used for valid bits); RESET = 0 ignores `rst`.
 // The stage modules are combinational; each is followed by one of these, as the Rust cycle
 // model (src/cycle/) places `lat` registers after each operation (docs/cycle.md).
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_delay #(

@@ -2,6 +2,7 @@
 // zero-extending it otherwise, so that the wider code stands for the same value.
 // OUT_W must be at least IN_W. (A helper of the stage modules; no Rust counterpart: in
 // src/fixed the raws live in i64/i128.)
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_extend #(

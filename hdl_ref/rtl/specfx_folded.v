@@ -14,7 +14,9 @@
 // Latency (K + 2) * LAT_MUL + 1 cycles to the output register; initiation interval
 // (K + 2) * LAT_MUL cycles.
 //
-// Parameters as specfx_pipelined (formats, packed squaring-stage vectors, mode codes).
+// Parameters as specfx_pipelined (formats, packed squaring-stage vectors, mode codes,
+// RESET_DATA).
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_folded #(
@@ -54,7 +56,8 @@ module specfx_folded #(
     parameter integer OUT_S    = 0,
     parameter integer OUT_RND  = 2,
     parameter integer OUT_OVF  = 1,
-    parameter integer LAT_MUL  = 1
+    parameter integer LAT_MUL  = 1,
+    parameter integer RESET_DATA = 0
 ) (
     input  wire                clk,
     input  wire                rst,
@@ -269,17 +272,27 @@ module specfx_folded #(
         end
     end
 
-    // ---- Data registers (no reset). ----
+    // ---- Data registers (reset only when RESET_DATA = 1). ----
     always @(posedge clk) begin
-        if (step_done) x <= step_result;
-        if (out_load) out_data <= out_q;
-        if (in_fire) begin
-            x           <= d_x;
-            slope_r     <= in_slope;
-            offset_r    <= in_offset;
-            threshold_r <= in_threshold;
-            c_cl_r      <= c_cl_in;
-            coef_r      <= in_coef;
+        if (RESET_DATA != 0 && rst) begin
+            x           <= {X_W{1'b0}};
+            out_data    <= {OUT_W{1'b0}};
+            slope_r     <= {SLOPE_W{1'b0}};
+            offset_r    <= {OFFSET_W{1'b0}};
+            threshold_r <= {C_W{1'b0}};
+            c_cl_r      <= {C_W{1'b0}};
+            coef_r      <= {COEF_W{1'b0}};
+        end else begin
+            if (step_done) x <= step_result;
+            if (out_load) out_data <= out_q;
+            if (in_fire) begin
+                x           <= d_x;
+                slope_r     <= in_slope;
+                offset_r    <= in_offset;
+                threshold_r <= in_threshold;
+                c_cl_r      <= c_cl_in;
+                coef_r      <= in_coef;
+            end
         end
     end
 endmodule

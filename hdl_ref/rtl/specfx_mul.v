@@ -4,6 +4,7 @@
 // the low P_W bits of the product (specfx_folded, where each step reads only the bits of its
 // own exact product). The fraction bits of the product are the sum of the operands' (the
 // caller knows them). Rust: the `i128` products of src/pipeline/datapath.rs `eval`.
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_mul #(
@@ -17,11 +18,20 @@ module specfx_mul #(
     input  wire [B_W-1:0] b,
     output wire [P_W-1:0] p
 );
-    // Both operands as signed values one bit wider, then a signed multiply in P_W bits.
+    // Both operands as signed values one bit wider, then a signed multiply in M_W bits: P_W,
+    // or the wider operand's width when P_W is narrower (specfx_folded, a one-bit factor
+    // beside a wide operand). Its low P_W bits are the same either way.
+    localparam integer AB_W = ((A_W > B_W) ? A_W : B_W) + 1;
+    localparam integer M_W = (P_W > AB_W) ? P_W : AB_W;
     wire signed [A_W:0] a_x = {(A_S != 0) & a[A_W-1], a};
     wire signed [B_W:0] b_x = {(B_S != 0) & b[B_W-1], b};
-    wire signed [P_W-1:0] product = a_x * b_x;
-    assign p = product;
+    wire signed [M_W-1:0] product = a_x * b_x;
+    assign p = product[P_W-1:0];
+    generate
+        if (M_W > P_W) begin : g_unused
+            wire _unused_ok = &{1'b0, product[M_W-1:P_W]};
+        end
+    endgenerate
 endmodule
 
 `default_nettype wire

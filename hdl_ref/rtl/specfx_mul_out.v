@@ -2,6 +2,7 @@
 // `eval`). The last square x (X_W bits, X_F fraction bits) times the per-n coefficient (COEF_W
 // bits, COEF_F fraction bits): the exact product has X_F + COEF_F fraction bits and is
 // quantized to OUT with OUT_RND and OUT_OVF. Combinational.
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_mul_out #(

@@ -5,6 +5,7 @@
 // SLOPE_POW2 = 1 (plain variant, every n a power of two, so the slope is one-hot): the product
 // is d shifted left by the position of the slope's one bit, a multiplexer instead of a
 // multiplier, equal to d * slope for every one-hot slope.
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_mul_t #(

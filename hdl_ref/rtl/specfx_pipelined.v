@@ -15,7 +15,9 @@
 // 16 bits per stage: stage i (1..7) in bits [16*i-1:16*(i-1)]; F fields are two's complement.
 // Rounding codes: 0 TRN, 1 TRN_ZERO, 2 RND, 3 RND_ZERO, 4 RND_INF, 5 RND_MIN_INF, 6 RND_CONV,
 // 7 RND_CONV_ODD. Overflow codes: 0 WRAP, 1 SAT, 2 SAT_ZERO, 3 SAT_SYM. Cutoff codes: 0 clamp,
-// 1 paper, 2 none.
+// 1 paper, 2 none. RESET_DATA = 1 clears the data registers on rst too (else only the valid
+// bits reset).
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_pipelined #(
@@ -58,7 +60,8 @@ module specfx_pipelined #(
     parameter integer OUT_OVF  = 1,
     parameter integer LAT_SUB  = 1,
     parameter integer LAT_MUL  = 1,
-    parameter integer LAT_ADD  = 1
+    parameter integer LAT_ADD  = 1,
+    parameter integer RESET_DATA = 0
 ) (
     input  wire                clk,
     input  wire                rst,
@@ -120,7 +123,9 @@ module specfx_pipelined #(
     wire [OFFSET_W-1:0] offset_1;
     wire [C_W-1:0]      threshold_1;
     wire [COEF_W-1:0]   coef_1;
-    specfx_delay #(.W(D_W + 2 * C_W + SLOPE_W + OFFSET_W + COEF_W), .LAT(LAT_SUB)) r_sub (
+    specfx_delay #(
+        .W(D_W + 2 * C_W + SLOPE_W + OFFSET_W + COEF_W), .LAT(LAT_SUB), .RESET(RESET_DATA)
+    ) r_sub (
         .clk(clk), .rst(rst), .en(advance),
         .d({in_coef, in_threshold, in_offset, in_slope, c_cl_0, d_0}),
         .q({coef_1, threshold_1, offset_1, slope_1, c_cl_1, d_1})
@@ -140,7 +145,7 @@ module specfx_pipelined #(
     wire [OFFSET_W-1:0] offset_2;
     wire [C_W-1:0]      threshold_2;
     wire [COEF_W-1:0]   coef_2;
-    specfx_delay #(.W(T_W + 2 * C_W + OFFSET_W + COEF_W), .LAT(LAT_MUL)) r_mul_t (
+    specfx_delay #(.W(T_W + 2 * C_W + OFFSET_W + COEF_W), .LAT(LAT_MUL), .RESET(RESET_DATA)) r_mul_t (
         .clk(clk), .rst(rst), .en(advance),
         .d({coef_1, threshold_1, offset_1, c_cl_1, t_1}),
         .q({coef_2, threshold_2, offset_2, c_cl_2, t_2})
@@ -165,7 +170,7 @@ module specfx_pipelined #(
     // the buses' widths are 16, 32 or 64 bits (a false positive, but a failed lint).
     wire [COEF_W-1:0] coef_b;
     wire [B_W-1:0]    b_q;
-    specfx_delay #(.W(B_W + COEF_W), .LAT(LAT_ADD)) r_add_b (
+    specfx_delay #(.W(B_W + COEF_W), .LAT(LAT_ADD), .RESET(RESET_DATA)) r_add_b (
         .clk(clk), .rst(rst), .en(advance),
         .d({coef_2, b_2}),
         .q({coef_b, b_q})
@@ -189,7 +194,7 @@ module specfx_pipelined #(
             ) u_square (
                 .x(chain[chain_off(i - 1) +: X_W]), .y(y)
             );
-            specfx_delay #(.W(Y_W + COEF_W), .LAT(LAT_MUL)) r_square (
+            specfx_delay #(.W(Y_W + COEF_W), .LAT(LAT_MUL), .RESET(RESET_DATA)) r_square (
                 .clk(clk), .rst(rst), .en(advance),
                 .d({coefs[(i-1)*COEF_W +: COEF_W], y}),
                 .q({coef_q, y_q})
@@ -208,7 +213,7 @@ module specfx_pipelined #(
     ) u_mul_out (
         .x(chain[chain_off(K) +: chain_w(K)]), .coef(coefs[K*COEF_W +: COEF_W]), .out(out_k)
     );
-    specfx_delay #(.W(OUT_W), .LAT(LAT_MUL)) r_mul_out (
+    specfx_delay #(.W(OUT_W), .LAT(LAT_MUL), .RESET(RESET_DATA)) r_mul_out (
         .clk(clk), .rst(rst), .en(advance), .d(out_k), .q(out_data)
     );
 endmodule

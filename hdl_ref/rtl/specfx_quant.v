@@ -14,6 +14,7 @@
 // ac_fixed, every value <= min, min itself included, gives min | 1; unsigned formats as SAT).
 //
 // Purely combinational; every intermediate is exact (Verilog vectors of any width).
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_quant #(

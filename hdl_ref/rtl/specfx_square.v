@@ -2,6 +2,7 @@
 // stages of src/pipeline/datapath.rs `eval`; sq_0 = b). The input x has X_W bits, X_F fraction
 // bits; the exact square has 2 X_F fraction bits (e.g. u1.16 x u1.16 -> u2.32) and is
 // quantized to Y with Y_RND and Y_OVF. Combinational.
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_square #(

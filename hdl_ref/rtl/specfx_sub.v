@@ -3,6 +3,7 @@
 // 1.0 = 1 << C_F (inputs above 1.0 become 1.0), then d = (c_clamped - one) << (D_F - C_F),
 // exact in the signed format D (D_W bits, D_F fraction bits; validated by the Rust model:
 // C_F >= 0, D_F >= C_F, and D holds c - 1 for every input). Combinational.
+`timescale 1ns / 1ps
 `default_nettype none
 
 module specfx_sub #(

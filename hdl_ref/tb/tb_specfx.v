@@ -1,42 +1,64 @@
-// tb_specfx: co-simulation testbench of specfx_dut against the golden vectors of
+// tb_specfx: co-simulation testbench of specfx_top against the golden vectors of
 // `specfx vectors` and the stimulus of `specfx hdl stimulus` (docs/cycle.md).
 //
 // Reads from the current directory ($readmemh): in_c.hex, in_n.hex, in_slope.hex,
-// in_offset.hex, in_threshold.hex, in_coef.hex, expected_out.hex (one word per vector), stim_valid.hex,
-// stim_ready.hex (one bit per cycle) and expected_cycle.hex (one 32-bit word per vector).
-// Macros: specfx_params.vh (formats), SPECFX_NVEC (vectors) and SPECFX_NCYC (lines of the
-// stimulus files), given on the command line (-D).
+// in_offset.hex, in_threshold.hex, in_coef.hex, expected_out.hex (one word per vector),
+// stim_valid.hex, stim_ready.hex (one bit per cycle) and expected_cycle.hex (one 32-bit word
+// per vector). Parameters (set per run: iverilog -Ptb_specfx.<NAME>=<value>, verilator
+// -G<NAME>=<value>; `specfx hdl params --format iverilog --top tb_specfx` prints them):
+// NVEC (vectors), NCYC (lines of the stimulus files) and every parameter of specfx_top, passed
+// to the DUT instance `dut`. Defining SPECFX_VCD dumps every signal to rtl.vcd.
 //
 // During cycle t (cycle 0 is the first after reset): in_valid = (vectors left) &&
-// stim_valid[t], out_ready = stim_ready[t] (both 1 past the end of the files). On each output
+// stim_valid[t], out_ready = stim_ready[t] (both 1 past the end of the files); the input ports
+// show the next vector also while in_valid is low (zeros after the last). On each output
 // transfer, out_data is compared with expected_out[i] and the cycle with expected_cycle[i]; a
 // vector passes when both match. The run stops when every output has arrived, or at a
 // timeout (the missing outputs count as failed). A change of out_data or a drop of out_valid
 // while out_valid is high and out_ready low (docs/cycle.md, rule 5) counts as one more
-// failure. Prints the first 10 mismatches, then exactly one line `N passed, N failed`.
-// With SPECFX_VCD defined, dumps every signal to rtl.vcd (Verilator: also --trace).
-`include "specfx_params.vh"
+// failure, and so does, with RESET_DATA = 1, an out_data other than 0 in cycle 0. Prints the
+// first 10 mismatches, then exactly one line `N passed, N failed`.
+`timescale 1ns / 1ps
 `default_nettype none
 // A testbench: blocking counters in the clocked checker and a nonblocking reset release are
 // intended (the DUT only sees signals that change after a clock edge).
 /* verilator lint_off BLKSEQ */
 /* verilator lint_off INITIALDLY */
 
-module tb_specfx;
-    localparam integer NVEC = `SPECFX_NVEC;
-    localparam integer NCYC = `SPECFX_NCYC;
+module tb_specfx #(
+    parameter integer NVEC = 1, parameter integer NCYC = 1,
+    parameter integer ARCH = 0, parameter integer K = 4, parameter integer CUTOFF = 0,
+    parameter integer C_W = 16, parameter integer C_F = 15, parameter integer C_S = 0,
+    parameter integer D_W = 16, parameter integer D_F = 15, parameter integer SLOPE_W = 11,
+    parameter integer SLOPE_F = 4, parameter integer SLOPE_S = 0, parameter integer SLOPE_POW2 = 0,
+    parameter integer OFFSET_W = 1, parameter integer OFFSET_F = 0, parameter integer OFFSET_S = 0,
+    parameter integer T_W = 18, parameter integer T_F = 16, parameter integer T_S = 1,
+    parameter integer T_RND = 2, parameter integer T_OVF = 1, parameter integer B_W = 17,
+    parameter integer B_F = 16, parameter integer B_S = 0, parameter integer B_RND = 2,
+    parameter integer B_OVF = 1, parameter integer SQ1_W = 17, parameter integer SQ1_F = 16,
+    parameter integer SQ1_S = 0, parameter integer SQ1_RND = 2, parameter integer SQ1_OVF = 1,
+    parameter integer SQ2_W = 17, parameter integer SQ2_F = 16, parameter integer SQ2_S = 0,
+    parameter integer SQ2_RND = 2, parameter integer SQ2_OVF = 1, parameter integer SQ3_W = 17,
+    parameter integer SQ3_F = 16, parameter integer SQ3_S = 0, parameter integer SQ3_RND = 2,
+    parameter integer SQ3_OVF = 1, parameter integer SQ4_W = 17, parameter integer SQ4_F = 16,
+    parameter integer SQ4_S = 0, parameter integer SQ4_RND = 2, parameter integer SQ4_OVF = 1,
+    parameter integer SQ5_W = 17, parameter integer SQ5_F = 16, parameter integer SQ5_S = 0,
+    parameter integer SQ5_RND = 2, parameter integer SQ5_OVF = 1, parameter integer SQ6_W = 17,
+    parameter integer SQ6_F = 16, parameter integer SQ6_S = 0, parameter integer SQ6_RND = 2,
+    parameter integer SQ6_OVF = 1, parameter integer SQ7_W = 17, parameter integer SQ7_F = 16,
+    parameter integer SQ7_S = 0, parameter integer SQ7_RND = 2, parameter integer SQ7_OVF = 1,
+    parameter integer COEF_W = 24, parameter integer COEF_F = 16, parameter integer COEF_S = 0,
+    parameter integer OUT_W = 24, parameter integer OUT_F = 16, parameter integer OUT_S = 0,
+    parameter integer OUT_RND = 2, parameter integer OUT_OVF = 1, parameter integer LAT_SUB = 1,
+    parameter integer LAT_MUL = 1, parameter integer LAT_ADD = 1, parameter integer RESET_DATA = 0
+);
     localparam integer NVEC_MEM = (NVEC > 0) ? NVEC : 1;
     localparam integer NCYC_MEM = (NCYC > 0) ? NCYC : 1;
-    localparam integer C_W = `SPECFX_C_W;
-    localparam integer N_W = `SPECFX_N_W;
-    localparam integer SLOPE_W = `SPECFX_SLOPE_W;
-    localparam integer OFFSET_W = `SPECFX_OFFSET_W;
-    localparam integer COEF_W = `SPECFX_COEF_W;
-    localparam integer OUT_W = `SPECFX_OUT_W;
+    // in_n is not a DUT port (the per-n constants are); the testbench shows it in traces.
+    localparam integer N_W = 32;
     // Past the stimulus every cycle offers and accepts, so each vector needs at most one
     // initiation interval; the slack covers the latency.
-    localparam integer PER_VECTOR = (`SPECFX_K + 2) * (`SPECFX_LAT_MUL) + (`SPECFX_LAT_SUB)
-                                  + (`SPECFX_LAT_ADD) + 2;
+    localparam integer PER_VECTOR = (K + 2) * LAT_MUL + LAT_SUB + LAT_ADD + 2;
     localparam integer TIMEOUT = NCYC + (NVEC + 8) * PER_VECTOR + 1000;
     localparam integer MAX_SHOWN = 10;
 
@@ -86,10 +108,7 @@ module tb_specfx;
     wire in_valid = !rst && (in_idx < NVEC) && offer;
     wire out_ready = !rst && ((cycle < NCYC) ? stim_ready[cycle] : 1'b1);
     wire [C_W-1:0]      in_c         = (in_idx < NVEC) ? mem_c[in_idx] : {C_W{1'b0}};
-    // The vector's n, for traces only (the DUT takes the per-n constants, not n).
-    /* verilator lint_off UNUSEDSIGNAL */
     wire [N_W-1:0]      in_n         = (in_idx < NVEC) ? mem_n[in_idx] : {N_W{1'b0}};
-    /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOPE_W-1:0]  in_slope     = (in_idx < NVEC) ? mem_slope[in_idx] : {SLOPE_W{1'b0}};
     wire [OFFSET_W-1:0] in_offset    = (in_idx < NVEC) ? mem_offset[in_idx] : {OFFSET_W{1'b0}};
     wire [C_W-1:0]      in_threshold = (in_idx < NVEC) ? mem_threshold[in_idx] : {C_W{1'b0}};
@@ -98,7 +117,21 @@ module tb_specfx;
     wire out_valid;
     wire [OUT_W-1:0] out_data;
 
-    specfx_dut dut (
+    specfx_top #(
+        .ARCH(ARCH), .K(K), .CUTOFF(CUTOFF), .C_W(C_W), .C_F(C_F), .C_S(C_S), .D_W(D_W), .D_F(D_F),
+        .SLOPE_W(SLOPE_W), .SLOPE_F(SLOPE_F), .SLOPE_S(SLOPE_S), .SLOPE_POW2(SLOPE_POW2), .OFFSET_W(OFFSET_W),
+        .OFFSET_F(OFFSET_F), .OFFSET_S(OFFSET_S), .T_W(T_W), .T_F(T_F), .T_S(T_S), .T_RND(T_RND),
+        .T_OVF(T_OVF), .B_W(B_W), .B_F(B_F), .B_S(B_S), .B_RND(B_RND), .B_OVF(B_OVF), .SQ1_W(SQ1_W),
+        .SQ1_F(SQ1_F), .SQ1_S(SQ1_S), .SQ1_RND(SQ1_RND), .SQ1_OVF(SQ1_OVF), .SQ2_W(SQ2_W),
+        .SQ2_F(SQ2_F), .SQ2_S(SQ2_S), .SQ2_RND(SQ2_RND), .SQ2_OVF(SQ2_OVF), .SQ3_W(SQ3_W),
+        .SQ3_F(SQ3_F), .SQ3_S(SQ3_S), .SQ3_RND(SQ3_RND), .SQ3_OVF(SQ3_OVF), .SQ4_W(SQ4_W),
+        .SQ4_F(SQ4_F), .SQ4_S(SQ4_S), .SQ4_RND(SQ4_RND), .SQ4_OVF(SQ4_OVF), .SQ5_W(SQ5_W),
+        .SQ5_F(SQ5_F), .SQ5_S(SQ5_S), .SQ5_RND(SQ5_RND), .SQ5_OVF(SQ5_OVF), .SQ6_W(SQ6_W),
+        .SQ6_F(SQ6_F), .SQ6_S(SQ6_S), .SQ6_RND(SQ6_RND), .SQ6_OVF(SQ6_OVF), .SQ7_W(SQ7_W),
+        .SQ7_F(SQ7_F), .SQ7_S(SQ7_S), .SQ7_RND(SQ7_RND), .SQ7_OVF(SQ7_OVF), .COEF_W(COEF_W),
+        .COEF_F(COEF_F), .COEF_S(COEF_S), .OUT_W(OUT_W), .OUT_F(OUT_F), .OUT_S(OUT_S), .OUT_RND(OUT_RND),
+        .OUT_OVF(OUT_OVF), .LAT_SUB(LAT_SUB), .LAT_MUL(LAT_MUL), .LAT_ADD(LAT_ADD), .RESET_DATA(RESET_DATA)
+    ) dut (
         .clk(clk), .rst(rst),
         .in_valid(in_valid), .in_ready(in_ready),
         .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),
@@ -129,6 +162,12 @@ module tb_specfx;
 
     always @(posedge clk) begin
         if (!rst) begin
+            if (RESET_DATA != 0 && cycle == 0 && out_data !== {OUT_W{1'b0}}) begin
+                n_failed = n_failed + 1;
+                if (n_shown < MAX_SHOWN)
+                    $display("protocol: out_data=%h after reset with RESET_DATA=1, want 0", out_data);
+                n_shown = n_shown + 1;
+            end
             if (held && (!out_valid || out_data !== held_data)) begin
                 n_failed = n_failed + 1;
                 if (n_shown < MAX_SHOWN)

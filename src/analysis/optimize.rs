@@ -209,7 +209,9 @@ impl FromStr for Budget {
                 (Metric::ShapeTotal | Metric::ShapeQuant, u) if u.starts_with("lsb") => {
                     let bits: i32 = u[3..]
                         .parse()
-                        .map_err(|_| bad(part, "lsbN needs a number N"))?;
+                        .ok()
+                        .filter(|b| (1..=64).contains(b))
+                        .ok_or_else(|| bad(part, "lsbN needs a number N in 1..=64"))?;
                     value * (-f64::from(bits)).exp2()
                 }
                 (Metric::Out | Metric::OutTotal, "ulp" | "") => value,
@@ -224,6 +226,15 @@ impl FromStr for Budget {
                     ))
                 }
             };
+            if !value.is_finite() || value < 0.0 {
+                return Err(bad(part, "the limit must be a finite number >= 0"));
+            }
+            if metric == Metric::Correct && limit > 1.0 {
+                return Err(bad(part, "a share of inputs is at most 100%"));
+            }
+            if metric == Metric::EffectiveBits && limit > 64.0 {
+                return Err(bad(part, "effective bits are at most 64"));
+            }
             bounds.push(Bound { metric, limit });
         }
         Ok(Budget {

@@ -81,13 +81,19 @@ fn space_error(key: &str, problem: String) -> Error {
 }
 
 /// Expands `"10..=16"` (or `"10..16"`, both ends included) into integers; other values stay.
+/// The most values one axis may take.
+pub const MAX_AXIS_VALUES: usize = 257;
+
+/// The most points a space may hold (every point is checked exhaustively).
+pub const MAX_POINTS: u64 = 1 << 20;
+
 fn expand(key: &str, v: &toml::Value) -> Result<Vec<toml::Value>, Error> {
     match v {
         toml::Value::Array(items) => {
-            if items.is_empty() {
+            if items.is_empty() || items.len() > MAX_AXIS_VALUES {
                 return Err(space_error(
                     &format!("vary.{key}"),
-                    "expected at least one value".into(),
+                    format!("expected 1..={MAX_AXIS_VALUES} values, got {}", items.len()),
                 ));
             }
             Ok(items.clone())
@@ -104,10 +110,15 @@ fn expand(key: &str, v: &toml::Value) -> Result<Vec<toml::Value>, Error> {
                 })
             };
             let (lo, hi) = (parse(lo)?, parse(hi)?);
-            if lo > hi || hi - lo > 256 {
+            if hi
+                .checked_sub(lo)
+                .is_none_or(|d| !(0..MAX_AXIS_VALUES as i64).contains(&d))
+            {
                 return Err(space_error(
                     &format!("vary.{key}"),
-                    format!("expected an ascending range of at most 257 values, got \"{s}\""),
+                    format!(
+                        "expected an ascending range of at most {MAX_AXIS_VALUES} values, got \"{s}\""
+                    ),
                 ));
             }
             Ok((lo..=hi).map(toml::Value::Integer).collect())
@@ -174,6 +185,25 @@ impl Space {
                 .map_err(|e: Error| space_error("target", e.to_string()))?,
             None => default_target(),
         };
+        let points = axes
+            .values()
+            .try_fold(1u64, |acc, v| acc.checked_mul(v.len() as u64))
+            .filter(|&p| p <= MAX_POINTS);
+        if points.is_none() {
+            let sizes: Vec<String> = axes
+                .iter()
+                .map(|(k, v)| format!("{k} {}", v.len()))
+                .collect();
+            return Err(space_error(
+                "vary",
+                format!(
+                    "expected at most {MAX_POINTS} points (the product of the axes' lengths), got {} ({})",
+                    axes.values()
+                        .fold(1u128, |acc, v| acc.saturating_mul(v.len() as u128)),
+                    sizes.join(" x ")
+                ),
+            ));
+        }
         let space = Space { base, axes, target };
         // Every value must at least be of the right kind for its axis.
         for (key, values) in &space.axes {

@@ -26,7 +26,11 @@ pub struct MethodFigures {
     pub max_abs_err: f64,
     /// Mean over n and over the c grid of |method - cos^n|.
     pub mean_abs_err: f64,
-    /// Software evaluations per second, single thread, measured in this run.
+    /// Software evaluations per second, single thread, measured in this run. A measurement of
+    /// this machine, not a property of the method: it is kept out of the JSON (and of every file
+    /// but `measured_speed.csv` and the `measured_speed_accuracy` chart), so that the other
+    /// outputs are byte-identical from run to run.
+    #[serde(skip)]
     pub evals_per_s: f64,
     /// Multipliers of a hardware implementation (None: needs a divider, exp or log unit).
     pub multipliers: Option<u32>,

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 
 use specfx::nset::NSet;
 use specfx::pipeline::{Config, Datapath};
@@ -20,16 +20,17 @@ pub fn load(arg: &str, n: Option<&NSet>) -> Result<Datapath> {
             config_from_manifest(path)?
         }
         None => {
-            let text = std::fs::read_to_string(path).with_context(|| {
-                format!("config {arg}: cannot read it (and it is not a built-in name: baseline)")
-            })?;
+            if !path.exists() {
+                bail!("config {arg}: no such file (and it is not a built-in name: baseline)");
+            }
+            let text = super::input::read_text(path, &format!("config {arg}"))?;
             let mut config = Config::from_toml(&text).with_context(|| format!("config {arg}"))?;
             let names_itself = text
                 .parse::<toml::Table>()
                 .is_ok_and(|t| t.contains_key("name"));
             if !names_itself {
                 if let Some(stem) = path.file_stem() {
-                    config.name = stem.to_string_lossy().into_owned();
+                    config.name = specfx::pipeline::config::name_from(&stem.to_string_lossy());
                 }
             }
             config
@@ -48,8 +49,7 @@ pub fn config_from_manifest(path: &Path) -> Result<Config> {
     } else {
         path.to_path_buf()
     };
-    let text = std::fs::read_to_string(&file)
-        .with_context(|| format!("cannot read {}", file.display()))?;
+    let text = super::input::read_text(&file, &file.display().to_string())?;
     let value: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("{}: not JSON", file.display()))?;
     let config = value

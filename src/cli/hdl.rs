@@ -13,8 +13,8 @@ use super::Outcome;
 use specfx::cycle::sim::{simulate, Stimulus, Stop};
 use specfx::cycle::vcd::write_vcd;
 use specfx::cycle::Arch;
-use specfx::hdl::params_header;
 use specfx::hdl::rom::rom_verilog;
+use specfx::hdl::{render_parameters, ParamsFormat};
 
 /// Arguments of `specfx hdl`.
 #[derive(Debug, Args)]
@@ -25,7 +25,8 @@ pub struct HdlArgs {
 
 #[derive(Debug, Subcommand)]
 enum HdlCommand {
-    /// Prints the `specfx_params.vh` header (Verilog `define macros) of a configuration.
+    /// Prints the values of `specfx_top`'s Verilog parameters for a configuration: the
+    /// `specfx_params.vh` header of `specfx_dut.v`, JSON, simulator flags or an instance.
     Params(ParamsArgs),
     /// Prints the per-n constant ROM (`specfx_rom.v`) of a configuration: a `case` on n (a
     /// contiguous n range) or on the index of n in the set (a list, e.g. a fitted scene's).
@@ -46,7 +47,19 @@ struct ParamsArgs {
     /// Microarchitecture: pipelined or folded.
     #[arg(long, default_value = "pipelined")]
     arch: Arch,
-    /// Write the header here instead of printing it.
+    /// How to render the parameters of `specfx_top`: define (the `specfx_params.vh` header of
+    /// `specfx_dut.v`), json, iverilog (`-P` flags), verilator (`-G` flags) or instance (a
+    /// Verilog instantiation).
+    #[arg(long, default_value = "define")]
+    format: ParamsFormat,
+    /// The module whose parameters the iverilog `-P` flags set.
+    #[arg(long, default_value = "specfx_top")]
+    top: String,
+    /// Clear the data registers on reset too (`RESET_DATA = 1`), so out_data is 0 until the
+    /// first result.
+    #[arg(long)]
+    reset_data: bool,
+    /// Write the parameters here instead of printing them.
     #[arg(long)]
     out: Option<PathBuf>,
 }
@@ -118,7 +131,8 @@ fn params(args: &ParamsArgs) -> Result<Outcome> {
         Some(dir) => super::datapath::load(&dir.to_string_lossy(), None)?,
         None => super::datapath::load(&args.config, None)?,
     };
-    print_or_write(args.out.as_deref(), &params_header(&dp, args.arch))
+    let text = render_parameters(&dp, args.arch, args.reset_data, args.format, &args.top);
+    print_or_write(args.out.as_deref(), &text)
 }
 
 fn bits_file(bits: &[bool]) -> String {
@@ -127,8 +141,29 @@ fn bits_file(bits: &[bool]) -> String {
         .collect()
 }
 
-fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
-    let dir: &Path = &args.vectors;
+/// What [`write_stimulus`] wrote: the run's size and latency range.
+pub struct StimulusInfo {
+    /// Vectors streamed.
+    pub n_vectors: usize,
+    /// Lines of `stim_valid.hex` and `stim_ready.hex`.
+    pub n_cycles: u64,
+    /// Shortest and longest input-to-output latency of the run, in cycles.
+    pub latency: (u64, u64),
+}
+
+/// Writes the co-simulation stimulus of a vector directory into `out`: `stim_valid.hex`,
+/// `stim_ready.hex`, `expected_cycle.hex` and `stim.json`, from the cycle model run on the
+/// vectors in file order under seeded bubbles and stalls; with `vcd`, also the model's trace
+/// of that run (every cycle until the last output transfers) to that file.
+pub fn write_stimulus(
+    dir: &Path,
+    arch: Arch,
+    seed: u64,
+    bubble: f64,
+    stall: f64,
+    out: &Path,
+    vcd: Option<&Path>,
+) -> Result<StimulusInfo> {
     let dp = super::datapath::load(&dir.to_string_lossy(), None)?;
     let rows = super::datapath::vector_inputs(dir)?;
     let ns = dp.config().n.values();
@@ -140,12 +175,12 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
             })
         })
         .collect::<Result<_>>()?;
-    let mut stim = Stimulus::new(args.seed, args.bubble, args.stall);
+    let mut stim = Stimulus::new(seed, bubble, stall);
     let limit = 1_000 + items.len() as u64 * 1_000;
-    let trace_cycles = if args.vcd.is_some() { u64::MAX } else { 0 };
+    let trace_cycles = if vcd.is_some() { u64::MAX } else { 0 };
     let result = simulate(
         &dp,
-        args.arch,
+        arch,
         items.iter().copied(),
         &mut stim,
         Stop::Drained(limit),
@@ -160,28 +195,27 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
             s.mismatches
         );
     }
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut cycles = String::new();
     for o in &result.outputs {
         writeln!(cycles, "{:08x}", o.cycle).expect("write to String");
     }
     write_atomic(
-        &args.out.join("stim_valid.hex"),
+        &out.join("stim_valid.hex"),
         bits_file(&result.valid_bits).as_bytes(),
     )?;
     write_atomic(
-        &args.out.join("stim_ready.hex"),
+        &out.join("stim_ready.hex"),
         bits_file(&result.ready_bits).as_bytes(),
     )?;
-    write_atomic(&args.out.join("expected_cycle.hex"), cycles.as_bytes())?;
+    write_atomic(&out.join("expected_cycle.hex"), cycles.as_bytes())?;
     let info = serde_json::json!({
-        "arch": args.arch.name(),
-        "latency": args.arch.latency(dp.config()),
-        "initiation_interval": args.arch.initiation_interval(dp.config()),
-        "seed": args.seed,
-        "bubble": args.bubble,
-        "stall": args.stall,
+        "arch": arch.name(),
+        "latency": arch.latency(dp.config()),
+        "initiation_interval": arch.initiation_interval(dp.config()),
+        "seed": seed,
+        "bubble": bubble,
+        "stall": stall,
         "n_cycles": s.n_cycles,
         "n_vectors": items.len(),
         "latency_min": s.latency_min,
@@ -189,19 +223,32 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
     });
     let mut json = serde_json::to_vec_pretty(&info)?;
     json.push(b'\n');
-    write_atomic(&args.out.join("stim.json"), &json)?;
-    if let Some(path) = &args.vcd {
+    write_atomic(&out.join("stim.json"), &json)?;
+    if let Some(path) = vcd {
         let mut buf = Vec::new();
-        write_vcd(&mut buf, &dp, args.arch, &result.trace)?;
+        write_vcd(&mut buf, &dp, arch, &result.trace)?;
         write_atomic(path, &buf)?;
     }
+    Ok(StimulusInfo {
+        n_vectors: items.len(),
+        n_cycles: s.n_cycles,
+        latency: (s.latency_min, s.latency_max),
+    })
+}
+
+fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
+    let s = write_stimulus(
+        &args.vectors,
+        args.arch,
+        args.seed,
+        args.bubble,
+        args.stall,
+        &args.out,
+        args.vcd.as_deref(),
+    )?;
     println!(
         "{} vectors over {} cycles ({}, latency {}..{})",
-        items.len(),
-        s.n_cycles,
-        args.arch,
-        s.latency_min,
-        s.latency_max
+        s.n_vectors, s.n_cycles, args.arch, s.latency.0, s.latency.1
     );
     Ok(Outcome::Ok)
 }

@@ -6,11 +6,13 @@
 pub mod budget;
 mod calibrate;
 mod check;
+mod cosim;
 pub mod cost;
 mod datapath;
 pub mod fit;
 pub mod furnace;
 mod hdl;
+mod input;
 mod optimize;
 mod output;
 mod paper;
@@ -52,6 +54,9 @@ enum Command {
     Sim(sim::SimArgs),
     /// Reference Verilog helpers: parameter headers and co-simulation stimulus.
     Hdl(hdl::HdlArgs),
+    /// Co-simulates the reference Verilog against golden vectors and the cycle model's output
+    /// cycles, in Icarus Verilog or Verilator (bit and cycle exact, under bubbles and stalls).
+    Cosim(cosim::CosimArgs),
     /// VCD traces: compares the model's trace with the RTL's, signal by signal.
     Trace(trace::TraceArgs),
     /// Synthesis cost of a configuration: yosys on the reference Verilog, and the analytic model.
@@ -87,6 +92,41 @@ enum Command {
     Throughput(throughput::ThroughputArgs),
 }
 
+/// clap's whole error message on one line: the error, the missing arguments' names, the
+/// "did you mean" tips and possible values, without the usage block and the `--help` footer.
+///
+/// # Examples
+/// (in the unit tests below)
+fn one_line(text: &str) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        if !line.is_empty() {
+            parts.push(line.to_string());
+        }
+    }
+    let mut out = String::new();
+    for (i, p) in parts.iter().enumerate() {
+        if i > 0 {
+            // A list under a line ending in ':' continues it; anything else is a new clause.
+            out.push_str(if parts[i - 1].ends_with(':') {
+                " "
+            } else {
+                "; "
+            });
+        }
+        out.push_str(p);
+    }
+    if out.is_empty() {
+        "bad arguments".to_string()
+    } else {
+        out
+    }
+}
+
 /// What a command reports back besides errors.
 pub enum Outcome {
     /// Everything ran and every check passed.
@@ -108,9 +148,7 @@ pub fn main() -> ExitCode {
             e.exit()
         }
         Err(e) => {
-            // One line: clap's first, without its "For more information" footer.
-            let text = e.to_string();
-            eprintln!("specfx: {}", text.lines().next().unwrap_or("bad arguments"));
+            eprintln!("specfx: {}", one_line(&e.render().to_string()));
             return ExitCode::from(2);
         }
     };
@@ -122,6 +160,7 @@ pub fn main() -> ExitCode {
         Command::Minimax(args) => reference::run_minimax(&args),
         Command::Vectors(args) => vectors::run(&args),
         Command::Sim(args) => sim::run(&args),
+        Command::Cosim(args) => cosim::run(&args),
         Command::Cost(args) => cost::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Timing(args) => pnr::run(&args),
@@ -144,6 +183,43 @@ pub fn main() -> ExitCode {
         Err(err) => {
             eprintln!("specfx: error: {err:#}");
             ExitCode::from(2)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clap_errors_keep_names_and_tips_on_one_line() {
+        let err = |args: &[&str]| {
+            let e = Cli::try_parse_from(std::iter::once("specfx").chain(args.iter().copied()))
+                .expect_err("bad arguments");
+            one_line(&e.render().to_string())
+        };
+        let missing = err(&["vectors"]);
+        assert!(
+            missing.contains("were not provided: --out <OUT>"),
+            "{missing}"
+        );
+        let typo = err(&["vectors", "--fo"]);
+        assert!(
+            typo.contains("unexpected argument '--fo'") && typo.contains("'--force'"),
+            "{typo}"
+        );
+        let sub = err(&["vectorz"]);
+        assert!(
+            sub.contains("'vectorz'") && sub.contains("'vectors'"),
+            "{sub}"
+        );
+        let value = err(&["cosim", "--sim", "foo"]);
+        assert!(
+            value.contains("[possible values: icarus, verilator]"),
+            "{value}"
+        );
+        for e in [missing, typo, sub, value] {
+            assert!(!e.contains('\n') && !e.contains("Usage"), "{e}");
         }
     }
 }

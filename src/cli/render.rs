@@ -200,11 +200,18 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(match path {
         None => Scene::default_scene(),
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("scene {}: cannot read it", path.display()))?;
+            let text = super::input::read_text(path, &format!("scene {}", path.display()))?;
             // Mesh files are named relative to the scene file.
             let dir = path.parent().map(|d| d.to_path_buf()).unwrap_or_default();
-            let load = |file: &str| std::fs::read(dir.join(file));
+            let load = |file: &str| {
+                let p = dir.join(file);
+                super::input::read_bytes(
+                    &p,
+                    &p.display().to_string(),
+                    super::input::MAX_BINARY_BYTES,
+                )
+                .map_err(|e| std::io::Error::other(format!("{e:#}")))
+            };
             Scene::from_toml_with(&text, &load)
                 .with_context(|| format!("scene {}", path.display()))?
         }

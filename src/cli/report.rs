@@ -177,19 +177,16 @@ fn write_index(
     }
     writeln!(w, "</table></div>")?;
     writeln!(w, "<h2>Error against hardware cost</h2><p>Each fixed-point datapath of the trade-off (plain k = 4 at 8, 12 and 16 fraction bits; minimax k = 3..6) by its lobe error in lsb8 against the calibrated analytic cost on each target (<a href=\"tradeoff/tradeoff.csv\">tradeoff.csv</a>; the model and its calibration error: <code>docs/cost.md</code>).</p><img src=\"tradeoff/error_vs_luts_ice40.png\" alt=\"error against iCE40 LUTs\"><img src=\"tradeoff/error_vs_dsps_ice40.png\" alt=\"error against iCE40 DSPs\"><img src=\"tradeoff/error_vs_luts_xilinx.png\" alt=\"error against Xilinx LUTs\"><img src=\"tradeoff/error_vs_latency.png\" alt=\"error against latency\">")?;
-    writeln!(w, "<h2>Speed against accuracy</h2><img src=\"tradeoff/speed_accuracy.png\" alt=\"speed against accuracy\"><img src=\"tradeoff/error_vs_n.png\" alt=\"error against n\">")?;
+    writeln!(w, "<h2>Speed against accuracy</h2><p>Software speed is measured in this run on this machine (one core), so the chart and <a href=\"tradeoff/measured_speed.csv\">measured_speed.csv</a> differ from run to run; every other file of the report is the same on every run.</p><img src=\"tradeoff/measured_speed_accuracy.png\" alt=\"speed against accuracy (measured)\"><img src=\"tradeoff/error_vs_n.png\" alt=\"error against n\">")?;
     writeln!(
         w,
-        "<div class=\"table\"><table><tr><th>method</th><th>max |err|</th><th>mean |err|</th><th>Meval/s</th></tr>"
+        "<div class=\"table\"><table><tr><th>method</th><th>max |err|</th><th>mean |err|</th></tr>"
     )?;
     for f in figures {
         writeln!(
             w,
-            "<tr><td>{}</td><td>{:.3e}</td><td>{:.3e}</td><td>{:.1}</td></tr>",
-            f.method,
-            f.max_abs_err,
-            f.mean_abs_err,
-            f.evals_per_s / 1e6
+            "<tr><td>{}</td><td>{:.3e}</td><td>{:.3e}</td></tr>",
+            f.method, f.max_abs_err, f.mean_abs_err
         )?;
     }
     writeln!(w, "</table></div>")?;
@@ -359,7 +356,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         yosys_present.then_some(specfx::hdl::cost::Target::Ice40),
     )?;
     written.push(tradeoff_dir.join("tradeoff.csv"));
-    written.push(tradeoff_dir.join("speed_accuracy.png"));
+    written.push(tradeoff_dir.join("measured_speed_accuracy.png"));
     written.push(tradeoff_dir.join("error_vs_n.png"));
     for (_, stem) in specfx::report::tradeoff::CostAxis::CHARTS {
         written.push(tradeoff_dir.join(format!("{stem}.png")));

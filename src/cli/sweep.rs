@@ -67,8 +67,8 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
     let space = match &args.space {
         None => Space::builtin(),
         Some(space_path) => {
-            let text = fs::read_to_string(space_path)
-                .with_context(|| format!("cannot read {}", space_path.display()))?;
+            let text =
+                super::input::read_text(space_path, &format!("space {}", space_path.display()))?;
             Space::from_toml(&text).with_context(|| format!("space {}", space_path.display()))?
         }
     };

@@ -3,7 +3,7 @@
 
 use std::fs::File;
 use std::io::{BufReader, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
@@ -48,13 +48,19 @@ pub fn run(args: &TraceArgs) -> Result<Outcome> {
 }
 
 fn run_compare(args: &CompareArgs) -> Result<Outcome> {
-    let paths = [&args.first, &args.second];
-    let open = |p: &PathBuf| -> Result<BufReader<File>> {
+    compare_files(&args.first, &args.second)
+}
+
+/// Compares two trace files (the model's first) and prints the comparison: `Ok` when they
+/// agree, `CheckFailed` when they differ, an error naming the file when one cannot be read.
+pub fn compare_files(first: &Path, second: &Path) -> Result<Outcome> {
+    let paths = [first, second];
+    let open = |p: &Path| -> Result<BufReader<File>> {
         Ok(BufReader::new(
             File::open(p).with_context(|| format!("cannot read {}", p.display()))?,
         ))
     };
-    let (a, b) = (open(paths[0])?, open(paths[1])?);
+    let (a, b) = (open(first)?, open(second)?);
     let c = match compare(a, b) {
         Ok(c) => c,
         Err(Error::Trace { which, problem }) => {
@@ -62,10 +68,7 @@ fn run_compare(args: &CompareArgs) -> Result<Outcome> {
         }
         Err(e) => return Err(e.into()),
     };
-    let names = [
-        args.first.display().to_string(),
-        args.second.display().to_string(),
-    ];
+    let names = [first.display().to_string(), second.display().to_string()];
     print_with(|w| write_comparison(w, &c, &names))?;
     Ok(if c.agrees() {
         Outcome::Ok

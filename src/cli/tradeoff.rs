@@ -87,20 +87,19 @@ pub fn tradeoff(
     let mut csv = Vec::new();
     writeln!(
         csv,
-        "method,kind,max_abs_err,max_err_lsb8,mean_abs_err,evals_per_s,multipliers,ice40_luts,ice40_dsps,ice40_ffs,xilinx_luts,xilinx_dsps,xilinx_ffs,generic_gates,generic_ffs,latency,yosys_target,yosys_luts,yosys_dsps,yosys_ffs"
+        "method,kind,max_abs_err,max_err_lsb8,mean_abs_err,multipliers,ice40_luts,ice40_dsps,ice40_ffs,xilinx_luts,xilinx_dsps,xilinx_ffs,generic_gates,generic_ffs,latency,yosys_target,yosys_luts,yosys_dsps,yosys_ffs"
     )?;
     let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
     let cost = |f: &MethodFigures, t: Target| f.costs.iter().find(|c| c.target == t).copied();
     for f in &figures {
         writeln!(
             csv,
-            "{},{},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{:e},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             f.method,
             f.kind,
             f.max_abs_err,
             f.max_abs_err / specfx::analysis::LSB8,
             f.mean_abs_err,
-            f.evals_per_s,
             opt(f.multipliers.map(u64::from)),
             opt(cost(f, Target::Ice40).map(|c| c.luts)),
             opt(cost(f, Target::Ice40).map(|c| c.dsps)),
@@ -124,7 +123,18 @@ pub fn tradeoff(
     for (axis, stem) in CostAxis::CHARTS {
         write_chart(dir, stem, &cost_chart(&figures, axis))?;
     }
-    write_chart(dir, "speed_accuracy", &speed_chart(&figures))?;
+    // Wall-clock measurements of this run, apart: every other file is the same on every run.
+    let mut speed = Vec::new();
+    writeln!(speed, "method,kind,evals_per_s,max_abs_err")?;
+    for f in &figures {
+        writeln!(
+            speed,
+            "{},{},{:e},{:e}",
+            f.method, f.kind, f.evals_per_s, f.max_abs_err
+        )?;
+    }
+    write_atomic(&dir.join("measured_speed.csv"), &speed)?;
+    write_chart(dir, "measured_speed_accuracy", &speed_chart(&figures))?;
     write_chart(
         dir,
         "error_vs_n",

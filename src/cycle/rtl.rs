@@ -20,8 +20,11 @@
 //! constants from [`Datapath::constants`].
 
 use crate::cycle::{Arch, Op, RegisterView, Token, Word};
-use crate::golden::{constant_formats, n_format};
+use crate::golden::constant_formats;
 use crate::pipeline::Datapath;
+
+/// The width of the testbench's `in_n` (`tb_specfx.v`'s `N_W`).
+pub const TESTBENCH_N_W: u32 = 32;
 
 /// The scope of the core below the DUT (`specfx_dut`'s generate block and instance).
 pub fn core_scope(arch: Arch) -> &'static str {
@@ -37,7 +40,8 @@ pub fn core_scope(arch: Arch) -> &'static str {
 pub struct Widths {
     /// `c`, `in_c` and `in_threshold`.
     pub c: u32,
-    /// The testbench's `in_n`.
+    /// The testbench's `in_n` (32 bits, whatever the largest n: `in_n.hex` words are
+    /// zero-extended).
     pub n: u32,
     /// `in_slope`.
     pub slope: u32,
@@ -65,7 +69,7 @@ impl Widths {
     /// use specfx::cycle::rtl::Widths;
     /// use specfx::pipeline::{Config, Datapath};
     /// let w = Widths::of(&Datapath::new(Config::baseline()).unwrap());
-    /// assert_eq!((w.c, w.n, w.slope, w.offset, w.coef, w.out), (16, 11, 11, 1, 24, 24));
+    /// assert_eq!((w.c, w.n, w.slope, w.offset, w.coef, w.out), (16, 32, 11, 1, 24, 24));
     /// assert_eq!(w.folded_x(), 18);
     /// ```
     pub fn of(dp: &Datapath) -> Widths {
@@ -73,7 +77,7 @@ impl Widths {
         let (slope, offset) = constant_formats(cfg);
         Widths {
             c: cfg.c.format.width(),
-            n: n_format(cfg).width(),
+            n: TESTBENCH_N_W,
             slope: slope.width(),
             offset: offset.width(),
             coef: cfg.coef.format.width(),

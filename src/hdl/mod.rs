@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 
 use crate::cycle::Arch;
 use crate::fixed::{Format, Overflow, Rounding};
-use crate::golden::{constant_formats, n_format};
+use crate::golden::constant_formats;
 use crate::pipeline::{Datapath, StageSpec};
 use crate::reference::lobe::Cutoff;
 
@@ -50,17 +50,88 @@ pub fn cutoff_code(c: Cutoff) -> u32 {
     }
 }
 
-/// One 112-bit vector of seven 16-bit fields, stage 1 in the low field.
-fn packed(values: impl Iterator<Item = i64>) -> String {
-    let mut fields = [0u16; 7];
-    for (i, v) in values.enumerate() {
-        fields[i] = v as u16;
+/// The most squaring stages (`SQ1_*` .. `SQ7_*` parameters of `specfx_top`).
+pub const MAX_SQUARES: usize = 7;
+
+/// The values of `hdl_ref/rtl/specfx_top.v`'s parameters for a configuration and an
+/// architecture, in the module's order: `ARCH`, `K`, `CUTOFF`, the formats (`<X>_W`, `<X>_F`,
+/// `<X>_S`), modes (`<X>_RND`, `<X>_OVF`), the seven squaring stages `SQ1_*` .. `SQ7_*` (stages
+/// above k are 0), `LAT_SUB`, `LAT_MUL`, `LAT_ADD` and `RESET_DATA` (1 when `reset_data`).
+///
+/// # Examples
+/// ```
+/// use specfx::cycle::Arch;
+/// use specfx::hdl::top_parameters;
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let p = top_parameters(&dp, Arch::Folded, false);
+/// assert_eq!(p[0], ("ARCH".to_string(), 1));
+/// assert!(p.contains(&("SQ4_W".to_string(), 17)) && p.contains(&("SQ5_W".to_string(), 0)));
+/// ```
+pub fn top_parameters(dp: &Datapath, arch: Arch, reset_data: bool) -> Vec<(String, i64)> {
+    let cfg = dp.config();
+    let (slope, offset) = constant_formats(cfg);
+    let mut p: Vec<(String, i64)> = Vec::new();
+    let mut def = |name: &str, value: i64| p.push((name.to_string(), value));
+    let format = |def: &mut dyn FnMut(&str, i64), x: &str, f: Format| {
+        def(&format!("{x}_W"), i64::from(f.width()));
+        def(&format!("{x}_F"), i64::from(f.frac_bits()));
+        def(&format!("{x}_S"), i64::from(f.is_signed()));
+    };
+    let modes = |def: &mut dyn FnMut(&str, i64), x: &str, s: Option<&StageSpec>| {
+        def(
+            &format!("{x}_RND"),
+            s.map_or(0, |s| i64::from(rounding_code(s.rounding))),
+        );
+        def(
+            &format!("{x}_OVF"),
+            s.map_or(0, |s| i64::from(overflow_code(s.overflow))),
+        );
+    };
+    def(
+        "ARCH",
+        match arch {
+            Arch::Pipelined => 0,
+            Arch::Folded => 1,
+        },
+    );
+    def("K", i64::from(cfg.k));
+    def("CUTOFF", i64::from(cutoff_code(cfg.cutoff)));
+    format(&mut def, "C", cfg.c.format);
+    def("D_W", i64::from(cfg.d.format.width()));
+    def("D_F", i64::from(cfg.d.format.frac_bits()));
+    format(&mut def, "SLOPE", slope);
+    def("SLOPE_POW2", i64::from(slope_is_pow2(cfg)));
+    format(&mut def, "OFFSET", offset);
+    format(&mut def, "T", cfg.t.format);
+    modes(&mut def, "T", Some(&cfg.t));
+    format(&mut def, "B", cfg.b.format);
+    modes(&mut def, "B", Some(&cfg.b));
+    for i in 0..MAX_SQUARES {
+        let x = format!("SQ{}", i + 1);
+        match cfg.square.get(i) {
+            Some(s) => format(&mut def, &x, s.format),
+            None => {
+                for f in ["W", "F", "S"] {
+                    def(&format!("{x}_{f}"), 0);
+                }
+            }
+        }
+        modes(&mut def, &x, cfg.square.get(i));
     }
-    let hex: String = fields.iter().rev().map(|f| format!("{f:04x}")).collect();
-    format!("112'h{hex}")
+    format(&mut def, "COEF", cfg.coef.format);
+    format(&mut def, "OUT", cfg.out.format);
+    modes(&mut def, "OUT", Some(&cfg.out));
+    def("LAT_SUB", i64::from(cfg.latency.sub));
+    def("LAT_MUL", i64::from(cfg.latency.mul));
+    def("LAT_ADD", i64::from(cfg.latency.add));
+    def("RESET_DATA", i64::from(reset_data));
+    p
 }
 
-/// The `specfx_params.vh` header of a configuration for one architecture.
+/// The `specfx_params.vh` header of a configuration for one architecture: one
+/// `` `define SPECFX_<NAME> <value> `` per parameter of [`top_parameters`] (data registers
+/// without reset), for `hdl_ref/specfx_dut.v`.
 ///
 /// # Examples
 /// ```
@@ -69,76 +140,24 @@ fn packed(values: impl Iterator<Item = i64>) -> String {
 /// use specfx::pipeline::{Config, Datapath};
 /// let h = params_header(&Datapath::new(Config::baseline()).unwrap(), Arch::Pipelined);
 /// assert!(h.contains("`define SPECFX_T_W 18\n"));
-/// assert!(h.contains("`define SPECFX_SQ_W 112'h0000000000000011001100110011\n"));
+/// assert!(h.contains("`define SPECFX_SQ4_W 17\n`define SPECFX_SQ4_F 16\n"));
 /// ```
 pub fn params_header(dp: &Datapath, arch: Arch) -> String {
+    define_header(dp, arch, false)
+}
+
+fn define_header(dp: &Datapath, arch: Arch, reset_data: bool) -> String {
     let cfg = dp.config();
-    let (slope, offset) = constant_formats(cfg);
-    let mut h = String::new();
-    let mut def = |name: &str, value: String| {
-        writeln!(h, "`define SPECFX_{name} {value}").expect("write to String");
-    };
-    let fmt_defs = |def: &mut dyn FnMut(&str, String), p: &str, f: Format| {
-        def(&format!("{p}_W"), f.width().to_string());
-        def(&format!("{p}_F"), f.frac_bits().to_string());
-        def(&format!("{p}_S"), u32::from(f.is_signed()).to_string());
-    };
-    let stage_defs = |def: &mut dyn FnMut(&str, String), p: &str, s: &StageSpec| {
-        fmt_defs(def, p, s.format);
-        def(&format!("{p}_RND"), rounding_code(s.rounding).to_string());
-        def(&format!("{p}_OVF"), overflow_code(s.overflow).to_string());
-    };
-    def(
-        "ARCH",
-        match arch {
-            Arch::Pipelined => "0",
-            Arch::Folded => "1",
-        }
-        .into(),
-    );
-    def("K", cfg.k.to_string());
-    def("CUTOFF", cutoff_code(cfg.cutoff).to_string());
-    fmt_defs(&mut def, "C", cfg.c.format);
-    def("N_W", n_format(cfg).width().to_string());
-    def("D_W", cfg.d.format.width().to_string());
-    def("D_F", cfg.d.format.frac_bits().to_string());
-    fmt_defs(&mut def, "SLOPE", slope);
-    def("SLOPE_POW2", u32::from(slope_is_pow2(cfg)).to_string());
-    fmt_defs(&mut def, "OFFSET", offset);
-    stage_defs(&mut def, "T", &cfg.t);
-    stage_defs(&mut def, "B", &cfg.b);
-    let sq = &cfg.square;
-    def(
-        "SQ_W",
-        packed(sq.iter().map(|s| i64::from(s.format.width()))),
-    );
-    def(
-        "SQ_F",
-        packed(sq.iter().map(|s| i64::from(s.format.frac_bits()))),
-    );
-    def(
-        "SQ_S",
-        packed(sq.iter().map(|s| i64::from(s.format.is_signed()))),
-    );
-    def(
-        "SQ_RND",
-        packed(sq.iter().map(|s| i64::from(rounding_code(s.rounding)))),
-    );
-    def(
-        "SQ_OVF",
-        packed(sq.iter().map(|s| i64::from(overflow_code(s.overflow)))),
-    );
-    fmt_defs(&mut def, "COEF", cfg.coef.format);
-    stage_defs(&mut def, "OUT", &cfg.out);
-    def("LAT_SUB", cfg.latency.sub.to_string());
-    def("LAT_MUL", cfg.latency.mul.to_string());
-    def("LAT_ADD", cfg.latency.add.to_string());
-    format!(
-        "// specfx parameters: configuration '{}', architecture {}, latency {} cycles.\n// Generated by `specfx hdl params`; include before specfx_dut.v.\n{h}",
+    let mut h = format!(
+        "// specfx parameters: configuration '{}', architecture {}, latency {} cycles.\n// Generated by `specfx hdl params`; include before specfx_dut.v.\n",
         cfg.name,
         arch,
         arch.latency(cfg)
-    )
+    );
+    for (name, value) in top_parameters(dp, arch, reset_data) {
+        writeln!(h, "`define SPECFX_{name} {value}").expect("write to String");
+    }
+    h
 }
 
 /// Whether every slope is a power of two: the plain variant (slope n with k fraction bits) with
@@ -158,4 +177,82 @@ pub fn params_header(dp: &Datapath, arch: Arch) -> String {
 pub fn slope_is_pow2(cfg: &crate::pipeline::Config) -> bool {
     cfg.variant == crate::pipeline::Variant::Plain
         && cfg.n.values().iter().all(|n| n.is_power_of_two())
+}
+
+/// How `specfx hdl params` renders a configuration's parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ParamsFormat {
+    /// `specfx_params.vh`: `` `define SPECFX_<NAME> <value> `` lines for `specfx_dut.v`.
+    Define,
+    /// A JSON object `{"NAME": value, ...}` (cocotb, VUnit, FuseSoC scripts).
+    Json,
+    /// Icarus Verilog flags, one per line: `-P<top>.<NAME>=<value>`.
+    Iverilog,
+    /// Verilator flags, one per line: `-G<NAME>=<value>` (for the top module).
+    Verilator,
+    /// A Verilog instantiation of `specfx_top` with every parameter set.
+    Instance,
+}
+
+/// The parameters of [`top_parameters`] rendered in `format`; `top` names the module whose
+/// parameters Icarus's `-P` flags set (the testbench or `specfx_top`).
+///
+/// # Examples
+/// ```
+/// use specfx::cycle::Arch;
+/// use specfx::hdl::{render_parameters, ParamsFormat};
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let flags = render_parameters(&dp, Arch::Pipelined, true, ParamsFormat::Iverilog, "tb");
+/// assert!(flags.starts_with("-Ptb.ARCH=0\n-Ptb.K=4\n"));
+/// assert!(flags.ends_with("-Ptb.RESET_DATA=1\n"));
+/// ```
+pub fn render_parameters(
+    dp: &Datapath,
+    arch: Arch,
+    reset_data: bool,
+    format: ParamsFormat,
+    top: &str,
+) -> String {
+    let params = top_parameters(dp, arch, reset_data);
+    let mut s = String::new();
+    match format {
+        ParamsFormat::Define => s = define_header(dp, arch, reset_data),
+        ParamsFormat::Json => {
+            let map: serde_json::Map<String, serde_json::Value> = params
+                .into_iter()
+                .map(|(k, v)| (k, serde_json::Value::from(v)))
+                .collect();
+            s = serde_json::to_string_pretty(&map).expect("a map of integers") + "\n";
+        }
+        ParamsFormat::Iverilog => {
+            for (name, value) in params {
+                writeln!(s, "-P{top}.{name}={value}").expect("write to String");
+            }
+        }
+        ParamsFormat::Verilator => {
+            for (name, value) in params {
+                writeln!(s, "-G{name}={value}").expect("write to String");
+            }
+        }
+        ParamsFormat::Instance => {
+            let cfg = dp.config();
+            writeln!(
+                s,
+                "// specfx_top for configuration '{}', architecture {arch} (specfx hdl params --format instance).",
+                cfg.name
+            )
+            .expect("write to String");
+            s.push_str("specfx_top #(\n");
+            let n = params.len();
+            for (i, (name, value)) in params.into_iter().enumerate() {
+                let sep = if i + 1 < n { "," } else { "" };
+                writeln!(s, "    .{name}({value}){sep}").expect("write to String");
+            }
+            s.push_str(
+                ") u_specfx (\n    .clk(clk), .rst(rst),\n    .in_valid(in_valid), .in_ready(in_ready),\n    .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),\n    .in_threshold(in_threshold), .in_coef(in_coef),\n    .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)\n);\n",
+            );
+        }
+    }
+    s
 }

@@ -122,6 +122,76 @@ fn fmt(s: &str) -> Format {
     s.parse().expect("built-in format notation is valid")
 }
 
+/// The longest configuration name.
+pub const MAX_NAME_LEN: usize = 64;
+
+/// Checks a configuration name. Names end up in file names, Verilog comments, CSV, HTML,
+/// Markdown, TOML and VCD, so they are 1..=64 ASCII letters, digits and `_ - . +`, not
+/// starting with `.` or `-`: nothing that could change a generated file's meaning or escape
+/// a directory.
+///
+/// # Errors
+/// A description of what was expected.
+///
+/// # Examples
+/// ```
+/// use specfx::pipeline::config::check_name;
+/// assert!(check_name("k5_minimax-2.1").is_ok());
+/// assert!(check_name("a\n`define X").is_err());
+/// assert!(check_name("../escaped").is_err());
+/// ```
+pub fn check_name(name: &str) -> Result<(), String> {
+    let ok_char = |c: char| c.is_ascii_alphanumeric() || "_-.+".contains(c);
+    let bad = name.chars().find(|&c| !ok_char(c));
+    if name.is_empty()
+        || name.len() > MAX_NAME_LEN
+        || bad.is_some()
+        || name.starts_with('.')
+        || name.starts_with('-')
+    {
+        let why = match bad {
+            Some(c) => format!("{:?} is not allowed", c),
+            None if name.is_empty() => "it is empty".to_string(),
+            None if name.len() > MAX_NAME_LEN => format!("it has {} characters", name.len()),
+            None => "it starts with '.' or '-'".to_string(),
+        };
+        return Err(format!(
+            "expected 1..={MAX_NAME_LEN} ASCII letters, digits and _ - . + (not starting with . or -), got {name:?}: {why}"
+        ));
+    }
+    Ok(())
+}
+
+/// A valid name made from any text (a file stem): every other character becomes `_`, a
+/// leading `.` or `-` is dropped, at most [`MAX_NAME_LEN`] characters; `config` if nothing
+/// is left.
+///
+/// # Examples
+/// ```
+/// use specfx::pipeline::config::name_from;
+/// assert_eq!(name_from("my design (v2)"), "my_design__v2_");
+/// assert_eq!(name_from(".."), "config");
+/// ```
+pub fn name_from(text: &str) -> String {
+    let s: String = text
+        .trim_start_matches(['.', '-'])
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "_-.+".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .take(MAX_NAME_LEN)
+        .collect();
+    if s.is_empty() {
+        "config".to_string()
+    } else {
+        s
+    }
+}
+
 impl Config {
     /// The built-in `baseline` configuration (see `docs/arithmetic.md`).
     ///

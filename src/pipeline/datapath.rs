@@ -259,6 +259,7 @@ impl Datapath {
     /// );
     /// ```
     pub fn new(config: Config) -> Result<Datapath, Error> {
+        super::config::check_name(&config.name).map_err(|e| config_error("name", e))?;
         let k = config.k;
         if !crate::reference::lobe::K_RANGE.contains(&k) {
             return Err(config_error(

@@ -1,0 +1,261 @@
+#!/usr/bin/env python3
+"""Runs the cocotb testbench test_specfx.py on specfx_top under Icarus Verilog.
+
+Usage:
+  run.py --vectors DIR [--arch pipelined|folded] [--seed S] [--bubble P] [--stall P]
+         [--reset-data] [--specfx PATH] [--hdl-ref DIR] [--build-dir DIR] [--keep]
+
+For a vector directory written by `specfx vectors --out DIR`, it asks specfx for the Verilog
+parameters of specfx_top (`specfx hdl params --vectors DIR --arch A --format json
+[--reset-data]`) and for the seeded valid/ready stimulus (`specfx hdl stimulus`), builds
+`<hdl-ref>/rtl/*.v` with Icarus Verilog (cocotb's Python runner, `cocotb_tools.runner`) with
+those parameters on the toplevel, runs the test in a build directory (a temporary one, removed
+afterwards, unless --build-dir or --keep) and prints one verdict line, e.g.
+`cocotb: 1029 vectors passed (icarus, pipelined)`.
+
+Exit code: 0 when every vector passed; 1 when the test ran and found a problem (or checked
+nothing); 2 on bad usage or a failing tool (specfx, iverilog, a missing cocotb).
+
+The specfx binary is --specfx, else $SPECFX, else this repository's target/release/specfx,
+else `specfx` on PATH. Needs cocotb (pinned in requirements.txt beside this file; ./scripts/test
+installs it in target/cocotb-venv) and Icarus Verilog.
+"""
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent.parent
+TOPLEVEL = "specfx_top"
+TEST_MODULE = "test_specfx"
+
+EXIT_OK, EXIT_FAILED, EXIT_ERROR = 0, 1, 2
+
+
+class UsageError(Exception):
+    """Bad usage or a failing tool: exit code 2."""
+
+
+def probability(text):
+    try:
+        p = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text}") from None
+    if not 0.0 <= p < 1.0:
+        raise argparse.ArgumentTypeError(f"a probability must be in [0, 1), got {text}")
+    return text  # passed to specfx as written
+
+
+def parse_args(argv):
+    ap = argparse.ArgumentParser(
+        prog="run.py",
+        description="Run the cocotb testbench of specfx_top (Icarus Verilog) on a vector "
+        "directory.",
+    )
+    ap.add_argument(
+        "--vectors", required=True, type=Path, help="vector directory (specfx vectors --out DIR)"
+    )
+    ap.add_argument(
+        "--arch", choices=["pipelined", "folded"], default="pipelined", help="microarchitecture"
+    )
+    ap.add_argument("--seed", type=int, default=1, help="seed of the bubble/stall patterns")
+    ap.add_argument(
+        "--bubble", type=probability, default="0.2", help="probability of no input in a cycle"
+    )
+    ap.add_argument(
+        "--stall", type=probability, default="0.2", help="probability of out_ready low in a cycle"
+    )
+    ap.add_argument(
+        "--reset-data",
+        action="store_true",
+        help="build with RESET_DATA = 1 (the test then checks out_data == 0 after reset)",
+    )
+    ap.add_argument("--specfx", type=Path, help="the specfx binary")
+    ap.add_argument(
+        "--hdl-ref",
+        type=Path,
+        default=REPO / "hdl_ref",
+        help="reference Verilog directory whose rtl/*.v is built (default: this repository's)",
+    )
+    ap.add_argument(
+        "--build-dir", type=Path, help="build and run here (kept), not in a temporary directory"
+    )
+    ap.add_argument(
+        "--keep", action="store_true", help="keep the temporary build directory (path printed)"
+    )
+    return ap.parse_args(argv)
+
+
+def find_specfx(given):
+    candidates = []
+    if given is not None:
+        candidates.append(given)
+    elif os.environ.get("SPECFX"):
+        candidates.append(Path(os.environ["SPECFX"]))
+    else:
+        candidates.append(REPO / "target" / "release" / "specfx")
+        on_path = shutil.which("specfx")
+        if on_path:
+            candidates.append(Path(on_path))
+    for c in candidates:
+        if c.is_file() and os.access(c, os.X_OK):
+            return c
+    raise UsageError(
+        f"no specfx binary ({', '.join(str(c) for c in candidates)}): build it with "
+        "`cargo build --release` or pass --specfx PATH"
+    )
+
+
+def run_specfx(specfx, args):
+    proc = subprocess.run([str(specfx), *args], capture_output=True, text=True)
+    if proc.returncode != 0:
+        err = proc.stderr.strip() or proc.stdout.strip()
+        raise UsageError(f"specfx {' '.join(args[:2])} failed: {err}")
+    return proc.stdout
+
+
+def rtl_sources(hdl_ref):
+    sources = sorted((hdl_ref / "rtl").glob("*.v"))
+    if not any(s.name == f"{TOPLEVEL}.v" for s in sources):
+        raise UsageError(f"{hdl_ref}: no rtl/{TOPLEVEL}.v")
+    return sources
+
+
+def import_runner():
+    try:
+        from cocotb_tools.runner import get_runner
+    except ImportError:
+        raise UsageError(
+            f"cocotb is not installed for {sys.executable}: run ./scripts/test (it makes "
+            "target/cocotb-venv), or `python3 -m venv target/cocotb-venv && "
+            "target/cocotb-venv/bin/pip install -r hdl_ref/cocotb/requirements.txt` and run "
+            "this script with target/cocotb-venv/bin/python"
+        ) from None
+    return get_runner
+
+
+def simulate(args, build_dir):
+    """Builds and runs the test in build_dir; returns the test's summary (a dict)."""
+    vectors = args.vectors.resolve()
+    if not (vectors / "manifest.json").is_file():
+        raise UsageError(
+            f"{vectors}: no manifest.json (write one with specfx vectors --out {vectors})"
+        )
+    if shutil.which("iverilog") is None or shutil.which("vvp") is None:
+        raise UsageError(
+            "iverilog and vvp not found on PATH (Debian/Ubuntu: apt-get install -y iverilog)"
+        )
+    get_runner = import_runner()
+    specfx = find_specfx(args.specfx)
+    sources = rtl_sources(args.hdl_ref.resolve())
+
+    params_args = ["hdl", "params", "--vectors", str(vectors), "--arch", args.arch]
+    params_args += ["--format", "json"]
+    if args.reset_data:
+        params_args.append("--reset-data")
+    try:
+        parameters = json.loads(run_specfx(specfx, params_args))
+    except ValueError as e:
+        raise UsageError(f"specfx hdl params printed no JSON: {e}") from None
+    stim = build_dir / "stimulus"
+    stim_args = ["hdl", "stimulus", "--vectors", str(vectors), "--arch", args.arch]
+    stim_args += ["--seed", str(args.seed), "--bubble", args.bubble, "--stall", args.stall]
+    run_specfx(specfx, stim_args + ["--out", str(stim)])
+
+    summary_path = build_dir / "summary.json"
+    runner = get_runner("icarus")
+    try:
+        runner.build(
+            sources=sources,
+            hdl_toplevel=TOPLEVEL,
+            parameters=parameters,
+            build_args=["-g2005"],
+            build_dir=build_dir,
+            always=True,
+            timescale=("1ns", "1ps"),
+        )
+    except (subprocess.CalledProcessError, SystemExit) as e:
+        raise UsageError(f"iverilog failed to build {TOPLEVEL} ({e})") from None
+    try:
+        runner.test(
+            test_module=TEST_MODULE,
+            hdl_toplevel=TOPLEVEL,
+            build_dir=build_dir,
+            test_dir=build_dir,
+            extra_env={
+                "SPECFX_VECTORS": str(vectors),
+                "SPECFX_STIMULUS": str(stim),
+                "SPECFX_RESET_DATA": str(parameters.get("RESET_DATA", 0)),
+                "SPECFX_SUMMARY": str(summary_path),
+                # No __pycache__ beside test_specfx.py in the repository.
+                "PYTHONDONTWRITEBYTECODE": "1",
+            },
+        )
+    except SystemExit as e:
+        # The simulator exited non-zero; the summary, if written, still tells what happened.
+        if not summary_path.is_file():
+            raise UsageError(
+                f"the simulation failed (exit code {e.code}) before the test ended"
+            ) from None
+    if not summary_path.is_file():
+        raise UsageError("the test wrote no summary (did cocotb load test_specfx?)")
+    summary = json.loads(summary_path.read_text())
+    from cocotb_tools.runner import get_results
+
+    try:
+        summary["cocotb_tests"], summary["cocotb_failed"] = get_results(build_dir / "results.xml")
+    except RuntimeError as e:
+        raise UsageError(str(e)) from None
+    return summary
+
+
+def main(argv):
+    args = parse_args(argv)
+    temporary = args.build_dir is None
+    if temporary:
+        build_dir = Path(tempfile.mkdtemp(prefix="specfx-cocotb."))
+    else:
+        build_dir = args.build_dir.resolve()
+        build_dir.mkdir(parents=True, exist_ok=True)
+    where = f"icarus, {args.arch}" + (", RESET_DATA = 1" if args.reset_data else "")
+    try:
+        summary = simulate(args, build_dir)
+    except UsageError as e:
+        print(f"cocotb: error: {e}", file=sys.stderr)
+        return EXIT_ERROR
+    finally:
+        if temporary and not args.keep:
+            shutil.rmtree(build_dir, ignore_errors=True)
+        elif temporary:
+            print(f"cocotb: build directory {build_dir}", file=sys.stderr)
+
+    passed, failed = summary.get("passed", 0), summary.get("failed", 0)
+    n = summary.get("n_vectors")
+    if (
+        n
+        and passed == n
+        and failed == 0
+        and summary["cocotb_tests"] == 1
+        and summary["cocotb_failed"] == 0
+    ):
+        print(f"cocotb: {passed} vectors passed ({where})")
+        return EXIT_OK
+    for line in summary.get("problems", []):
+        print(line)
+    if n is None:
+        print(f"cocotb: FAIL: the test could not start ({where})")
+    elif n == 0:
+        print(f"cocotb: FAIL: the vector directory holds no vector, nothing was checked ({where})")
+    else:
+        print(f"cocotb: FAIL: {passed} of {n} vectors passed, {failed} failed ({where})")
+    return EXIT_FAILED
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,427 @@
+//! `specfx cosim`: co-simulates the reference Verilog (or a copy of it) against golden vectors
+//! and the cycle model's output cycles, in Icarus Verilog or Verilator.
+//!
+//! The testbench `hdl_ref/tb/tb_specfx.v` instantiates the parameterized top `specfx_top`
+//! with the configuration's values set as Verilog parameters on the simulator's command line
+//! (`-P` for Icarus, `-G` for Verilator), so the co-simulation exercises the same top a
+//! cocotb, VUnit or FuseSoC flow instantiates.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+
+use super::hdl::write_stimulus;
+use super::sim::parse_probability;
+use super::Outcome;
+use specfx::cycle::Arch;
+use specfx::golden::CaseSelection;
+use specfx::hdl::{render_parameters, ParamsFormat};
+use specfx::nset::NSet;
+
+/// A Verilog simulator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Simulator {
+    /// Icarus Verilog (`iverilog -g2005`, `vvp`).
+    Icarus,
+    /// Verilator (`verilator --binary`).
+    Verilator,
+}
+
+impl Simulator {
+    fn name(self) -> &'static str {
+        match self {
+            Simulator::Icarus => "icarus",
+            Simulator::Verilator => "verilator",
+        }
+    }
+
+    /// The programs it needs and the Debian package that has them.
+    fn programs(self) -> (&'static [&'static str], &'static str) {
+        match self {
+            Simulator::Icarus => (&["iverilog", "vvp"], "iverilog"),
+            Simulator::Verilator => (&["verilator"], "verilator"),
+        }
+    }
+
+    fn installed(self) -> bool {
+        self.programs().0.iter().all(|p| find_program(p).is_some())
+    }
+}
+
+/// The program's path on `PATH`, if it is there.
+pub fn find_program(name: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(name))
+        .find(|p| p.is_file())
+}
+
+/// Arguments of `specfx cosim`.
+#[derive(Debug, Args)]
+pub struct CosimArgs {
+    /// A vector directory (`specfx vectors --out DIR`). Without it, vectors are written for
+    /// --config into the work directory.
+    #[arg(long, conflicts_with_all = ["config", "n", "cases"])]
+    vectors: Option<PathBuf>,
+    /// A TOML configuration file or a built-in name (baseline), when no --vectors is given.
+    #[arg(long, default_value = "baseline")]
+    config: String,
+    /// Exponents, replacing the configuration's set (with --config).
+    #[arg(long)]
+    n: Option<NSet>,
+    /// Which cases to write (with --config): corner, exhaustive, random:N, comma-separated.
+    #[arg(long, default_value = "corner,random:1000")]
+    cases: CaseSelection,
+    /// The simulator: icarus or verilator. Default: icarus when installed, else verilator.
+    #[arg(long)]
+    sim: Option<Simulator>,
+    /// Microarchitecture: pipelined or folded.
+    #[arg(long, default_value = "pipelined")]
+    arch: Arch,
+    /// Seed of the bubble/stall patterns (and of the vectors written for --config).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Probability that the source offers no input in a cycle.
+    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
+    bubble: f64,
+    /// Probability that the sink is not ready in a cycle.
+    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
+    stall: f64,
+    /// Build the DUT with RESET_DATA = 1 (data registers cleared on reset; the testbench then
+    /// also checks that out_data is 0 in the first cycle).
+    #[arg(long)]
+    reset_data: bool,
+    /// First lint the DUT with `verilator --lint-only -Wall` (a warning fails the run).
+    #[arg(long)]
+    lint: bool,
+    /// The reference Verilog directory (`rtl/*.v` and `tb/tb_specfx.v`); default: this
+    /// repository's hdl_ref/ (or $SPECFX_HDL_REF). Point it at a modified copy to co-simulate
+    /// your own RTL behind the same ports.
+    #[arg(long)]
+    hdl_ref: Option<PathBuf>,
+    /// Write both traces of the run into this directory, the RTL's (every signal of the
+    /// testbench) as rtl.vcd and the model's (under the RTL's names) as model.vcd, and compare
+    /// them signal by signal (`specfx trace compare`; exit code 1 when they differ).
+    #[arg(long)]
+    vcd: Option<PathBuf>,
+    /// Keep the work directory (its path is printed) instead of deleting it.
+    #[arg(long)]
+    keep: bool,
+}
+
+/// The testbench's verdict.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Verdict {
+    /// Vectors whose output and cycle matched.
+    pub passed: u64,
+    /// Vectors that did not, plus protocol failures.
+    pub failed: u64,
+    /// The testbench's problem lines (mismatch, protocol, unexpected, timeout).
+    pub problems: Vec<String>,
+}
+
+/// Runs `specfx cosim`. Exit code 1 when a vector failed or nothing was checked.
+pub fn run(args: &CosimArgs) -> Result<Outcome> {
+    let sim = choose_simulator(args.sim)?;
+    if args.lint && !Simulator::Verilator.installed() {
+        bail!("--lint: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator)");
+    }
+    let hdl = super::cost::hdl_ref_dir(args.hdl_ref.as_deref());
+    let rtl = rtl_sources(&hdl)?;
+    let tb = hdl.join("tb/tb_specfx.v");
+    if !tb.is_file() {
+        bail!("{}: the testbench is missing", tb.display());
+    }
+    let work = tempfile::Builder::new()
+        .prefix("specfx-cosim.")
+        .tempdir()
+        .context("cannot create a work directory")?;
+    let wd = work.path();
+
+    // The vectors: given, or written for --config.
+    let vectors = match &args.vectors {
+        Some(dir) => {
+            if !dir.join("manifest.json").is_file() {
+                bail!(
+                    "{}: no manifest.json (write a vector directory with specfx vectors --out {})",
+                    dir.display(),
+                    dir.display()
+                );
+            }
+            dir.clone()
+        }
+        None => {
+            let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+            let dir = wd.join("vectors");
+            super::vectors::write_dir(&dp, &dir, &args.cases, args.seed, false)?;
+            dir
+        }
+    };
+    let dp = super::datapath::load(&vectors.to_string_lossy(), None)?;
+    if let Some(dir) = &args.vcd {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
+    let stim = write_stimulus(
+        &vectors,
+        args.arch,
+        args.seed,
+        args.bubble,
+        args.stall,
+        wd,
+        model_vcd.as_deref(),
+    )?;
+    for port in [
+        "in_c",
+        "in_n",
+        "in_slope",
+        "in_offset",
+        "in_threshold",
+        "in_coef",
+        "expected_out",
+    ] {
+        let from = vectors.join(format!("{port}.hex"));
+        std::fs::copy(&from, wd.join(format!("{port}.hex")))
+            .with_context(|| format!("cannot copy {}", from.display()))?;
+    }
+
+    let mut params = vec![
+        ("NVEC".to_string(), stim.n_vectors as i64),
+        ("NCYC".to_string(), stim.n_cycles as i64),
+    ];
+    params.extend(
+        render_parameters(&dp, args.arch, args.reset_data, ParamsFormat::Json, "")
+            .parse::<serde_json::Value>()
+            .ok()
+            .and_then(|v| v.as_object().cloned())
+            .expect("render_parameters writes a JSON object of integers")
+            .into_iter()
+            .map(|(k, v)| (k, v.as_i64().expect("integer parameters"))),
+    );
+
+    if args.lint {
+        eprintln!("cosim: verilator --lint-only -Wall (specfx_top + rtl)");
+        let mut cmd = Command::new("verilator");
+        cmd.args(["--lint-only", "-Wall", "--top-module", "specfx_top"])
+            .args(
+                params
+                    .iter()
+                    .filter(|(k, _)| k != "NVEC" && k != "NCYC")
+                    .map(|(k, v)| format!("-G{k}={v}")),
+            )
+            .args(&rtl);
+        let o = cmd.output().context("cannot run verilator")?;
+        if !o.status.success() || !o.stderr.is_empty() {
+            eprint!("{}", String::from_utf8_lossy(&o.stderr));
+            eprintln!("cosim: lint failed");
+            return Ok(Outcome::CheckFailed);
+        }
+    }
+
+    eprintln!(
+        "cosim: {}, {}, {} vectors ({}), {} stimulus cycles (seed {}, bubble {}, stall {}){}",
+        sim.name(),
+        args.arch,
+        stim.n_vectors,
+        dp.config().name,
+        stim.n_cycles,
+        args.seed,
+        args.bubble,
+        args.stall,
+        if args.reset_data {
+            ", RESET_DATA = 1"
+        } else {
+            ""
+        }
+    );
+    let log = simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
+    if let Some(dir) = &args.vcd {
+        let from = wd.join("rtl.vcd");
+        std::fs::copy(&from, dir.join("rtl.vcd"))
+            .with_context(|| format!("the simulator wrote no {}", from.display()))?;
+    }
+    if args.keep {
+        let kept = work.keep();
+        eprintln!("cosim: work directory {}", kept.display());
+    }
+    let verdict = match parse_log(&log) {
+        Ok(v) => v,
+        Err(e) => {
+            eprintln!("cosim: FAIL: {e}");
+            return Ok(Outcome::CheckFailed);
+        }
+    };
+    for line in &verdict.problems {
+        println!("{line}");
+    }
+    println!("{} passed, {} failed", verdict.passed, verdict.failed);
+    if verdict.failed != 0 {
+        eprintln!("cosim: FAIL ({}, {})", sim.name(), args.arch);
+        return Ok(Outcome::CheckFailed);
+    }
+    if verdict.passed == 0 {
+        eprintln!("cosim: FAIL: nothing was checked");
+        return Ok(Outcome::CheckFailed);
+    }
+    if let Some(dir) = &args.vcd {
+        let (model, rtl) = (dir.join("model.vcd"), dir.join("rtl.vcd"));
+        if matches!(
+            super::trace::compare_files(&model, &rtl)?,
+            Outcome::CheckFailed
+        ) {
+            eprintln!(
+                "cosim: FAIL: the model's and the RTL's traces differ ({}, {})",
+                sim.name(),
+                args.arch
+            );
+            return Ok(Outcome::CheckFailed);
+        }
+    }
+    Ok(Outcome::Ok)
+}
+
+fn choose_simulator(asked: Option<Simulator>) -> Result<Simulator> {
+    let hint = |s: Simulator| {
+        let (programs, package) = s.programs();
+        format!(
+            "{} not found on PATH (Debian/Ubuntu: apt-get install -y {package}; ./scripts/test installs it)",
+            programs.join(" and ")
+        )
+    };
+    match asked {
+        Some(s) if s.installed() => Ok(s),
+        Some(s) => bail!("--sim {}: {}", s.name(), hint(s)),
+        None => [Simulator::Icarus, Simulator::Verilator]
+            .into_iter()
+            .find(|s| s.installed())
+            .ok_or_else(|| {
+                anyhow::anyhow!(
+                    "no Verilog simulator: {}; or {}",
+                    hint(Simulator::Icarus),
+                    hint(Simulator::Verilator)
+                )
+            }),
+    }
+}
+
+/// Every `rtl/*.v` of a reference Verilog directory, sorted.
+fn rtl_sources(hdl: &Path) -> Result<Vec<PathBuf>> {
+    let mut files = super::cost::rtl_files(hdl)?;
+    // rtl_files ends with specfx_dut.v, the `define top; the co-simulation uses specfx_top.
+    files.retain(|f| f.parent().is_some_and(|p| p.ends_with("rtl")));
+    if !files.iter().any(|f| f.ends_with("specfx_top.v")) {
+        bail!("{}: no rtl/specfx_top.v", hdl.display());
+    }
+    Ok(files)
+}
+
+/// Compiles and runs the testbench in `wd`; returns the simulator's output.
+fn simulate(
+    sim: Simulator,
+    wd: &Path,
+    tb: &Path,
+    rtl: &[PathBuf],
+    params: &[(String, i64)],
+    vcd: bool,
+) -> Result<String> {
+    let run = |cmd: &mut Command, what: &str| -> Result<std::process::Output> {
+        let o = cmd
+            .current_dir(wd)
+            .output()
+            .with_context(|| format!("cannot run {what}"))?;
+        Ok(o)
+    };
+    let quiet = !std::io::stderr().is_terminal();
+    match sim {
+        Simulator::Icarus => {
+            let mut cmd = Command::new("iverilog");
+            cmd.args(["-g2005", "-s", "tb_specfx", "-o", "tb.vvp"])
+                .args(params.iter().map(|(k, v)| format!("-Ptb_specfx.{k}={v}")));
+            if vcd {
+                cmd.arg("-DSPECFX_VCD");
+            }
+            let o = run(cmd.arg(tb).args(rtl), "iverilog")?;
+            if !o.status.success() {
+                bail!(
+                    "iverilog failed: {}",
+                    String::from_utf8_lossy(&o.stderr).trim()
+                );
+            }
+            let o = run(Command::new("vvp").args(["-n", "tb.vvp"]), "vvp")?;
+            Ok(String::from_utf8_lossy(&o.stdout).into_owned()
+                + &String::from_utf8_lossy(&o.stderr))
+        }
+        Simulator::Verilator => {
+            if !quiet {
+                eprintln!("cosim: building with verilator (a minute or less)");
+            }
+            let mut cmd = Command::new("verilator");
+            cmd.args([
+                "--binary",
+                "-j",
+                "0",
+                "-Wno-fatal",
+                "-Wno-lint",
+                "-Wno-style",
+                "--top-module",
+                "tb_specfx",
+                "-Mdir",
+                "obj",
+            ])
+            .args(params.iter().map(|(k, v)| format!("-G{k}={v}")));
+            if vcd {
+                cmd.args(["--trace", "-DSPECFX_VCD"]);
+            }
+            let o = run(cmd.arg(tb).args(rtl), "verilator")?;
+            if !o.status.success() {
+                let err = String::from_utf8_lossy(&o.stderr);
+                let first = err
+                    .lines()
+                    .find(|l| l.contains("%Error"))
+                    .unwrap_or("see its output");
+                bail!("verilator failed: {}", first.trim());
+            }
+            let o = run(&mut Command::new(wd.join("obj/Vtb_specfx")), "the model")?;
+            Ok(String::from_utf8_lossy(&o.stdout).into_owned()
+                + &String::from_utf8_lossy(&o.stderr))
+        }
+    }
+}
+
+/// The testbench's problem lines and its `N passed, N failed` summary.
+///
+/// # Errors
+/// When the summary line is missing (the simulation died or never finished).
+pub fn parse_log(log: &str) -> Result<Verdict> {
+    let problems: Vec<String> = log
+        .lines()
+        .filter(|l| {
+            ["mismatch", "protocol", "unexpected", "timeout"]
+                .iter()
+                .any(|p| l.starts_with(p))
+        })
+        .map(str::to_string)
+        .collect();
+    let summary = log.lines().rev().find_map(|l| {
+        let (p, f) = l.trim().split_once(" passed, ")?;
+        let f = f.strip_suffix(" failed")?;
+        Some((p.parse::<u64>().ok()?, f.parse::<u64>().ok()?))
+    });
+    match summary {
+        Some((passed, failed)) => Ok(Verdict {
+            passed,
+            failed,
+            problems,
+        }),
+        None => {
+            let tail: Vec<&str> = log.lines().rev().take(5).collect();
+            bail!(
+                "the simulation printed no `N passed, N failed` line; its last lines: {}",
+                tail.into_iter().rev().collect::<Vec<_>>().join(" | ")
+            )
+        }
+    }
+}

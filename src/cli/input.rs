@@ -1,0 +1,64 @@
+//! Reading the files a user names: regular files only (a FIFO or a device would block or
+//! never end), within a stated size limit, as UTF-8 text when text is expected.
+
+use std::io::Read;
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+
+/// The largest text input (a configuration, design space, scene or manifest): 16 MiB.
+pub const MAX_TEXT_BYTES: u64 = 16 << 20;
+
+/// The largest binary input (a mesh): 1 GiB.
+pub const MAX_BINARY_BYTES: u64 = 1 << 30;
+
+/// The bytes of a regular file of at most `max` bytes; `what` names it in errors
+/// (e.g. "config my.toml").
+pub fn read_bytes(path: &Path, what: &str, max: u64) -> Result<Vec<u8>> {
+    let meta = std::fs::metadata(path).with_context(|| format!("{what}: cannot read it"))?;
+    if !meta.is_file() {
+        bail!("{what}: expected a regular file, got {}", kind(&meta));
+    }
+    if meta.len() > max {
+        bail!(
+            "{what}: expected at most {max} bytes, got {} bytes",
+            meta.len()
+        );
+    }
+    let file = std::fs::File::open(path).with_context(|| format!("{what}: cannot open it"))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(max + 1)
+        .read_to_end(&mut bytes)
+        .with_context(|| format!("{what}: cannot read it"))?;
+    if bytes.len() as u64 > max {
+        bail!("{what}: expected at most {max} bytes, it grew while being read");
+    }
+    Ok(bytes)
+}
+
+/// The text of a regular UTF-8 file of at most [`MAX_TEXT_BYTES`].
+pub fn read_text(path: &Path, what: &str) -> Result<String> {
+    let bytes = read_bytes(path, what, MAX_TEXT_BYTES)?;
+    String::from_utf8(bytes).map_err(|e| {
+        anyhow::anyhow!(
+            "{what}: expected UTF-8 text, got an invalid byte at offset {}",
+            e.utf8_error().valid_up_to()
+        )
+    })
+}
+
+fn kind(meta: &std::fs::Metadata) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    let t = meta.file_type();
+    if t.is_dir() {
+        "a directory"
+    } else if t.is_fifo() {
+        "a FIFO"
+    } else if t.is_socket() {
+        "a socket"
+    } else if t.is_char_device() || t.is_block_device() {
+        "a device"
+    } else {
+        "not a regular file"
+    }
+}

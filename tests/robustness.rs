@@ -1,0 +1,235 @@
+//! Bad input through the real binary, table-driven: every case must end with exit code 2 and
+//! one clear line on stderr naming the culprit, without a panic, without hanging and without
+//! leaving a file behind in its working directory.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// What a case puts in its working directory before running.
+enum Input {
+    /// A text file.
+    File(&'static str, &'static str),
+    /// A named pipe (reading it would block forever).
+    Fifo(&'static str),
+}
+
+/// One bad invocation: arguments (`{dir}` is the case's working directory), the inputs it
+/// needs, and a piece of the one error line it must print.
+struct Case {
+    args: &'static [&'static str],
+    inputs: &'static [Input],
+    expect: &'static str,
+}
+
+const CASES: &[Case] = &[
+    // Names end up in generated files and file names.
+    Case {
+        args: &["hdl", "params", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "name = \"a\\n`define SPECFX_K 9\"\n")],
+        expect: "name: expected 1..=64 ASCII letters",
+    },
+    Case {
+        args: &["stability", "--config", "{dir}/c.toml", "--out", "{dir}/out"],
+        inputs: &[Input::File("c.toml", "name = \"x/y\"\n")],
+        expect: "'/' is not allowed",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "name = \"../../escaped\"\n")],
+        expect: "name: expected",
+    },
+    Case {
+        args: &["vectors", "--config", "{dir}/c.toml", "--out", "{dir}/v"],
+        inputs: &[Input::File("c.toml", "name = \"a */ b\"\n")],
+        expect: "' ' is not allowed",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "name = \"\"\n")],
+        expect: "it is empty",
+    },
+    // Budgets that cannot mean anything.
+    Case {
+        args: &["optimize", "--budget", "shape_total <= NaN", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "the limit must be a finite number >= 0",
+    },
+    Case {
+        args: &["optimize", "--budget", "shape_total <= -1 lsb8", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "the limit must be a finite number >= 0",
+    },
+    Case {
+        args: &["optimize", "--budget", "correct >= 150%", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "at most 100%",
+    },
+    Case {
+        args: &["budget", "--budget", "luts <= inf", "--out", "{dir}/b"],
+        inputs: &[],
+        expect: "the limit must be a finite number >= 0",
+    },
+    Case {
+        args: &["optimize", "--budget", "effective_bits >= 65", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "effective bits are at most 64",
+    },
+    Case {
+        args: &["optimize", "--budget", "shape_total <= 1 lsb999", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "lsbN needs a number N in 1..=64",
+    },
+    // Design spaces: ranges at the i64 limits, and more points than a sweep may hold.
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File(
+            "s.toml",
+            "[vary]\n\"square.frac\" = \"-9223372036854775808..=9223372036854775807\"\n",
+        )],
+        expect: "at most 257 values",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File(
+            "s.toml",
+            "[vary]\n\"square.frac\" = \"9223372036854775800..=-9223372036854775800\"\n",
+        )],
+        expect: "at most 257 values",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File(
+            "s.toml",
+            "[vary]\n\"square.frac\" = \"1..=200\"\n\"t.frac\" = \"1..=200\"\n\"b.frac\" = \"1..=200\"\nk = [1, 2, 3, 4, 5, 6, 7]\n",
+        )],
+        expect: "expected at most 1048576 points",
+    },
+    // Files that are not regular files would block or never end.
+    Case {
+        args: &["check", "--config", "{dir}/fifo.toml"],
+        inputs: &[Input::Fifo("fifo.toml")],
+        expect: "expected a regular file, got a FIFO",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/fifo.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::Fifo("fifo.toml")],
+        expect: "expected a regular file, got a FIFO",
+    },
+    Case {
+        args: &["render", "--scene", "{dir}/fifo.toml", "--out", "{dir}/r"],
+        inputs: &[Input::Fifo("fifo.toml")],
+        expect: "expected a regular file, got a FIFO",
+    },
+    Case {
+        args: &["check", "--config", "{dir}"],
+        inputs: &[],
+        expect: "manifest.json",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/missing.toml"],
+        inputs: &[],
+        expect: "no such file (and it is not a built-in name: baseline)",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "k = 9\n")],
+        expect: "k",
+    },
+];
+
+/// How long a case may run before it counts as hung.
+const TIMEOUT: Duration = Duration::from_secs(60);
+
+fn files_in(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = walk(dir);
+    v.sort();
+    v
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    if let Ok(rd) = std::fs::read_dir(dir) {
+        for e in rd.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                out.extend(walk(&p));
+            }
+            out.push(p);
+        }
+    }
+    out
+}
+
+#[test]
+fn bad_input_gets_one_line_and_exit_code_2_and_leaves_nothing() {
+    let mut failures = Vec::new();
+    for (i, case) in CASES.iter().enumerate() {
+        let dir = std::env::temp_dir().join(format!("specfx-bad-{}-{i}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        for input in case.inputs {
+            match input {
+                Input::File(name, text) => std::fs::write(dir.join(name), text).unwrap(),
+                Input::Fifo(name) => {
+                    let ok = Command::new("mkfifo")
+                        .arg(dir.join(name))
+                        .status()
+                        .unwrap()
+                        .success();
+                    assert!(ok, "mkfifo");
+                }
+            }
+        }
+        let before = files_in(&dir);
+        let args: Vec<String> = case
+            .args
+            .iter()
+            .map(|a| a.replace("{dir}", dir.to_str().unwrap()))
+            .collect();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_specfx"))
+            .args(&args)
+            .current_dir(&dir)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break Some(s);
+            }
+            if start.elapsed() > TIMEOUT {
+                child.kill().unwrap();
+                break None;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let label = format!("case {i} `specfx {}`", args.join(" "));
+        match status {
+            None => failures.push(format!("{label}: hung")),
+            Some(s) if s.code() != Some(2) => {
+                failures.push(format!("{label}: exit {:?}, stderr {stderr}", s.code()))
+            }
+            Some(_) => {}
+        }
+        if stderr.contains("panicked") {
+            failures.push(format!("{label}: panicked: {stderr}"));
+        }
+        if stderr.lines().count() != 1 || !stderr.contains(case.expect) {
+            failures.push(format!(
+                "{label}: expected one line containing {:?}, got {stderr:?}",
+                case.expect
+            ));
+        }
+        let after = files_in(&dir);
+        if after != before {
+            failures.push(format!("{label}: left {:?}", after));
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
