@@ -56,8 +56,10 @@ fn run_compare(args: &CompareArgs) -> Result<Outcome> {
 pub fn compare_files(first: &Path, second: &Path) -> Result<Outcome> {
     let paths = [first, second];
     let open = |p: &Path| -> Result<BufReader<File>> {
+        let what = format!("trace {}", p.display());
+        super::input::check_regular_file(p, &what)?;
         Ok(BufReader::new(
-            File::open(p).with_context(|| format!("cannot read {}", p.display()))?,
+            File::open(p).with_context(|| format!("{what}: cannot open it"))?,
         ))
     };
     let (a, b) = (open(first)?, open(second)?);
