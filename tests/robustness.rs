@@ -238,3 +238,127 @@ fn bad_input_gets_one_line_and_exit_code_2_and_leaves_nothing() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+fn specfx_in(dir: &Path, args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+fn fresh_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("specfx-out-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The staging directories (`.<name>.partial-<pid>`) in `dir`.
+fn staging(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".partial-") || n.contains(".old-"))
+        .collect()
+}
+
+/// A result directory is replaced by the same command, refused for anything else unless
+/// --force, and a file in its place is refused.
+#[test]
+fn results_replace_their_own_kind_only() {
+    let dir = fresh_dir("replace");
+    let budget = |out: &str, force: bool| {
+        let mut args = vec!["budget", "--no-gappa", "--n", "16..=64", "--out", out];
+        if force {
+            args.push("--force");
+        }
+        specfx_in(&dir, &args)
+    };
+    assert!(budget("b", false).status.success());
+    let first = std::fs::read(dir.join("b/budget.json")).unwrap();
+    assert!(
+        budget("b", false).status.success(),
+        "an earlier budget is replaced"
+    );
+    assert_eq!(std::fs::read(dir.join("b/budget.json")).unwrap(), first);
+    std::fs::create_dir(dir.join("mine")).unwrap();
+    std::fs::write(dir.join("mine/data.txt"), "mine").unwrap();
+    let o = budget("mine", false);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("pass --force to replace it"));
+    assert_eq!(
+        std::fs::read_to_string(dir.join("mine/data.txt")).unwrap(),
+        "mine"
+    );
+    // Another command's result is not this command's either.
+    let o = specfx_in(
+        &dir,
+        &["stability", "--n", "1..=8", "--c-bits", "6", "--out", "b"],
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(budget("mine", true).status.success());
+    assert!(!dir.join("mine/data.txt").exists());
+    std::fs::write(dir.join("afile"), "x").unwrap();
+    let o = budget("afile", true);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("is not a directory"));
+    assert!(staging(&dir).is_empty(), "{:?}", staging(&dir));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Killed (SIGKILL) mid-run, a command leaves the earlier result as it was, its hidden
+/// staging directory is removed by the next run; interrupted (SIGINT, SIGTERM), it removes its
+/// staging directory itself and exits with 130.
+#[test]
+fn interrupted_runs_leave_the_earlier_result_intact() {
+    let dir = fresh_dir("kill");
+    let small = ["stability", "--n", "1..=8", "--c-bits", "6", "--out", "st"];
+    assert!(specfx_in(&dir, &small).status.success());
+    let before = std::fs::read(dir.join("st/stability.json")).unwrap();
+    for signal in ["KILL", "INT", "TERM"] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_specfx"))
+            .args(["stability", "--out", "st"])
+            .current_dir(&dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        while staging(&dir).is_empty() {
+            assert!(start.elapsed() < TIMEOUT, "no staging directory appeared");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        std::thread::sleep(Duration::from_millis(300));
+        let ok = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .unwrap()
+            .success();
+        assert!(ok);
+        let status = child.wait().unwrap();
+        assert_eq!(
+            std::fs::read(dir.join("st/stability.json")).unwrap(),
+            before,
+            "SIGTERM/INT/KILL changed the earlier result"
+        );
+        if signal == "KILL" {
+            assert_eq!(
+                staging(&dir).len(),
+                1,
+                "the killed run's staging is left hidden"
+            );
+            // The next run removes what the killed one left.
+            assert!(specfx_in(&dir, &small).status.success());
+        } else {
+            assert_eq!(status.code(), Some(130), "SIG{signal}");
+        }
+        assert!(staging(&dir).is_empty(), "SIG{signal}: {:?}", staging(&dir));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -35,6 +35,9 @@ pub struct BudgetArgs {
     /// Output directory.
     #[arg(long, default_value = "specfx-budget")]
     out: PathBuf,
+    /// Replace an existing output directory that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
     /// Exponents to prove a bound for with gappa (default: up to 8 spread over the set).
     #[arg(long)]
     gappa_n: Option<NSet>,
@@ -241,7 +244,14 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
         }
         None => Some(spread(&ns)),
     };
-    let report = budget(&dp, args.budget.as_ref(), gappa_n.as_deref(), &args.out)?;
+    let out_dir = super::output::OutDir::begin(&args.out, "budget", args.force)?;
+    let report = budget(
+        &dp,
+        args.budget.as_ref(),
+        gappa_n.as_deref(),
+        out_dir.path(),
+    )?;
+    out_dir.commit()?;
     if args.json {
         print_json(&report)?;
     } else {

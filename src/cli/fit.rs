@@ -24,7 +24,7 @@ use specfx::scene::render::{difference_of, image_error, render_fragments, ImageE
 use specfx::scene::Scene;
 
 /// Arguments of `specfx fit`.
-#[derive(Debug, Args)]
+#[derive(Debug, Clone, Args)]
 pub struct FitArgs {
     /// A scene TOML file (default: the built-in cells, vessel and bone scene).
     #[arg(long)]
@@ -50,6 +50,9 @@ pub struct FitArgs {
     /// Output directory.
     #[arg(long, default_value = "specfx-fit")]
     out: PathBuf,
+    /// Replace an existing output directory that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -67,6 +70,7 @@ impl FitArgs {
             analytic_only,
             start_frac: 20,
             out,
+            force: false,
             json: false,
         }
     }
@@ -205,7 +209,16 @@ pub fn run(args: &FitArgs) -> Result<Outcome> {
         .map_or("the built-in scene".to_string(), |p| {
             p.display().to_string()
         });
-    match fit_scene(&scene, &label, args)? {
+    let out_dir = super::output::OutDir::begin(&args.out, "fit", args.force)?;
+    let staged = FitArgs {
+        out: out_dir.path().to_path_buf(),
+        ..args.clone()
+    };
+    let fitted = fit_scene(&scene, &label, &staged)?;
+    if fitted.is_some() {
+        out_dir.commit()?;
+    }
+    match fitted {
         None => Ok(Outcome::CheckFailed),
         Some(report) => {
             if args.json {

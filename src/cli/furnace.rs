@@ -35,6 +35,9 @@ pub struct FurnaceArgs {
     /// Output directory.
     #[arg(long, default_value = "specfx-furnace")]
     out: PathBuf,
+    /// Replace an existing output directory that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -52,7 +55,9 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
         settings.angles_deg().len(),
         dp.config().name
     );
-    let report = write_furnace(&dp, &settings, &args.out)?;
+    let out_dir = super::output::OutDir::begin(&args.out, "furnace", args.force)?;
+    let report = write_furnace(&dp, &settings, out_dir.path())?;
+    out_dir.commit()?;
     let out = &args.out;
     let summary = report.summary();
     if args.json {

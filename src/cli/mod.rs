@@ -90,6 +90,150 @@ enum Command {
     Minimax(reference::MinimaxArgs),
     /// Measures how fast the engine computes a datapath's outputs, with a checksum.
     Throughput(throughput::ThroughputArgs),
+    /// Prints a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(CompletionsArgs),
+    /// Prints the man page (roff) generated from the command-line definition, or writes one
+    /// page per command into a directory.
+    Man(ManArgs),
+}
+
+/// An example per command, shown at the end of its `--help` (and in the man pages).
+const EXAMPLES: &[(&str, &str)] = &[
+    ("report", "specfx report --out specfx-out"),
+    ("paper", "specfx paper --json > paper.json"),
+    ("check", "specfx check --config my.toml --n 16..1024"),
+    (
+        "coef",
+        "specfx coef --form blinn_phong --source exact --n 16,64,256",
+    ),
+    (
+        "sim",
+        "specfx sim --config baseline --arch folded --cycles 5000 --vcd sim.vcd",
+    ),
+    ("hdl", "specfx hdl params --config my.toml --format json"),
+    (
+        "cosim",
+        "specfx cosim --config my.toml --sim verilator --arch folded --lint",
+    ),
+    (
+        "cost",
+        "specfx cost --config my.toml --target ice40 --timing",
+    ),
+    ("calibrate", "specfx calibrate --targets ice40 --fit-only"),
+    ("timing", "specfx timing --config my.toml --device up5k"),
+    (
+        "sweep",
+        "specfx sweep --space space.toml --out sweep-out --shard 1/4",
+    ),
+    (
+        "budget",
+        "specfx budget --config my.toml --budget 'shape_total <= 1 lsb8' --out budget-out",
+    ),
+    (
+        "optimize",
+        "specfx optimize --budget 'out_rel <= 1%, dsps <= 8 on ice40' --out best.toml",
+    ),
+    (
+        "stability",
+        "specfx stability --config my.toml --out stability-out",
+    ),
+    (
+        "tradeoff",
+        "specfx tradeoff --n 16..=1024 --out tradeoff-out --yosys ice40",
+    ),
+    (
+        "render",
+        "specfx render --scene examples/scenes/vessel_bifurcation.toml --config my.toml --out render-out",
+    ),
+    (
+        "fit",
+        "specfx fit --scene examples/scenes/vessel_bifurcation.toml --out fitted.toml",
+    ),
+    ("furnace", "specfx furnace --out furnace-out"),
+    (
+        "vectors",
+        "specfx vectors --config my.toml --cases corner,random:10000 --out vec",
+    ),
+    ("minimax", "specfx minimax --n 16,64,256 --k 4"),
+    (
+        "throughput",
+        "specfx throughput --config baseline --threads 2",
+    ),
+    (
+        "completions",
+        "specfx completions bash > ~/.local/share/bash-completion/completions/specfx",
+    ),
+    ("man", "specfx man --out man/ && man -l man/specfx-cosim.1"),
+];
+
+/// The command-line definition, with each command's example and the exit codes.
+fn command() -> clap::Command {
+    use clap::CommandFactory;
+    let mut cmd = Cli::command().after_help(
+        "Exit codes: 0 success; 1 the command ran but a check it performs failed; 2 bad input \
+         or an I/O error (one line on stderr, nothing written).",
+    );
+    for (name, example) in EXAMPLES {
+        cmd = cmd.mut_subcommand(*name, |c| c.after_help(format!("Example:\n  {example}")));
+    }
+    cmd
+}
+
+/// Arguments of `specfx completions`.
+#[derive(Debug, clap::Args)]
+pub struct CompletionsArgs {
+    /// The shell.
+    shell: clap_complete::Shell,
+}
+
+/// Arguments of `specfx man`.
+#[derive(Debug, clap::Args)]
+pub struct ManArgs {
+    /// Write specfx.1 and specfx-<command>.1 for every command into this directory instead of
+    /// printing specfx.1.
+    #[arg(long)]
+    out: Option<std::path::PathBuf>,
+}
+
+fn completions(args: &CompletionsArgs) -> anyhow::Result<Outcome> {
+    let mut cmd = command();
+    let mut buf = Vec::new();
+    clap_complete::generate(args.shell, &mut cmd, "specfx", &mut buf);
+    output::print_with(|w| {
+        use std::io::Write;
+        w.write_all(&buf)
+    })?;
+    Ok(Outcome::Ok)
+}
+
+fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
+    use anyhow::Context;
+    let cmd = command();
+    let render = |c: clap::Command| -> anyhow::Result<Vec<u8>> {
+        let mut buf = Vec::new();
+        clap_mangen::Man::new(c).render(&mut buf)?;
+        Ok(buf)
+    };
+    match &args.out {
+        None => {
+            let page = render(cmd)?;
+            output::print_with(|w| {
+                use std::io::Write;
+                w.write_all(&page)
+            })?;
+        }
+        Some(dir) => {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+            output::write_atomic(&dir.join("specfx.1"), &render(cmd.clone())?)?;
+            for sub in cmd.get_subcommands() {
+                let name = format!("specfx-{}", sub.get_name());
+                let page = render(sub.clone().name(name.clone()))?;
+                output::write_atomic(&dir.join(format!("{name}.1")), &page)?;
+            }
+        }
+    }
+    Ok(Outcome::Ok)
 }
 
 /// clap's whole error message on one line: the error, the missing arguments' names, the
@@ -137,7 +281,11 @@ pub enum Outcome {
 
 /// Parses the arguments, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    output::install_interrupt_handler();
+    let cli = match command()
+        .try_get_matches()
+        .and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m))
+    {
         Ok(cli) => cli,
         // Help and version go to stdout with exit code 0, as clap prints them; no command at
         // all shows the whole help.
@@ -175,6 +323,8 @@ pub fn main() -> ExitCode {
         Command::Hdl(args) => hdl::run(&args),
         Command::Trace(args) => trace::run(&args),
         Command::Throughput(args) => throughput::run(&args),
+        Command::Completions(args) => completions(&args),
+        Command::Man(args) => man(&args),
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,
@@ -194,7 +344,8 @@ mod tests {
     #[test]
     fn clap_errors_keep_names_and_tips_on_one_line() {
         let err = |args: &[&str]| {
-            let e = Cli::try_parse_from(std::iter::once("specfx").chain(args.iter().copied()))
+            let e = command()
+                .try_get_matches_from(std::iter::once("specfx").chain(args.iter().copied()))
                 .expect_err("bad arguments");
             one_line(&e.render().to_string())
         };
@@ -220,6 +371,42 @@ mod tests {
         );
         for e in [missing, typo, sub, value] {
             assert!(!e.contains('\n') && !e.contains("Usage"), "{e}");
+        }
+    }
+
+    #[test]
+    fn every_command_has_an_example_that_parses() {
+        let cmd = command();
+        for sub in cmd.get_subcommands() {
+            let name = sub.get_name();
+            let (_, example) = EXAMPLES
+                .iter()
+                .find(|(n, _)| *n == name)
+                .unwrap_or_else(|| panic!("no example for `specfx {name}`"));
+            // The example's arguments parse (single quotes group words; up to a shell
+            // redirection or `&&`).
+            let mut words: Vec<String> = Vec::new();
+            let mut quoted = false;
+            let mut word = String::new();
+            for ch in example.chars() {
+                match ch {
+                    '\'' => quoted = !quoted,
+                    ' ' if !quoted => {
+                        if !word.is_empty() {
+                            words.push(std::mem::take(&mut word));
+                        }
+                    }
+                    _ => word.push(ch),
+                }
+            }
+            words.push(word);
+            let end = words
+                .iter()
+                .position(|w| w == ">" || w == "&&")
+                .unwrap_or(words.len());
+            command()
+                .try_get_matches_from(&words[..end])
+                .unwrap_or_else(|e| panic!("example of {name}: {e}"));
         }
     }
 }

@@ -2,7 +2,7 @@
 
 use std::fs;
 use std::io::{self, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
@@ -106,6 +106,163 @@ impl Progress {
     pub fn finish(&self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
+        }
+    }
+}
+
+/// The name of the marker file every result directory holds: it says which specfx command
+/// wrote the directory, so that the command may replace its own earlier result.
+pub const MARKER: &str = ".specfx-result";
+
+/// Staging directories of this process not yet committed, removed on Ctrl-C or SIGTERM.
+static STAGING: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Installs the Ctrl-C / SIGTERM handler: removes this process's staging directories (the
+/// previous results stay as they were) and exits with code 130.
+pub fn install_interrupt_handler() {
+    let _ = ctrlc::set_handler(|| {
+        if let Ok(dirs) = STAGING.lock() {
+            for d in dirs.iter() {
+                let _ = std::fs::remove_dir_all(d);
+            }
+        }
+        eprintln!("specfx: interrupted; earlier results are unchanged");
+        std::process::exit(130);
+    });
+}
+
+/// A result directory that is complete or absent: everything is written into a staging
+/// directory beside it (`.<name>.partial-<pid>`), renamed onto the final path by
+/// [`OutDir::commit`]. Dropped without a commit (an error), the staging directory is removed;
+/// killed, it is left hidden beside the result and removed by the next run.
+///
+/// An existing directory is replaced only when it is an earlier result of the same command
+/// (it holds the [`MARKER`]) or with `force`; anything else there is refused.
+pub struct OutDir {
+    target: PathBuf,
+    staging: PathBuf,
+    done: bool,
+}
+
+impl OutDir {
+    /// Starts writing the result of `command` for `target`.
+    pub fn begin(target: &Path, command: &str, force: bool) -> Result<OutDir> {
+        let name = target
+            .file_name()
+            .with_context(|| format!("{}: expected a directory name", target.display()))?
+            .to_string_lossy()
+            .into_owned();
+        let parent = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        if target.exists() || target.is_symlink() {
+            if !target.is_dir() {
+                anyhow::bail!(
+                    "{}: exists and is not a directory (pass another --out)",
+                    target.display()
+                );
+            }
+            let marker = std::fs::read_to_string(target.join(MARKER)).unwrap_or_default();
+            if !force && marker.split_whitespace().next() != Some(command) {
+                anyhow::bail!(
+                    "{} already exists and is not an earlier `specfx {command}` result: pass --force to replace it",
+                    target.display()
+                );
+            }
+        }
+        std::fs::create_dir_all(&parent)
+            .with_context(|| format!("cannot create {}", parent.display()))?;
+        remove_stale(&parent, &name);
+        let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        if staging.exists() {
+            std::fs::remove_dir_all(&staging)
+                .with_context(|| format!("cannot remove {}", staging.display()))?;
+        }
+        std::fs::create_dir(&staging)
+            .with_context(|| format!("cannot create {}", staging.display()))?;
+        STAGING.lock().expect("staging list").push(staging.clone());
+        let out = OutDir {
+            target: target.to_path_buf(),
+            staging,
+            done: false,
+        };
+        std::fs::write(out.staging.join(MARKER), format!("{command}\n"))
+            .with_context(|| format!("cannot write into {}", out.staging.display()))?;
+        Ok(out)
+    }
+
+    /// Where to write the result's files.
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Puts the finished result in place of the target (and of an earlier result there).
+    pub fn commit(mut self) -> Result<()> {
+        let old = self.staging.with_file_name(
+            self.staging
+                .file_name()
+                .expect("a staging name")
+                .to_string_lossy()
+                .replace(".partial-", ".old-"),
+        );
+        let had_old = self.target.exists();
+        if had_old {
+            std::fs::rename(&self.target, &old)
+                .with_context(|| format!("cannot move {} aside", self.target.display()))?;
+        }
+        if let Err(e) = std::fs::rename(&self.staging, &self.target) {
+            if had_old {
+                let _ = std::fs::rename(&old, &self.target);
+            }
+            return Err(e).with_context(|| {
+                format!(
+                    "cannot rename {} to {}",
+                    self.staging.display(),
+                    self.target.display()
+                )
+            });
+        }
+        self.done = true;
+        self.unregister();
+        if had_old {
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        Ok(())
+    }
+
+    fn unregister(&self) {
+        if let Ok(mut dirs) = STAGING.lock() {
+            dirs.retain(|d| d != &self.staging);
+        }
+    }
+}
+
+impl Drop for OutDir {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = std::fs::remove_dir_all(&self.staging);
+            self.unregister();
+        }
+    }
+}
+
+/// Removes `.<name>.partial-<pid>` and `.<name>.old-<pid>` directories left by processes that
+/// no longer run (killed mid-write).
+fn remove_stale(parent: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let file = e.file_name().to_string_lossy().into_owned();
+        let pid = [".partial-", ".old-"].iter().find_map(|tag| {
+            file.strip_prefix(&format!(".{name}{tag}"))
+                .and_then(|p| p.parse::<u32>().ok())
+        });
+        if let Some(pid) = pid {
+            if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+                let _ = std::fs::remove_dir_all(e.path());
+            }
         }
     }
 }

@@ -32,6 +32,9 @@ pub struct RenderArgs {
     /// Output directory.
     #[arg(long, default_value = "specfx-render")]
     out: PathBuf,
+    /// Replace an existing output directory that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
     /// Print the table as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -48,7 +51,9 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
         .map_or("the built-in scene".to_string(), |p| {
             p.display().to_string()
         });
-    let (rows, table) = render_scene(&scene, &label, &dp, &args.out)?;
+    let out_dir = super::output::OutDir::begin(&args.out, "render", args.force)?;
+    let (rows, table) = render_scene(&scene, &label, &dp, out_dir.path())?;
+    out_dir.commit()?;
     if args.json {
         print_json(&rows)?;
     } else {

@@ -1,6 +1,5 @@
 //! `specfx report`: the main job on built-in defaults.
 
-use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -17,9 +16,13 @@ use specfx::report::paper::write_paper_table;
 /// Arguments of `specfx report`.
 #[derive(Debug, Args)]
 pub struct ReportArgs {
-    /// Output directory (created if missing; files in it are replaced).
+    /// Output directory. It is written completely or not at all (into a hidden staging
+    /// directory beside it, renamed when done), replacing an earlier report there.
     #[arg(long, default_value = "specfx-out")]
     out: PathBuf,
+    /// Replace an existing output directory that is not an earlier report.
+    #[arg(long)]
+    force: bool,
 }
 
 /// Renders into a buffer and writes it atomically to `dir/name`; returns the path.
@@ -225,8 +228,8 @@ fn step(msg: &str) {
 
 /// Runs `specfx report`.
 pub fn run(args: &ReportArgs) -> Result<Outcome> {
-    let dir = &args.out;
-    fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let out_dir = super::output::OutDir::begin(&args.out, "report", args.force)?;
+    let dir = out_dir.path();
     let mut written = Vec::new();
 
     step("reproducing the paper's claims");
@@ -451,7 +454,8 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         + usize::from(paper.delta.reproduced_max)
         + usize::from(paper.delta.reproduced_min);
     let mut out = std::io::stdout().lock();
-    writeln!(out, "specfx report: results in {}", dir.display())?;
+    out_dir.commit()?;
+    writeln!(out, "specfx report: results in {}", args.out.display())?;
     writeln!(
         out,
         "  paper: {n_ok} of {n_claims} printed claims reproduce (details: paper.txt)"

@@ -27,6 +27,9 @@ pub struct StabilityArgs {
     /// Output directory.
     #[arg(long, default_value = "specfx-stability")]
     out: PathBuf,
+    /// Replace an existing output directory that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
     /// Exponents of the map.
     #[arg(long, default_value = "1..=4096")]
     n: NSet,
@@ -186,7 +189,9 @@ pub fn run(args: &StabilityArgs) -> Result<Outcome> {
     if !(1..=24).contains(&grid.c_bits) {
         bail!("--c-bits: expected 1..=24, got {}", grid.c_bits);
     }
-    let report = stability(&args.out, &paths, &grid)?;
+    let out_dir = super::output::OutDir::begin(&args.out, "stability", args.force)?;
+    let report = stability(out_dir.path(), &paths, &grid)?;
+    out_dir.commit()?;
     if args.json {
         print_json(&report)?;
         return Ok(Outcome::Ok);
