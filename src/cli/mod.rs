@@ -116,6 +116,10 @@ const EXAMPLES: &[(&str, &str)] = &[
         "specfx cosim --config my.toml --sim verilator --arch folded --lint",
     ),
     (
+        "trace",
+        "specfx trace compare traces/model.vcd traces/rtl.vcd",
+    ),
+    (
         "cost",
         "specfx cost --config my.toml --target ice40 --timing",
     ),
