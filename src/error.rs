@@ -96,6 +96,14 @@ pub enum Error {
         /// Why.
         reason: String,
     },
+    /// A VCD trace that cannot be read, or lacks what a comparison needs.
+    #[error("{problem}")]
+    Trace {
+        /// Which trace: 0 the first, 1 the second.
+        which: usize,
+        /// What is wrong, e.g. `line 12: ...` or `no signal tb_specfx.clk`.
+        problem: String,
+    },
     /// The minimax table has no entry for this (n, k).
     #[error("no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..=7")]
     NoMinimaxEntry {

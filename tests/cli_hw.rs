@@ -57,7 +57,13 @@ fn sim_writes_a_vcd() {
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.contains("$enddefinitions"));
     assert!(text.contains(" out_valid $end"));
-    assert!(text.contains("#990"), "100 cycles of 10 ns");
+    assert!(text.contains("$scope module u_core $end"));
+    // Reset for four edges (the first at 5 ns), then 100 cycles of 10 ns: cycle 99 ends at
+    // the edge at 1035 ns.
+    assert!(
+        text.contains("#1035\n1!"),
+        "100 cycles of 10 ns after reset"
+    );
     std::fs::remove_file(&path).unwrap();
 }
 

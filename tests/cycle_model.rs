@@ -96,23 +96,7 @@ impl Machine for Literal {
     }
 
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
-        let k = dp.config().k as usize;
-        let mut index_in_op = 0;
-        (0..self.regs.len())
-            .map(|r| {
-                let op = self.owner[r];
-                index_in_op = if r > 0 && self.owner[r - 1] == op {
-                    index_in_op + 1
-                } else {
-                    0
-                };
-                RegisterView {
-                    name: format!("{}_q{}", op.name(), index_in_op),
-                    width: dp.stages()[op.stage().index(k)].format.width(),
-                    value: self.regs[r].map(|t| t.value),
-                }
-            })
-            .collect()
+        specfx::cycle::rtl::pipelined_registers(dp, &self.owner, &self.regs)
     }
 }
 
@@ -288,13 +272,22 @@ fn vcd_trace_parses_back() {
         100,
     );
     let mut buf = Vec::new();
-    specfx::cycle::vcd::write_vcd(&mut buf, &r.trace, 16, 24).unwrap();
+    specfx::cycle::vcd::write_vcd(&mut buf, &dp, Arch::Pipelined, &r.trace).unwrap();
     let mut parser = vcd::Parser::new(&buf[..]);
     let header = parser.parse_header().unwrap();
-    assert!(header.find_var(&["specfx", "out_valid"]).is_some());
+    let core = ["tb_specfx", "dut", "g_pipelined", "u_core"];
     assert!(header
-        .find_var(&["specfx", "registers", "mul_out_q0"])
+        .find_var(&["tb_specfx", "dut", "out_valid"])
         .is_some());
+    let y_q = header
+        .find_var(&[&core[..], &["g_square[4]", "y_q"]].concat())
+        .unwrap();
+    assert_eq!(y_q.size, 17);
+    let word = header
+        .find_var(&[&core[..], &["r_mul_t", "g_regs", "g_stage[0]", "r"]].concat())
+        .unwrap();
+    // {coef_2, threshold_2, offset_2, c_cl_2, t_2}: 24 + 16 + 1 + 16 + 18 bits.
+    assert_eq!(word.size, 75);
     let n_commands = parser.count();
     assert!(n_commands > 100 * 8);
 }

@@ -117,6 +117,11 @@ const CASES: &[Case] = &[
         expect: "expected a regular file, got a FIFO",
     },
     Case {
+        args: &["trace", "compare", "{dir}/a.vcd", "{dir}/fifo.vcd"],
+        inputs: &[Input::File("a.vcd", "$enddefinitions $end\n"), Input::Fifo("fifo.vcd")],
+        expect: "expected a regular file, got a FIFO",
+    },
+    Case {
         args: &["render", "--scene", "{dir}/fifo.toml", "--out", "{dir}/r"],
         inputs: &[Input::Fifo("fifo.toml")],
         expect: "expected a regular file, got a FIFO",

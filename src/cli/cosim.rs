@@ -106,7 +106,9 @@ pub struct CosimArgs {
     /// your own RTL behind the same ports.
     #[arg(long)]
     hdl_ref: Option<PathBuf>,
-    /// Write the RTL's VCD trace (every signal of the testbench) here as rtl.vcd.
+    /// Write both traces of the run into this directory, the RTL's (every signal of the
+    /// testbench) as rtl.vcd and the model's (under the RTL's names) as model.vcd, and compare
+    /// them signal by signal (`specfx trace compare`; exit code 1 when they differ).
     #[arg(long)]
     vcd: Option<PathBuf>,
     /// Keep the work directory (its path is printed) instead of deleting it.
@@ -163,7 +165,19 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
     };
     let dp = super::datapath::load(&vectors.to_string_lossy(), None)?;
-    let stim = write_stimulus(&vectors, args.arch, args.seed, args.bubble, args.stall, wd)?;
+    if let Some(dir) = &args.vcd {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
+    let stim = write_stimulus(
+        &vectors,
+        args.arch,
+        args.seed,
+        args.bubble,
+        args.stall,
+        wd,
+        model_vcd.as_deref(),
+    )?;
     for port in [
         "in_c",
         "in_n",
@@ -229,7 +243,6 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     );
     let log = simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
     if let Some(dir) = &args.vcd {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let from = wd.join("rtl.vcd");
         std::fs::copy(&from, dir.join("rtl.vcd"))
             .with_context(|| format!("the simulator wrote no {}", from.display()))?;
@@ -256,6 +269,20 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     if verdict.passed == 0 {
         eprintln!("cosim: FAIL: nothing was checked");
         return Ok(Outcome::CheckFailed);
+    }
+    if let Some(dir) = &args.vcd {
+        let (model, rtl) = (dir.join("model.vcd"), dir.join("rtl.vcd"));
+        if matches!(
+            super::trace::compare_files(&model, &rtl)?,
+            Outcome::CheckFailed
+        ) {
+            eprintln!(
+                "cosim: FAIL: the model's and the RTL's traces differ ({}, {})",
+                sim.name(),
+                args.arch
+            );
+            return Ok(Outcome::CheckFailed);
+        }
     }
     Ok(Outcome::Ok)
 }

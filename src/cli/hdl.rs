@@ -11,6 +11,7 @@ use super::output::write_atomic;
 use super::sim::parse_probability;
 use super::Outcome;
 use specfx::cycle::sim::{simulate, Stimulus, Stop};
+use specfx::cycle::vcd::write_vcd;
 use specfx::cycle::Arch;
 use specfx::hdl::rom::rom_verilog;
 use specfx::hdl::{render_parameters, ParamsFormat};
@@ -93,6 +94,10 @@ struct StimulusArgs {
     /// Directory for stim_valid.hex, stim_ready.hex, expected_cycle.hex and stim.json.
     #[arg(long)]
     out: PathBuf,
+    /// Also write the model's VCD trace of this run here (every cycle until the last output,
+    /// under the RTL's names), to compare with the testbench's dump (`specfx trace compare`).
+    #[arg(long)]
+    vcd: Option<PathBuf>,
 }
 
 /// Runs `specfx hdl ...`.
@@ -148,7 +153,8 @@ pub struct StimulusInfo {
 
 /// Writes the co-simulation stimulus of a vector directory into `out`: `stim_valid.hex`,
 /// `stim_ready.hex`, `expected_cycle.hex` and `stim.json`, from the cycle model run on the
-/// vectors in file order under seeded bubbles and stalls.
+/// vectors in file order under seeded bubbles and stalls; with `vcd`, also the model's trace
+/// of that run (every cycle until the last output transfers) to that file.
 pub fn write_stimulus(
     dir: &Path,
     arch: Arch,
@@ -156,6 +162,7 @@ pub fn write_stimulus(
     bubble: f64,
     stall: f64,
     out: &Path,
+    vcd: Option<&Path>,
 ) -> Result<StimulusInfo> {
     let dp = super::datapath::load(&dir.to_string_lossy(), None)?;
     let rows = super::datapath::vector_inputs(dir)?;
@@ -170,13 +177,14 @@ pub fn write_stimulus(
         .collect::<Result<_>>()?;
     let mut stim = Stimulus::new(seed, bubble, stall);
     let limit = 1_000 + items.len() as u64 * 1_000;
+    let trace_cycles = if vcd.is_some() { u64::MAX } else { 0 };
     let result = simulate(
         &dp,
         arch,
         items.iter().copied(),
         &mut stim,
         Stop::Drained(limit),
-        0,
+        trace_cycles,
     );
     let s = &result.stats;
     if s.n_outputs != items.len() as u64 || s.mismatches != 0 || s.order_errors != 0 {
@@ -216,6 +224,11 @@ pub fn write_stimulus(
     let mut json = serde_json::to_vec_pretty(&info)?;
     json.push(b'\n');
     write_atomic(&out.join("stim.json"), &json)?;
+    if let Some(path) = vcd {
+        let mut buf = Vec::new();
+        write_vcd(&mut buf, &dp, arch, &result.trace)?;
+        write_atomic(path, &buf)?;
+    }
     Ok(StimulusInfo {
         n_vectors: items.len(),
         n_cycles: s.n_cycles,
@@ -231,6 +244,7 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
         args.bubble,
         args.stall,
         &args.out,
+        args.vcd.as_deref(),
     )?;
     println!(
         "{} vectors over {} cycles ({}, latency {}..{})",

@@ -12,6 +12,16 @@ pub const MAX_TEXT_BYTES: u64 = 16 << 20;
 /// The largest binary input (a mesh): 1 GiB.
 pub const MAX_BINARY_BYTES: u64 = 1 << 30;
 
+/// Refuses a path that is not a regular file (a FIFO or a device would block or never end),
+/// for inputs read as a stream without a size limit (VCD traces); `what` names it in errors.
+pub fn check_regular_file(path: &Path, what: &str) -> Result<()> {
+    let meta = std::fs::metadata(path).with_context(|| format!("{what}: cannot read it"))?;
+    if !meta.is_file() {
+        bail!("{what}: expected a regular file, got {}", kind(&meta));
+    }
+    Ok(())
+}
+
 /// The bytes of a regular file of at most `max` bytes; `what` names it in errors
 /// (e.g. "config my.toml").
 pub fn read_bytes(path: &Path, what: &str, max: u64) -> Result<Vec<u8>> {

@@ -24,6 +24,7 @@ mod sim;
 pub mod stability;
 mod sweep;
 mod throughput;
+mod trace;
 pub mod tradeoff;
 pub mod vectors;
 
@@ -56,6 +57,8 @@ enum Command {
     /// Co-simulates the reference Verilog against golden vectors and the cycle model's output
     /// cycles, in Icarus Verilog or Verilator (bit and cycle exact, under bubbles and stalls).
     Cosim(cosim::CosimArgs),
+    /// VCD traces: compares the model's trace with the RTL's, signal by signal.
+    Trace(trace::TraceArgs),
     /// Synthesis cost of a configuration: yosys on the reference Verilog, and the analytic model.
     Cost(cost::CostArgs),
     /// Calibrates the analytic cost model against yosys: a seeded sample synthesised, the
@@ -111,6 +114,10 @@ const EXAMPLES: &[(&str, &str)] = &[
     (
         "cosim",
         "specfx cosim --config my.toml --sim verilator --arch folded --lint",
+    ),
+    (
+        "trace",
+        "specfx trace compare traces/model.vcd traces/rtl.vcd",
     ),
     (
         "cost",
@@ -318,6 +325,7 @@ pub fn main() -> ExitCode {
         Command::Furnace(args) => furnace::run(&args),
         Command::Stability(args) => stability::run(&args),
         Command::Hdl(args) => hdl::run(&args),
+        Command::Trace(args) => trace::run(&args),
         Command::Throughput(args) => throughput::run(&args),
         Command::Completions(args) => completions(&args),
         Command::Man(args) => man(&args),

@@ -295,12 +295,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         );
         if arch == specfx::cycle::Arch::Pipelined {
             written.push(emit(dir, "sim_baseline_pipelined.vcd", |b| {
-                specfx::cycle::vcd::write_vcd(
-                    b,
-                    &r.trace,
-                    dp.config().c.format.width(),
-                    dp.config().out.format.width(),
-                )
+                specfx::cycle::vcd::write_vcd(b, &dp, arch, &r.trace)
             })?);
         }
         sims.push(r.stats);

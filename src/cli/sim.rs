@@ -49,7 +49,8 @@ pub struct SimArgs {
     /// Exponents, replacing the configuration's set.
     #[arg(long)]
     n: Option<NSet>,
-    /// Write a VCD trace of the first --vcd-cycles cycles here.
+    /// Write a VCD trace of the first --vcd-cycles cycles here, under the reference RTL's
+    /// hierarchy, names and widths (docs/cycle.md, "Traces").
     #[arg(long)]
     vcd: Option<PathBuf>,
     /// Cycles in the VCD trace.
@@ -87,12 +88,7 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
     );
     if let Some(path) = &args.vcd {
         let mut buf = Vec::new();
-        write_vcd(
-            &mut buf,
-            &result.trace,
-            dp.config().c.format.width(),
-            dp.config().out.format.width(),
-        )?;
+        write_vcd(&mut buf, &dp, args.arch, &result.trace)?;
         super::output::write_atomic(path, &buf)?;
     }
     let s = &result.stats;

@@ -23,6 +23,8 @@
 //!
 //! **Invariant:** no I/O here; the VCD writer renders into any `io::Write`.
 
+pub mod compare;
+pub mod rtl;
 pub mod sim;
 pub mod vcd;
 
@@ -188,15 +190,67 @@ impl Op {
     }
 }
 
-/// A named register for traces: its value if it holds one.
+/// A register's bits as the RTL holds them: raw codes concatenated as Verilog's `{a, b, c}`
+/// (the first field in the high bits), each in two's complement of its width.
+///
+/// # Examples
+/// ```
+/// use specfx::cycle::Word;
+/// let w = Word::concat(&[(1, 1), (-2, 3)]); // {1'b1, 3'b110}
+/// assert_eq!(w.width(), 4);
+/// assert_eq!((0..4).map(|i| w.bit(i)).collect::<Vec<_>>(), [false, true, true, true]);
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Word {
+    /// `(raw, width)`, most significant field first.
+    fields: Vec<(i64, u32)>,
+}
+
+impl Word {
+    /// One raw code of `width` bits (bits above 63 repeat the sign).
+    pub fn new(raw: i64, width: u32) -> Word {
+        Word {
+            fields: vec![(raw, width)],
+        }
+    }
+
+    /// Raw codes `(raw, width)` concatenated, the first in the high bits.
+    pub fn concat(fields: &[(i64, u32)]) -> Word {
+        Word {
+            fields: fields.to_vec(),
+        }
+    }
+
+    /// The width in bits.
+    pub fn width(&self) -> u32 {
+        self.fields.iter().map(|f| f.1).sum()
+    }
+
+    /// Bit `i` (0 is the least significant).
+    pub fn bit(&self, i: u32) -> bool {
+        let mut low = 0;
+        for &(raw, width) in self.fields.iter().rev() {
+            if i < low + width {
+                return (raw >> (i - low).min(63)) & 1 == 1;
+            }
+            low += width;
+        }
+        panic!("bit {i} of a {low}-bit word")
+    }
+}
+
+/// A register of the RTL for traces: its hierarchical name below the core instance
+/// (`u_core`), its width and its contents.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RegisterView {
-    /// Register name, e.g. `mul_t_0` or `x`.
+    /// The RTL's name below the core, scopes separated by dots, e.g. `d_1`,
+    /// `g_square[2].y_q` or `r_mul_t.g_regs.g_stage[0].r` (see [`rtl`]).
     pub name: String,
-    /// Bit width in the trace.
+    /// Bit width, the RTL's.
     pub width: u32,
-    /// The value, when the register holds valid data.
-    pub value: Option<i64>,
+    /// The contents, when the register holds valid data (else the RTL's contents are
+    /// unspecified: `x` in a trace).
+    pub value: Option<Word>,
 }
 
 /// One microarchitecture's registers and its clocked step.
@@ -225,7 +279,8 @@ pub trait Machine: Clone {
     fn unit_names(&self) -> Vec<String>;
     /// Whether each unit holds valid data now.
     fn occupancy(&self) -> Vec<bool>;
-    /// Every register, for traces.
+    /// Every register of the RTL core but its ports (`out_valid`, `out_data`), under the RTL's
+    /// names and widths, for traces; only traces call it.
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView>;
 }
 
@@ -348,25 +403,17 @@ impl Machine for Pipelined {
     }
 
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
-        let stages = dp.stages();
-        let k = dp.config().k as usize;
-        let width_of = |op: Op| -> u32 { stages[op.stage().index(k)].format.width() };
-        let mut index_in_op = 0;
-        (0..self.owner.len())
+        let tokens: Vec<Option<Token>> = (0..self.owner.len())
             .map(|r| {
-                let op = self.owner[r];
-                if r > 0 && self.owner[r - 1] == op {
-                    index_in_op += 1;
-                } else {
-                    index_in_op = 0;
-                }
-                RegisterView {
-                    name: format!("{}_q{}", op.name(), index_in_op),
-                    width: width_of(op),
-                    value: self.reg(r).map(|it| it.value_at(dp, op.stage())),
-                }
+                self.reg(r).map(|it| Token {
+                    tag: it.tag,
+                    n_idx: it.n_idx,
+                    c: dp.op_sub(it.c_raw).0,
+                    value: it.value_at(dp, self.owner[r].stage()),
+                })
             })
-            .collect()
+            .collect();
+        rtl::pipelined_registers(dp, &self.owner, &tokens)
     }
 }
 
@@ -426,29 +473,15 @@ impl Machine for Folded {
     }
 
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
-        let widest = dp.widest_stage_bits();
-        vec![
-            RegisterView {
-                name: "x".into(),
-                width: widest,
-                value: self.x.map(|t| t.value),
+        rtl::folded_registers(
+            dp,
+            &rtl::FoldedState {
+                busy: self.busy,
+                step: self.step,
+                count: self.count,
+                x: self.x,
             },
-            RegisterView {
-                name: "step".into(),
-                width: 8,
-                value: self.busy.then_some(self.step as i64),
-            },
-            RegisterView {
-                name: "count".into(),
-                width: 8,
-                value: self.busy.then_some(i64::from(self.count)),
-            },
-            RegisterView {
-                name: "out_q".into(),
-                width: dp.stages()[dp.stage_out()].format.width(),
-                value: self.out.map(|o| o.1),
-            },
-        ]
+        )
     }
 }
 

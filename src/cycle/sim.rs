@@ -50,8 +50,10 @@ pub struct CycleTrace {
     pub in_valid: bool,
     /// `in_ready`.
     pub in_ready: bool,
-    /// `in_c` (when valid).
-    pub in_c: Option<i64>,
+    /// The input on the data ports, `(n_idx, c_raw)`: the source's next input whether it
+    /// offers it or not, as the co-simulation testbench drives them (`None` when the source has
+    /// no input left: the testbench drives zeros).
+    pub input: Option<(usize, i64)>,
     /// `out_valid`.
     pub out_valid: bool,
     /// `out_ready`.
@@ -338,7 +340,7 @@ pub fn run<M: Machine>(
                 cycle,
                 in_valid,
                 in_ready,
-                in_c: next_item.filter(|_| in_valid).map(|(_, c, _)| c),
+                input: next_item.map(|(n_idx, c, _)| (n_idx, c)),
                 out_valid: output.is_some(),
                 out_ready,
                 out_data: output.map(|o| o.1),

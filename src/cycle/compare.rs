@@ -1,0 +1,527 @@
+//! Signal-by-signal comparison of two VCD traces of the co-simulation testbench: the model's
+//! ([`crate::cycle::vcd`]) and a Verilog simulator's dump of `tb_specfx`.
+//!
+//! 1. Signals are matched by their full hierarchical name (`tb_specfx.dut.in_c`), a leading
+//!    `TOP` scope (Verilator's) dropped; a bit-select variable keeps its index (`a[3]`).
+//! 2. Each file is sampled just before every rising edge of `tb_specfx.clk` at which
+//!    `tb_specfx.rst` (when the file has it) is 0: the values of the last time step before the
+//!    edge's. A sample is keyed by the value of `tb_specfx.cycle` (the testbench's cycle
+//!    counter: during cycle t it holds t), so the two files need not share a time line.
+//! 3. For every signal in both files the widths must be equal (a signal whose widths differ is
+//!    reported and not compared); at every cycle sampled in both files, a bit that is `x` or
+//!    `z` in the **first** file is don't-care (the model writes `x` where a register holds no
+//!    valid data), and every other bit must be equal in the second.
+//!
+//! Reads from any `io::BufRead`; the files are the caller's business.
+
+use std::collections::HashMap;
+use std::io::BufRead;
+
+use vcd::{Command, IdCode, ReferenceIndex, ScopeItem, Value, VarType};
+
+use crate::error::Error;
+
+/// The clock, reset and cycle counter every trace is sampled by.
+pub const CLOCK: &str = "tb_specfx.clk";
+/// Samples are taken only while this is 0 (when the file has it).
+pub const RESET: &str = "tb_specfx.rst";
+/// The cycle counter samples are keyed by.
+pub const CYCLE: &str = "tb_specfx.cycle";
+
+/// A signal whose widths differ between the files.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WidthMismatch {
+    /// Full name.
+    pub signal: String,
+    /// Width in the first file.
+    pub first: u32,
+    /// Width in the second file.
+    pub second: u32,
+}
+
+/// The first cycle at which the files differ.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Difference {
+    /// The cycle (`tb_specfx.cycle`).
+    pub cycle: u64,
+    /// The first differing signal in the first file's declaration order.
+    pub signal: String,
+    /// Its value in the first file, hexadecimal (`x` for a digit with an unknown bit).
+    pub first: String,
+    /// Its value in the second file.
+    pub second: String,
+    /// The other signals that differ at that cycle, in the same order.
+    pub also: Vec<String>,
+}
+
+/// What [`compare`] found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Comparison {
+    /// Signals in both files with equal widths, compared at every common cycle.
+    pub signals_compared: usize,
+    /// Signals only in the first file.
+    pub only_first: Vec<String>,
+    /// Signals only in the second file.
+    pub only_second: Vec<String>,
+    /// Signals in both files with different widths.
+    pub width_mismatches: Vec<WidthMismatch>,
+    /// Cycles sampled in both files.
+    pub cycles_compared: u64,
+    /// Cycles sampled only in the first file.
+    pub cycles_only_first: u64,
+    /// Cycles sampled only in the second file.
+    pub cycles_only_second: u64,
+    /// Compared signals that are unknown (`x` or `z` in every bit) in the first file at every
+    /// cycle compared: nothing of them was checked.
+    pub never_known: Vec<String>,
+    /// Signals that differ at some cycle.
+    pub signals_differing: usize,
+    /// The first cycle with a difference.
+    pub first_difference: Option<Difference>,
+}
+
+impl Comparison {
+    /// Whether the files agree: something was compared, no width differs, no value differs.
+    pub fn agrees(&self) -> bool {
+        self.signals_compared > 0
+            && self.cycles_compared > 0
+            && self.width_mismatches.is_empty()
+            && self.first_difference.is_none()
+    }
+}
+
+/// A variable of a file: full name, width, identifier.
+struct Var {
+    name: String,
+    width: u32,
+    code: IdCode,
+}
+
+fn trace_error(which: usize, problem: String) -> Error {
+    Error::Trace { which, problem }
+}
+
+/// The file's variables in declaration order, full names unique (the first kept).
+fn variables(items: &[ScopeItem]) -> Vec<Var> {
+    fn walk(items: &[ScopeItem], path: &mut Vec<String>, out: &mut Vec<Var>) {
+        for item in items {
+            match item {
+                ScopeItem::Scope(s) => {
+                    // Verilator puts the design under a scope of its own.
+                    let top = path.is_empty() && s.identifier == "TOP";
+                    if !top {
+                        path.push(s.identifier.clone());
+                    }
+                    walk(&s.items, path, out);
+                    if !top {
+                        path.pop();
+                    }
+                }
+                ScopeItem::Var(v) => {
+                    if matches!(v.var_type, VarType::Real | VarType::String | VarType::Event) {
+                        continue;
+                    }
+                    let mut name = path.clone();
+                    let leaf = match v.index {
+                        Some(ReferenceIndex::BitSelect(i)) => format!("{}[{i}]", v.reference),
+                        _ => v.reference.clone(),
+                    };
+                    name.push(leaf);
+                    out.push(Var {
+                        name: name.join("."),
+                        width: v.size,
+                        code: v.code,
+                    });
+                }
+                _ => {}
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(items, &mut Vec::new(), &mut out);
+    let mut seen = std::collections::HashSet::new();
+    out.retain(|v| seen.insert(v.name.clone()));
+    out
+}
+
+/// The bits of some signals, packed: values and unknown (`x`/`z`) masks, bit `offset + i` of
+/// a signal at `offset` being its bit i.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Packed {
+    value: Vec<u64>,
+    unknown: Vec<u64>,
+}
+
+impl Packed {
+    fn get(&self, bit: usize) -> Option<bool> {
+        let (w, b) = (bit / 64, bit % 64);
+        if self.unknown[w] >> b & 1 == 1 {
+            None
+        } else {
+            Some(self.value[w] >> b & 1 == 1)
+        }
+    }
+}
+
+/// Where each compared signal sits in a [`Packed`] sample.
+struct Layout {
+    /// Per compared signal: bit offset, width.
+    fields: Vec<(usize, u32)>,
+    words: usize,
+}
+
+impl Layout {
+    fn new(widths: impl Iterator<Item = u32>) -> Layout {
+        let mut offset = 0;
+        let fields = widths
+            .map(|w| {
+                let f = (offset, w);
+                offset += w as usize;
+                f
+            })
+            .collect();
+        Layout {
+            fields,
+            words: offset.div_ceil(64).max(1),
+        }
+    }
+}
+
+/// A value change extended to `width` bits, most significant first (VCD's rule: a shorter
+/// value is padded on the left with 0, or with `x`/`z` when its first bit is one).
+fn extend(v: &[Value], width: usize) -> Vec<Value> {
+    if v.len() >= width {
+        return v[v.len() - width..].to_vec();
+    }
+    let pad = match v.first() {
+        Some(Value::X) => Value::X,
+        Some(Value::Z) => Value::Z,
+        None => Value::X,
+        _ => Value::V0,
+    };
+    let mut out = vec![pad; width - v.len()];
+    out.extend_from_slice(v);
+    out
+}
+
+/// One file being read: the parser, the current value of each variable of interest.
+struct Reader<R> {
+    which: usize,
+    parser: vcd::Parser<R>,
+    /// Identifier of each slot's variable(s) to the slot.
+    slots: HashMap<IdCode, usize>,
+    /// The current value of each slot, most significant bit first.
+    current: Vec<Vec<Value>>,
+    clk: usize,
+    rst: Option<usize>,
+    cycle: usize,
+    /// Per compared signal, its slot.
+    signal_slots: Vec<usize>,
+}
+
+impl<R: BufRead> Reader<R> {
+    /// Prepares to sample `compared` (full names) of a file whose variables are `vars`.
+    fn new(which: usize, parser: vcd::Parser<R>, vars: &[Var], compared: &[&str]) -> Reader<R> {
+        let mut slots = HashMap::new();
+        let mut current = Vec::new();
+        let mut slot_of = |v: &Var| -> usize {
+            *slots.entry(v.code).or_insert_with(|| {
+                current.push(vec![Value::X; v.width as usize]);
+                current.len() - 1
+            })
+        };
+        let find = |name: &str| vars.iter().find(|v| v.name == name);
+        let clk = slot_of(find(CLOCK).expect("checked"));
+        let rst = find(RESET).map(&mut slot_of);
+        let cycle = slot_of(find(CYCLE).expect("checked"));
+        let signal_slots = compared
+            .iter()
+            .map(|name| slot_of(find(name).expect("in both files")))
+            .collect();
+        Reader {
+            which,
+            parser,
+            slots,
+            current,
+            clk,
+            rst,
+            cycle,
+            signal_slots,
+        }
+    }
+
+    /// Reads the whole file, calling `sample(cycle, values)` before each rising clock edge at
+    /// which reset is low and the cycle counter known.
+    fn run(
+        mut self,
+        layout: &Layout,
+        mut sample: impl FnMut(u64, Packed) -> Result<(), Error>,
+    ) -> Result<(), Error> {
+        let mut batch: Vec<(usize, Vec<Value>)> = Vec::new();
+        loop {
+            let command = self.parser.next().transpose().map_err(|e| {
+                trace_error(self.which, format!("line {}: {e}", self.parser.line()))
+            })?;
+            let end_of_step = matches!(command, None | Some(Command::Timestamp(_)));
+            if end_of_step {
+                let clk_before = self.current[self.clk].last().copied();
+                let clk_after = batch
+                    .iter()
+                    .rev()
+                    .find(|(slot, _)| *slot == self.clk)
+                    .and_then(|(_, v)| v.last().copied());
+                if clk_before != Some(Value::V1) && clk_after == Some(Value::V1) {
+                    if let Some((cycle, packed)) = self.sample(layout) {
+                        sample(cycle, packed)?;
+                    }
+                }
+                for (slot, v) in batch.drain(..) {
+                    self.current[slot] = v;
+                }
+            }
+            match command {
+                None => return Ok(()),
+                Some(Command::ChangeScalar(id, v)) => self.change(&mut batch, id, &[v]),
+                Some(Command::ChangeVector(id, v)) => {
+                    let v: Vec<Value> = v.iter().collect();
+                    self.change(&mut batch, id, &v)
+                }
+                Some(_) => {}
+            }
+        }
+    }
+
+    fn change(&self, batch: &mut Vec<(usize, Vec<Value>)>, id: IdCode, v: &[Value]) {
+        if let Some(&slot) = self.slots.get(&id) {
+            batch.push((slot, extend(v, self.current[slot].len())));
+        }
+    }
+
+    /// The values now, if this is a sample: reset low, the cycle counter known.
+    fn sample(&self, layout: &Layout) -> Option<(u64, Packed)> {
+        if let Some(rst) = self.rst {
+            if self.current[rst].iter().any(|&b| b != Value::V0) {
+                return None;
+            }
+        }
+        let mut cycle = 0u64;
+        for &b in &self.current[self.cycle] {
+            cycle = cycle.wrapping_shl(1)
+                | match b {
+                    Value::V0 => 0,
+                    Value::V1 => 1,
+                    _ => return None,
+                };
+        }
+        let mut packed = Packed {
+            value: vec![0; layout.words],
+            unknown: vec![0; layout.words],
+        };
+        for (&slot, &(offset, width)) in self.signal_slots.iter().zip(&layout.fields) {
+            let v = &self.current[slot];
+            for i in 0..width as usize {
+                let bit = offset + i;
+                let (w, b) = (bit / 64, bit % 64);
+                match v[v.len() - 1 - i] {
+                    Value::V0 => {}
+                    Value::V1 => packed.value[w] |= 1 << b,
+                    _ => packed.unknown[w] |= 1 << b,
+                }
+            }
+        }
+        Some((cycle, packed))
+    }
+}
+
+/// A signal's value in a sample, hexadecimal: one digit per 4 bits, `x` for a digit with an
+/// unknown bit.
+fn hex(packed: &Packed, offset: usize, width: u32) -> String {
+    let digits = (width as usize).div_ceil(4).max(1);
+    (0..digits)
+        .rev()
+        .map(|d| {
+            let mut nibble = 0;
+            for i in (0..4).rev() {
+                let bit = d * 4 + i;
+                if bit >= width as usize {
+                    continue;
+                }
+                match packed.get(offset + bit) {
+                    None => return 'x',
+                    Some(b) => nibble = nibble << 1 | u32::from(b),
+                }
+            }
+            char::from_digit(nibble, 16).expect("a nibble")
+        })
+        .collect()
+}
+
+/// Whether signal `(offset, width)` differs: a known bit of `first` that `second` does not
+/// have (unknown in `second`, or the other value).
+fn differs(first: &Packed, second: &Packed, offset: usize, width: u32) -> bool {
+    (offset..offset + width as usize).any(|bit| match first.get(bit) {
+        None => false,
+        Some(b) => second.get(bit) != Some(b),
+    })
+}
+
+/// The variables of a file's header, which must hold the clock and the cycle counter.
+fn header<R: BufRead>(which: usize, p: &mut vcd::Parser<R>) -> Result<Vec<Var>, Error> {
+    let h = p
+        .parse_header()
+        .map_err(|e| trace_error(which, format!("not a VCD file: line {}: {e}", p.line())))?;
+    let vars = variables(&h.items);
+    for needed in [CLOCK, CYCLE] {
+        if !vars.iter().any(|v| v.name == needed) {
+            return Err(trace_error(which, format!("no signal {needed}")));
+        }
+    }
+    Ok(vars)
+}
+
+/// Compares two VCD traces of the testbench (see the module documentation); `first`'s `x` and
+/// `z` bits are don't-care.
+///
+/// # Errors
+/// [`Error::Trace`] (naming the file, 0 or 1) when a file is not VCD or lacks `tb_specfx.clk`
+/// or `tb_specfx.cycle`.
+///
+/// # Examples
+/// ```
+/// use specfx::cycle::compare::compare;
+/// let model = "$scope module tb_specfx $end $var reg 1 ! clk $end
+/// $var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end $enddefinitions $end
+/// #0 0! b0 \" bx #
+/// #5 1! #6 b1 \" b101 # #10 0! #15 1!\n";
+/// let rtl = model.replace("b101", "b100");
+/// let c = compare(model.as_bytes(), rtl.as_bytes()).unwrap();
+/// let d = c.first_difference.unwrap();
+/// assert_eq!((d.cycle, d.signal.as_str(), d.first.as_str(), d.second.as_str()),
+///     (1, "tb_specfx.v", "5", "4"));
+/// assert_eq!(c.cycles_compared, 2); // cycle 0: v is x in the model, don't-care
+/// ```
+pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, Error> {
+    let mut pa = vcd::Parser::new(first);
+    let mut pb = vcd::Parser::new(second);
+    let va = header(0, &mut pa)?;
+    let vb = header(1, &mut pb)?;
+    let by_name_b: HashMap<&str, &Var> = vb.iter().map(|v| (v.name.as_str(), v)).collect();
+    let by_name_a: HashMap<&str, &Var> = va.iter().map(|v| (v.name.as_str(), v)).collect();
+    let mut compared: Vec<(&str, u32)> = Vec::new();
+    let mut width_mismatches = Vec::new();
+    let mut only_first = Vec::new();
+    for a in &va {
+        match by_name_b.get(a.name.as_str()) {
+            None => only_first.push(a.name.clone()),
+            Some(b) if b.width != a.width => width_mismatches.push(WidthMismatch {
+                signal: a.name.clone(),
+                first: a.width,
+                second: b.width,
+            }),
+            Some(_) => compared.push((&a.name, a.width)),
+        }
+    }
+    let only_second: Vec<String> = vb
+        .iter()
+        .filter(|b| !by_name_a.contains_key(b.name.as_str()))
+        .map(|b| b.name.clone())
+        .collect();
+    let names: Vec<&str> = compared.iter().map(|c| c.0).collect();
+    let layout = Layout::new(compared.iter().map(|c| c.1));
+
+    // The first file's samples, then the second's compared with them as they come.
+    let mut samples_a: Vec<Packed> = Vec::new();
+    let mut index_a: HashMap<u64, usize> = HashMap::new();
+    Reader::new(0, pa, &va, &names).run(&layout, |cycle, packed| {
+        index_a.entry(cycle).or_insert_with(|| {
+            samples_a.push(packed);
+            samples_a.len() - 1
+        });
+        Ok(())
+    })?;
+    let mut matched = vec![false; samples_a.len()];
+    let mut seen_b = std::collections::HashSet::new();
+    let (mut cycles_compared, mut cycles_only_second) = (0u64, 0u64);
+    let mut first_cycle_of = vec![None::<u64>; compared.len()];
+    let mut known = vec![false; compared.len()];
+    let mut first_difference: Option<Difference> = None;
+    Reader::new(1, pb, &vb, &names).run(&layout, |cycle, b| {
+        if !seen_b.insert(cycle) {
+            return Ok(());
+        }
+        let Some(&ia) = index_a.get(&cycle) else {
+            cycles_only_second += 1;
+            return Ok(());
+        };
+        matched[ia] = true;
+        cycles_compared += 1;
+        let a = &samples_a[ia];
+        for (s, k) in known.iter_mut().enumerate() {
+            let (offset, width) = layout.fields[s];
+            *k = *k || (offset..offset + width as usize).any(|bit| a.get(bit).is_some());
+        }
+        let differing: Vec<usize> = (0..compared.len())
+            .filter(|&s| differs(a, &b, layout.fields[s].0, layout.fields[s].1))
+            .collect();
+        for &s in &differing {
+            let first = first_cycle_of[s].get_or_insert(cycle);
+            *first = (*first).min(cycle);
+        }
+        if let Some(&s) = differing.first() {
+            if first_difference.as_ref().is_none_or(|d| cycle < d.cycle) {
+                let (offset, width) = layout.fields[s];
+                first_difference = Some(Difference {
+                    cycle,
+                    signal: names[s].to_string(),
+                    first: hex(a, offset, width),
+                    second: hex(&b, offset, width),
+                    also: differing[1..]
+                        .iter()
+                        .map(|&o| names[o].to_string())
+                        .collect(),
+                });
+            }
+        }
+        Ok(())
+    })?;
+    Ok(Comparison {
+        signals_compared: compared.len(),
+        only_first,
+        only_second,
+        width_mismatches,
+        cycles_compared,
+        cycles_only_first: matched.iter().filter(|&&m| !m).count() as u64,
+        cycles_only_second,
+        never_known: (0..compared.len())
+            .filter(|&s| !known[s])
+            .map(|s| names[s].to_string())
+            .collect(),
+        signals_differing: first_cycle_of.iter().filter(|c| c.is_some()).count(),
+        first_difference,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn short_vector_values_are_padded_as_vcd_says() {
+        use Value::*;
+        assert_eq!(extend(&[V1, V0], 4), [V0, V0, V1, V0]);
+        assert_eq!(extend(&[X, V1], 3), [X, X, V1]);
+        assert_eq!(extend(&[Z], 2), [Z, Z]);
+        assert_eq!(extend(&[V1, V1, V0], 2), [V1, V0]);
+    }
+
+    #[test]
+    fn hex_digits_show_unknown_nibbles() {
+        let p = Packed {
+            value: vec![0b1_0110_1010],
+            unknown: vec![1 << 9],
+        };
+        assert_eq!(hex(&p, 0, 9), "16a");
+        assert_eq!(hex(&p, 0, 10), "x6a");
+        assert_eq!(hex(&p, 4, 4), "6");
+    }
+}
