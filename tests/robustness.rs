@@ -105,6 +105,28 @@ const CASES: &[Case] = &[
         )],
         expect: "expected at most 1048576 points",
     },
+    // Counts that cannot be written, or that wrap.
+    Case {
+        args: &[
+            "vectors",
+            "--cases",
+            "random:18446744073709551615,random:1",
+            "--out",
+            "{dir}/v",
+        ],
+        inputs: &[],
+        expect: "at most 67108864 in all",
+    },
+    Case {
+        args: &["vectors", "--cases", "random:1000000000000", "--out", "{dir}/v"],
+        inputs: &[],
+        expect: "at most 67108864 in all",
+    },
+    Case {
+        args: &["cosim", "--bubble", "0.9999", "--sim", "icarus", "--cases", "corner"],
+        inputs: &[],
+        expect: "the stimulus is limited to 67108864 cycles",
+    },
     // Files that are not regular files would block or never end.
     Case {
         args: &["check", "--config", "{dir}/fifo.toml"],

@@ -141,6 +141,10 @@ fn bits_file(bits: &[bool]) -> String {
         .collect()
 }
 
+/// The longest stimulus `specfx hdl stimulus` writes, in cycles (a line of each of its bit
+/// files per cycle).
+pub const MAX_STIMULUS_CYCLES: u64 = 1 << 26;
+
 /// What [`write_stimulus`] wrote: the run's size and latency range.
 pub struct StimulusInfo {
     /// Vectors streamed.
@@ -176,7 +180,20 @@ pub fn write_stimulus(
         })
         .collect::<Result<_>>()?;
     let mut stim = Stimulus::new(seed, bubble, stall);
-    let limit = 1_000 + items.len() as u64 * 1_000;
+    // Each vector needs about one offer (1 / (1 - bubble) cycles) and, folded, an initiation
+    // interval of accepted outputs (ii / (1 - stall)); twenty times that, plus the latency,
+    // drains any run but one of vanishing probability. Longer stimuli are refused up front.
+    let ii = arch.initiation_interval(dp.config()) as f64;
+    let per_vector = 1.0 / (1.0 - bubble) + ii / (1.0 - stall);
+    let expected = (items.len() as f64 * per_vector).ceil();
+    let limit_f = 20.0 * expected + 100.0 * arch.latency(dp.config()) as f64 + 1_000.0;
+    if limit_f > MAX_STIMULUS_CYCLES as f64 {
+        bail!(
+            "--bubble {bubble} and --stall {stall} would need about {expected:.0} cycles for {} vectors; the stimulus is limited to {MAX_STIMULUS_CYCLES} cycles (lower the probabilities or use fewer vectors)",
+            items.len()
+        );
+    }
+    let limit = limit_f as u64;
     let trace_cycles = if vcd.is_some() { u64::MAX } else { 0 };
     let result = simulate(
         &dp,
@@ -187,6 +204,13 @@ pub fn write_stimulus(
         trace_cycles,
     );
     let s = &result.stats;
+    if s.n_outputs != items.len() as u64 && s.mismatches == 0 && s.order_errors == 0 {
+        bail!(
+            "the stimulus did not drain within {limit} cycles ({} of {} outputs, --bubble {bubble}, --stall {stall}): lower the probabilities or change --seed",
+            s.n_outputs,
+            items.len()
+        );
+    }
     if s.n_outputs != items.len() as u64 || s.mismatches != 0 || s.order_errors != 0 {
         bail!(
             "the cycle model delivered {} of {} outputs with {} mismatches: this is a bug",

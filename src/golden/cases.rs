@@ -100,7 +100,15 @@ impl FromStr for CaseSelection {
                         .and_then(|c| c.parse::<u64>().ok())
                         .filter(|&c| c > 0)
                         .ok_or_else(|| bad(part))?;
-                    sel.random += count;
+                    sel.random = sel
+                        .random
+                        .checked_add(count)
+                        .filter(|&r| r <= MAX_CASES)
+                        .ok_or_else(|| Error::OutOfRange {
+                            what: "the number of random vectors",
+                            expected: format!("at most {MAX_CASES} in all"),
+                            got: s.to_string(),
+                        })?;
                 }
             }
         }
