@@ -4,7 +4,7 @@
 //! `SPECFX_COCOTB_PYTHON`) and Icarus Verilog.
 
 mod common;
-use common::specfx;
+use common::{config_path, specfx};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -33,14 +33,6 @@ fn temp_dir(name: &str) -> PathBuf {
     let p = std::env::temp_dir().join(format!("specfx-cocotb-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&p);
     p
-}
-
-fn config_path(name: &str) -> String {
-    root()
-        .join("tests/configs")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
 }
 
 /// Writes vectors into a fresh directory; returns it and the manifest's `n_vectors`.

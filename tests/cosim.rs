@@ -2,7 +2,7 @@
 //! in Icarus Verilog and Verilator (both must be installed: `./scripts/test` installs them).
 
 mod common;
-use common::specfx;
+use common::{config_path, specfx};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -67,14 +67,6 @@ fn vectors(config: &str, name: &str, cases: &str) -> (PathBuf, u64) {
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
     (dir, manifest["n_vectors"].as_u64().unwrap())
-}
-
-fn config_path(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/configs")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
 }
 
 fn check_all(config: &str, name: &str, arch: &str, cases: &str) {

@@ -4,7 +4,7 @@
 //! and signal; the comparison's rules on hand-written traces.
 
 mod common;
-use common::specfx;
+use common::{config_path, specfx};
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -20,14 +20,6 @@ fn temp_dir(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&p);
     std::fs::create_dir_all(&p).unwrap();
     p
-}
-
-fn config_path(name: &str) -> String {
-    root()
-        .join("tests/configs")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
 }
 
 fn json(path: &Path) -> serde_json::Value {

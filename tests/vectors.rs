@@ -3,7 +3,7 @@
 //! `$readmemh` files, each checked against figures the test derives itself.
 
 mod common;
-use common::specfx;
+use common::{config_path, specfx};
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -15,14 +15,6 @@ use specfx::pipeline::{Config, Datapath};
 /// A fresh, empty temporary directory that is removed when dropped.
 fn temp_dir() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
-}
-
-fn config_path(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/configs")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
 }
 
 /// Few non-zero outputs: a coarse output (LSB 2) and, at n = 1500, only the last codes below

@@ -13,10 +13,8 @@ use std::process::Command;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 
-use super::hdl::write_stimulus;
-use super::sim::parse_probability;
+use super::hdl::{write_stimulus, RunOpts};
 use super::Outcome;
-use specfx::cycle::Arch;
 use specfx::golden::{CaseSelection, Order};
 use specfx::hdl::{render_parameters, ParamsFormat};
 use specfx::nset::NSet;
@@ -82,18 +80,8 @@ pub struct CosimArgs {
     /// The simulator: icarus or verilator. Default: icarus when installed, else verilator.
     #[arg(long)]
     sim: Option<Simulator>,
-    /// Microarchitecture: pipelined or folded.
-    #[arg(long, default_value = "pipelined")]
-    arch: Arch,
-    /// Seed of the bubble/stall patterns (and of the vectors written for --config).
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Probability that the source offers no input in a cycle.
-    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
-    bubble: f64,
-    /// Probability that the sink is not ready in a cycle.
-    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
-    stall: f64,
+    #[command(flatten)]
+    run: RunOpts,
     /// Build the DUT with RESET_DATA = 1 (data registers cleared on reset; the testbench then
     /// also checks that out_data is 0 in the first cycle).
     #[arg(long)]
@@ -160,7 +148,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         None => {
             let dp = super::datapath::load(&args.config, args.n.as_ref())?;
             let dir = wd.join("vectors");
-            super::vectors::write_dir(&dp, &dir, &args.cases, args.order, args.seed, false)?;
+            super::vectors::write_dir(&dp, &dir, &args.cases, args.order, args.run.seed, false)?;
             dir
         }
     };
@@ -169,15 +157,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
-    let stim = write_stimulus(
-        &vectors,
-        args.arch,
-        args.seed,
-        args.bubble,
-        args.stall,
-        wd,
-        model_vcd.as_deref(),
-    )?;
+    let stim = write_stimulus(&vectors, args.run, wd, model_vcd.as_deref())?;
     for port in [
         "in_c",
         "in_n",
@@ -197,7 +177,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         ("NCYC".to_string(), stim.n_cycles as i64),
     ];
     params.extend(
-        render_parameters(&dp, args.arch, args.reset_data, ParamsFormat::Json, "")
+        render_parameters(&dp, args.run.arch, args.reset_data, ParamsFormat::Json, "")
             .parse::<serde_json::Value>()
             .ok()
             .and_then(|v| v.as_object().cloned())
@@ -228,13 +208,13 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     eprintln!(
         "cosim: {}, {}, {} vectors ({}), {} stimulus cycles (seed {}, bubble {}, stall {}){}",
         sim.name(),
-        args.arch,
+        args.run.arch,
         stim.n_vectors,
         dp.config().name,
         stim.n_cycles,
-        args.seed,
-        args.bubble,
-        args.stall,
+        args.run.seed,
+        args.run.bubble,
+        args.run.stall,
         if args.reset_data {
             ", RESET_DATA = 1"
         } else {
@@ -263,7 +243,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     }
     println!("{} passed, {} failed", verdict.passed, verdict.failed);
     if verdict.failed != 0 {
-        eprintln!("cosim: FAIL ({}, {})", sim.name(), args.arch);
+        eprintln!("cosim: FAIL ({}, {})", sim.name(), args.run.arch);
         return Ok(Outcome::CheckFailed);
     }
     if verdict.passed == 0 {
@@ -279,7 +259,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             eprintln!(
                 "cosim: FAIL: the model's and the RTL's traces differ ({}, {})",
                 sim.name(),
-                args.arch
+                args.run.arch
             );
             return Ok(Outcome::CheckFailed);
         }

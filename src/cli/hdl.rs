@@ -74,23 +74,31 @@ struct RomArgs {
     out: Option<PathBuf>,
 }
 
+/// The run a stimulus describes: the microarchitecture and the seeded valid/ready patterns
+/// (`specfx hdl stimulus`, `specfx cosim`).
+#[derive(Debug, Clone, Copy, Args)]
+pub struct RunOpts {
+    /// Microarchitecture: pipelined or folded.
+    #[arg(long, default_value = "pipelined")]
+    pub arch: Arch,
+    /// Seed of the bubble/stall patterns (`cosim`: also of the vectors it writes).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Probability that the source offers no input in a cycle.
+    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
+    pub bubble: f64,
+    /// Probability that the sink is not ready in a cycle.
+    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
+    pub stall: f64,
+}
+
 #[derive(Debug, Args)]
 struct StimulusArgs {
     /// The vector directory (written by `specfx vectors`).
     #[arg(long)]
     vectors: PathBuf,
-    /// Microarchitecture: pipelined or folded.
-    #[arg(long, default_value = "pipelined")]
-    arch: Arch,
-    /// Seed of the bubble/stall patterns.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Probability that the source offers no input in a cycle.
-    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
-    bubble: f64,
-    /// Probability that the sink is not ready in a cycle.
-    #[arg(long, default_value = "0.2", value_parser = parse_probability)]
-    stall: f64,
+    #[command(flatten)]
+    run: RunOpts,
     /// Directory for stim_valid.hex, stim_ready.hex, expected_cycle.hex and stim.json.
     #[arg(long)]
     out: PathBuf,
@@ -161,13 +169,16 @@ pub struct StimulusInfo {
 /// of that run (every cycle until the last output transfers) to that file.
 pub fn write_stimulus(
     dir: &Path,
-    arch: Arch,
-    seed: u64,
-    bubble: f64,
-    stall: f64,
+    run: RunOpts,
     out: &Path,
     vcd: Option<&Path>,
 ) -> Result<StimulusInfo> {
+    let RunOpts {
+        arch,
+        seed,
+        bubble,
+        stall,
+    } = run;
     let dp = super::datapath::load(&dir.to_string_lossy(), None)?;
     let rows = super::datapath::vector_inputs(dir)?;
     let ns = dp.config().n.values();
@@ -261,18 +272,10 @@ pub fn write_stimulus(
 }
 
 fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
-    let s = write_stimulus(
-        &args.vectors,
-        args.arch,
-        args.seed,
-        args.bubble,
-        args.stall,
-        &args.out,
-        args.vcd.as_deref(),
-    )?;
+    let s = write_stimulus(&args.vectors, args.run, &args.out, args.vcd.as_deref())?;
     println!(
         "{} vectors over {} cycles ({}, latency {}..{})",
-        s.n_vectors, s.n_cycles, args.arch, s.latency.0, s.latency.1
+        s.n_vectors, s.n_cycles, args.run.arch, s.latency.0, s.latency.1
     );
     Ok(Outcome::Ok)
 }

@@ -22,3 +22,13 @@ pub fn srgb8(x: f64) -> u16 {
     };
     (s * 255.0).round() as u16
 }
+
+/// The path of a configuration in `tests/configs/`, as an argument for `--config`.
+#[allow(dead_code)]
+pub fn config_path(name: &str) -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/configs")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
