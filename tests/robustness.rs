@@ -127,6 +127,27 @@ const CASES: &[Case] = &[
         inputs: &[],
         expect: "the stimulus is limited to 67108864 cycles",
     },
+    // Options whose help makes the value bad input, and their messages.
+    Case {
+        args: &["optimize", "--start-frac", "0", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "0 is not in 1..=48",
+    },
+    Case {
+        args: &["minimax", "--k", "0"],
+        inputs: &[],
+        expect: "expected numbers of squarings k in 1..=7",
+    },
+    Case {
+        args: &["optimize", "--k", "8", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "expected numbers of squarings k in 1..=7",
+    },
+    Case {
+        args: &["hdl", "stimulus", "--vectors", "{dir}", "--bubble", "1", "--out", "{dir}/s"],
+        inputs: &[],
+        expect: "expected a probability in [0, 1)",
+    },
     // Files that are not regular files would block or never end.
     Case {
         args: &["check", "--config", "{dir}/fifo.toml"],
@@ -186,6 +207,26 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
         }
     }
     out
+}
+
+/// A full disk behind stdout is an error that names stdout, not a panic.
+#[test]
+fn a_full_stdout_is_named() {
+    for args in [
+        &["paper"][..],
+        &["check", "--n", "16..=20"][..],
+        &["hdl", "params"][..],
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+            .args(args)
+            .stdout(std::fs::File::create("/dev/full").unwrap())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("cannot write to stdout"), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
 }
 
 #[test]

@@ -255,7 +255,7 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
     if args.json {
         print_json(&report)?;
     } else {
-        let mut out = std::io::stdout().lock();
+        let mut out = super::output::stdout();
         let a = &report.attribution;
         writeln!(
             out,

@@ -239,9 +239,9 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
     };
     for line in &verdict.problems {
-        println!("{line}");
+        super::output::outln!("{line}")?;
     }
-    println!("{} passed, {} failed", verdict.passed, verdict.failed);
+    super::output::outln!("{} passed, {} failed", verdict.passed, verdict.failed)?;
     if verdict.failed != 0 {
         eprintln!("cosim: FAIL ({}, {})", sim.name(), args.run.arch);
         return Ok(Outcome::CheckFailed);

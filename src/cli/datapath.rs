@@ -108,3 +108,16 @@ pub fn vector_inputs(dir: &Path) -> Result<Vec<(u32, i64)>> {
     }
     Ok(rows)
 }
+
+/// Parses a set of numbers of squarings (`--k`): the n-set notation (`4`, `3..=5`, `1,4,7`)
+/// with every value in 1..=7.
+pub fn parse_k_set(s: &str) -> std::result::Result<NSet, String> {
+    let bad =
+        || format!("expected numbers of squarings k in 1..=7 (e.g. 4, 3..=5 or 1,4,7), got '{s}'");
+    let set: NSet = s.parse().map_err(|_| bad())?;
+    if set.values().iter().all(|k| (1..=7).contains(k)) {
+        Ok(set)
+    } else {
+        Err(bad())
+    }
+}

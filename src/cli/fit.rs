@@ -45,7 +45,7 @@ pub struct FitArgs {
     #[arg(long)]
     analytic_only: bool,
     /// Fraction bits the internal stages start from (the search shrinks them).
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=48))]
     start_frac: i32,
     /// Output directory.
     #[arg(long, default_value = "specfx-fit")]
@@ -224,7 +224,10 @@ pub fn run(args: &FitArgs) -> Result<Outcome> {
             if args.json {
                 print_json(&report)?;
             } else {
-                print!("{}", summary(&report));
+                super::output::print_with(|w| {
+                    use std::io::Write as _;
+                    write!(w, "{}", summary(&report))
+                })?;
                 eprintln!("fit: wrote {}", args.out.display());
             }
             Ok(Outcome::Ok)
@@ -497,24 +500,29 @@ fn print_no_fit(
     scene: &Scene,
     budget: &ImageBudget,
 ) -> Result<()> {
-    println!("fit: no datapath meets '{budget}' on this scene");
-    println!("the f64 floor of each algorithm (its image without quantization, against cos^n):");
-    print!("{}", floors_markdown(floors));
+    super::output::outln!("fit: no datapath meets '{budget}' on this scene")?;
+    super::output::outln!(
+        "the f64 floor of each algorithm (its image without quantization, against cos^n):"
+    )?;
+    super::output::print_with(|w| {
+        use std::io::Write as _;
+        write!(w, "{}", floors_markdown(floors))
+    })?;
     let best_floor = floors
         .iter()
         .filter_map(|f| f.figures.as_ref().map(|e| (f, budget.excess(scene, e))))
         .min_by(|a, b| a.1.total_cmp(&b.1));
     if let Some((f, excess)) = best_floor {
-        println!(
+        super::output::outln!(
             "the closest algorithm is k = {}, {}, whose f64 floor alone is {excess:.2}x the budget: no quantization can do better; loosen the budget to its floor's figures (see the table) or lower the scene's exponents",
             f.k,
             f.variant.name(),
-        );
+        )?;
     }
     if let Some(c) = closest {
         let dp = Datapath::new(c.config.clone())?;
         let e = judge.figures(&judge.datapath_image(&dp), true).all;
-        println!(
+        super::output::outln!(
             "closest datapath searched: k = {}, {}: max {} LSB, {:.2}% differing, FLIP {:.5} ({:.2}x the budget)",
             c.config.k,
             c.config.variant.name(),
@@ -522,7 +530,7 @@ fn print_no_fit(
             100.0 * e.differing,
             e.flip_mean,
             c.excess
-        );
+        )?;
     }
     Ok(())
 }

@@ -63,7 +63,10 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
     if args.json {
         print_json(&summary)?;
     } else {
-        print!("{}", summary_text(&summary));
+        super::output::print_with(|w| {
+            use std::io::Write as _;
+            write!(w, "{}", summary_text(&summary))
+        })?;
         eprintln!("furnace: wrote {}", out.display());
     }
     Ok(Outcome::Ok)

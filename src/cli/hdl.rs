@@ -273,9 +273,13 @@ pub fn write_stimulus(
 
 fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
     let s = write_stimulus(&args.vectors, args.run, &args.out, args.vcd.as_deref())?;
-    println!(
+    super::output::outln!(
         "{} vectors over {} cycles ({}, latency {}..{})",
-        s.n_vectors, s.n_cycles, args.run.arch, s.latency.0, s.latency.1
-    );
+        s.n_vectors,
+        s.n_cycles,
+        args.run.arch,
+        s.latency.0,
+        s.latency.1
+    )?;
     Ok(Outcome::Ok)
 }

@@ -41,13 +41,13 @@ pub struct OptimizeArgs {
     target: Target,
     /// Numbers of squarings to try (each is searched only if its f64 floor can meet the
     /// budget).
-    #[arg(long, default_value = "1..=7")]
+    #[arg(long, default_value = "1..=7", value_parser = super::datapath::parse_k_set)]
     k: NSet,
     /// Variants to try: plain, minimax or both.
     #[arg(long, default_value = "plain,minimax", value_delimiter = ',')]
     variants: Vec<String>,
     /// Fraction bits every searched stage starts from (must meet the budget).
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=48))]
     start_frac: i32,
     /// Microarchitecture costed.
     #[arg(long, default_value = "pipelined")]
@@ -161,18 +161,19 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    println!(
+    super::output::outln!(
         "optimize: budget '{}', {} exhaustive checks",
-        r.budget, r.n_evaluations
-    );
+        r.budget,
+        r.n_evaluations
+    )?;
     let Some(best) = &r.best else {
-        println!("no configuration in the space meets the budget");
-        println!("the f64 floor of each algorithm (its own error against cos^n before any quantization):");
+        super::output::outln!("no configuration in the space meets the budget")?;
+        super::output::outln!("the f64 floor of each algorithm (its own error against cos^n before any quantization):")?;
         let normalised = r.budget.bounds.iter().any(|b| b.metric.is_normalised());
         for f in &r.floors {
             let a = f.algorithm;
             match (f.shape_total, &f.reason) {
-                (Some(x), _) => println!(
+                (Some(x), _) => super::output::outln!(
                     "  k = {} {:<8} shape_total floor {:.3e} ({:.2} lsb8){}{}",
                     a.k,
                     a.variant.name(),
@@ -190,13 +191,13 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                     } else {
                         ": beyond the budget"
                     }
-                ),
-                (None, reason) => println!(
+                )?,
+                (None, reason) => super::output::outln!(
                     "  k = {} {:<8} not valid: {}",
                     a.k,
                     a.variant.name(),
                     reason.as_deref().unwrap_or("")
-                ),
+                )?,
             }
         }
         if let Some(f) = r
@@ -205,18 +206,18 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             .filter(|f| f.shape_total.is_some())
             .min_by(|a, b| a.shape_total.unwrap().total_cmp(&b.shape_total.unwrap()))
         {
-            println!(
+            super::output::outln!(
                 "closest algorithm: k = {} {}, whose f64 floor is {:.3e} ({:.2} lsb8); what would meet the budget: a shape_total limit above that floor (quantization adds to it), or fewer exponents (--n: the floors fall when every n is at least m = 2^k)",
                 f.algorithm.k,
                 f.algorithm.variant.name(),
                 f.shape_total.unwrap(),
                 f.shape_total.unwrap() * 256.0
-            );
+            )?;
         }
         if let Some(c) = &r.closest {
             let dp = Datapath::new(c.config.clone())?;
             let chk = check(&dp).map_err(anyhow::Error::msg)?;
-            println!(
+            super::output::outln!(
                 "closest: k = {}, {}: shape_total {:.3e}, shape_quant {:.3e}, out {:.2} ulp, {:.2}% correct ({:.2}x the budget)",
                 c.config.k,
                 c.config.variant.name(),
@@ -225,7 +226,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                 chk.out_max_ulp,
                 100.0 * chk.stages[dp.stage_out()].correctly_rounded,
                 c.excess
-            );
+            )?;
             for b in r.budget.bounds.iter().filter(|b| b.metric.is_cost()) {
                 let value = match b.metric {
                     Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t) => {
@@ -245,7 +246,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                     ),
                 };
                 let kind = if b.metric.is_yosys() { "" } else { "analytic " };
-                println!("  its {kind}{}: {value} (limit {})", b.metric, b.limit);
+                super::output::outln!("  its {kind}{}: {value} (limit {})", b.metric, b.limit)?;
             }
         }
         return Ok(Outcome::CheckFailed);
@@ -265,7 +266,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             continue;
         };
         let f = synth(&dp, arch, t)?;
-        println!(
+        super::output::outln!(
             "yosys on {}: {} {}, {} DSPs, {} flip-flops (the budget's {} <= {})",
             t.name(),
             f.luts,
@@ -274,7 +275,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             f.ffs,
             b.metric,
             b.limit
-        );
+        )?;
     }
     let header = format!(
         "# specfx optimize: cheapest configuration found for the budget '{}'\n# cost {:.0} {unit} ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
@@ -291,7 +292,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         &args.out,
         format!("{header}{}", config.to_toml()).as_bytes(),
     )?;
-    println!(
+    super::output::outln!(
         "best: k = {}, {}, t {} b {} squares {} out {}: {:.0} {unit} ({})",
         config.k,
         config.variant.name(),
@@ -306,14 +307,14 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         config.out.format,
         best.cost,
         args.objective
-    );
-    println!(
+    )?;
+    super::output::outln!(
         "proved by an exhaustive check: shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded",
         proof.shape_total_max_abs,
         proof.shape_quant_max_abs,
         proof.out_max_ulp,
         100.0 * proof.stages[dp.stage_out()].correctly_rounded
-    );
+    )?;
     // Overflow: a stage left to wrap must never overflow on any input (the exhaustive check
     // counts every event).
     let wrapping: Vec<String> = proof
@@ -323,12 +324,12 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         .map(|s| format!("{} ({} times)", s.stage, s.wrapped))
         .collect();
     if wrapping.is_empty() {
-        println!("overflow: no stage wraps on any input (exhaustive)");
+        super::output::outln!("overflow: no stage wraps on any input (exhaustive)")?;
     } else {
-        println!(
+        super::output::outln!(
             "overflow: WARNING, these stages wrap on some inputs although the budget holds: {}",
             wrapping.join(", ")
-        );
+        )?;
     }
     // The answer's cost on every target, beside the paper's datapath (baseline: plain, k = 4)
     // serving the same exponents.
@@ -336,27 +337,29 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     paper_cfg.n = config.n.clone();
     let paper = Datapath::new(paper_cfg)?;
     let paper_check = specfx::analysis::check::check_outputs(&paper)?;
-    println!(
+    super::output::outln!(
         "against the paper's datapath (baseline: plain, k = 4, same n): shape_total {:.3e} ({:.2} lsb8) against {:.3e} ({:.2} lsb8)",
         proof.shape_total_max_abs,
         proof.shape_total_max_abs / specfx::analysis::LSB8,
         paper_check.shape_total_max_abs,
         paper_check.shape_total_max_abs / specfx::analysis::LSB8
-    );
-    println!("  analytic cost, {arch} (the model `specfx cost --analytic-only` prints):");
-    println!("    {:<8} {:>28} {:>28}", "target", "this", "paper's");
+    )?;
+    super::output::outln!(
+        "  analytic cost, {arch} (the model `specfx cost --analytic-only` prints):"
+    )?;
+    super::output::outln!("    {:<8} {:>28} {:>28}", "target", "this", "paper's")?;
     for target in specfx::hdl::cost::REPORTED_TARGETS {
         let a = analytic_cost(&dp, arch, target);
         let p = analytic_cost(&paper, arch, target);
         let show = |c: &specfx::hdl::cost::AnalyticCost| {
             format!("{} {} {} DSPs {} FFs", c.luts, c.logic_unit, c.dsps, c.ffs)
         };
-        println!("    {:<8} {:>28} {:>28}", target.name(), show(&a), show(&p));
+        super::output::outln!("    {:<8} {:>28} {:>28}", target.name(), show(&a), show(&p))?;
     }
-    println!("why minimal (within this search, not over every possible datapath):");
+    super::output::outln!("why minimal (within this search, not over every possible datapath):")?;
     for m in &r.minimality {
-        println!("  {m}");
+        super::output::outln!("  {m}")?;
     }
-    println!("written to {}", args.out.display());
+    super::output::outln!("written to {}", args.out.display())?;
     Ok(Outcome::Ok)
 }

@@ -44,11 +44,51 @@ pub fn write_chart(dir: &Path, stem: &str, chart: &specfx::report::chart::Chart)
     Ok(svg)
 }
 
+/// Standard output whose errors say that they are stdout's (a full disk behind `> file`, a
+/// closed pipe), keeping the error kind so that a broken pipe is still recognised.
+pub struct Stdout(io::StdoutLock<'static>);
+
+/// Locks standard output; see [`Stdout`].
+pub fn stdout() -> Stdout {
+    Stdout(io::stdout().lock())
+}
+
+fn on_stdout(e: io::Error) -> io::Error {
+    io::Error::new(e.kind(), format!("cannot write to stdout: {e}"))
+}
+
+impl Write for Stdout {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.0.write(buf).map_err(on_stdout)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.0.flush().map_err(on_stdout)
+    }
+}
+
+impl Drop for Stdout {
+    fn drop(&mut self) {
+        // Errors were reported by the explicit flush of the callers that care; a late one
+        // (after a broken pipe) is not worth a panic.
+        let _ = self.0.flush();
+    }
+}
+
+/// `println!` on [`stdout`], returning the error (which names stdout) instead of panicking.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let mut out = $crate::cli::output::stdout();
+        writeln!(out, $($arg)*).and_then(|()| out.flush())
+    }};
+}
+pub(crate) use outln;
+
 /// Renders into a buffer with a writer function, then prints it to stdout in one go.
 pub fn print_with(render: impl FnOnce(&mut Vec<u8>) -> io::Result<()>) -> Result<()> {
     let mut buf = Vec::new();
     render(&mut buf)?;
-    let mut out = io::stdout().lock();
+    let mut out = stdout();
     out.write_all(&buf)?;
     out.flush()?;
     Ok(())

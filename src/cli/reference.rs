@@ -104,7 +104,7 @@ pub struct MinimaxArgs {
     #[arg(long, default_value = "16,64,256,1024")]
     n: NSet,
     /// Numbers of squarings to show, e.g. 4 or 1..=7.
-    #[arg(long, default_value = "4")]
+    #[arg(long, default_value = "4", value_parser = super::datapath::parse_k_set)]
     k: NSet,
     /// Recompute the whole table (n = 1..=N_MAX, k = 1..=7) and write it to this CSV file
     /// (the library embeds data/minimax.csv).

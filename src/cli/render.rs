@@ -57,7 +57,10 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
     if args.json {
         print_json(&rows)?;
     } else {
-        print!("{table}");
+        super::output::print_with(|w| {
+            use std::io::Write as _;
+            write!(w, "{table}")
+        })?;
         eprintln!("render: wrote {}", args.out.display());
     }
     Ok(Outcome::Ok)

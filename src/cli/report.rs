@@ -460,7 +460,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
         + usize::from(paper.delta.reproduced_max)
         + usize::from(paper.delta.reproduced_min);
-    let mut out = std::io::stdout().lock();
+    let mut out = super::output::stdout();
     out_dir.commit()?;
     writeln!(out, "specfx report: results in {}", args.out.display())?;
     writeln!(

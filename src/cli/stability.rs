@@ -196,7 +196,7 @@ pub fn run(args: &StabilityArgs) -> Result<Outcome> {
         print_json(&report)?;
         return Ok(Outcome::Ok);
     }
-    let mut out = std::io::stdout().lock();
+    let mut out = super::output::stdout();
     writeln!(
         out,
         "{:<16} {:>9} {:>11} {:>6} {:>8}  failing regions",

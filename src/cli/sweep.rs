@@ -157,12 +157,12 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
         synthesise_front(&info.space, &mut points, target, dir)?;
     }
     write_results(dir, &mut points, info.space.target)?;
-    println!(
+    super::output::outln!(
         "sweep: {} points in {} ({} on the Pareto front)",
         points.len(),
         dir.display(),
         points.iter().filter(|p| p.pareto).count()
-    );
+    )?;
     Ok(Outcome::Ok)
 }
 
@@ -313,11 +313,11 @@ fn merge(out: &Path, shards: &[PathBuf]) -> Result<Outcome> {
     write_atomic(&out.join("points.jsonl"), lines.as_bytes())?;
     let mut points: Vec<PointResult> = points.into_values().collect();
     write_results(out, &mut points, target)?;
-    println!(
+    super::output::outln!(
         "sweep merge: {} points from {} shards into {}",
         points.len(),
         shards.len(),
         out.display()
-    );
+    )?;
     Ok(Outcome::Ok)
 }

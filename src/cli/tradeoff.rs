@@ -160,7 +160,7 @@ pub fn run(args: &TradeoffArgs) -> Result<Outcome> {
     if args.json {
         print_json(&figures)?;
     } else {
-        let mut out = std::io::stdout().lock();
+        let mut out = super::output::stdout();
         writeln!(
             out,
             "{:<16} {:>6} {:>11} {:>11} {:>12} {:>5} {:>22} {:>7}",

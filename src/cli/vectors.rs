@@ -55,14 +55,14 @@ pub fn run(args: &VectorsArgs) -> Result<Outcome> {
         args.seed,
         args.force,
     )?;
-    println!(
+    super::output::outln!(
         "wrote {n} vectors ({}, {} order, seed {}) to {}",
         args.cases,
         args.order,
         args.seed,
         args.out.display()
-    );
-    println!("{}", coverage.summary());
+    )?;
+    super::output::outln!("{}", coverage.summary())?;
     Ok(Outcome::Ok)
 }
 
