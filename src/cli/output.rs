@@ -176,8 +176,8 @@ pub fn install_interrupt_handler() {
 /// [`OutDir::commit`]. Dropped without a commit (an error), the staging directory is removed;
 /// killed, it is left hidden beside the result and removed by the next run.
 ///
-/// An existing directory is replaced only when it is an earlier result of the same command
-/// (it holds the [`MARKER`]) or with `force`; anything else there is refused.
+/// An existing directory is replaced only when it is empty, an earlier result of the same
+/// command (it holds the [`MARKER`]) or with `force`; anything else there is refused.
 pub struct OutDir {
     target: PathBuf,
     staging: PathBuf,
@@ -204,7 +204,8 @@ impl OutDir {
                 );
             }
             let marker = std::fs::read_to_string(target.join(MARKER)).unwrap_or_default();
-            if !force && marker.split_whitespace().next() != Some(command) {
+            let empty = std::fs::read_dir(target).is_ok_and(|mut d| d.next().is_none());
+            if !force && !empty && marker.split_whitespace().next() != Some(command) {
                 anyhow::bail!(
                     "{} already exists and is not an earlier `specfx {command}` result: pass --force to replace it",
                     target.display()
