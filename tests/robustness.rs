@@ -339,7 +339,10 @@ fn results_replace_their_own_kind_only() {
         specfx_in(&dir, &args)
     };
     std::fs::create_dir(dir.join("b")).unwrap();
-    assert!(budget("b", false).status.success(), "an empty directory is taken");
+    assert!(
+        budget("b", false).status.success(),
+        "an empty directory is taken"
+    );
     let first = std::fs::read(dir.join("b/budget.json")).unwrap();
     assert!(
         budget("b", false).status.success(),
