@@ -184,6 +184,366 @@ const CASES: &[Case] = &[
         inputs: &[Input::File("c.toml", "k = 9\n")],
         expect: "k",
     },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "k = 0\n")],
+        expect: "k",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "k = \"four\"\n")],
+        expect: "line 1: invalid type: string",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "nonsense = 1\n")],
+        expect: "nonsense",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[t]\nformat = \"q1.15\"\n")],
+        expect: "t",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[t]\nformat = \"s1.200\"\n")],
+        expect: "t",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[t]\nrounding = \"ROUND\"\n")],
+        expect: "ROUND",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[t]\noverflow = \"CLIP\"\n")],
+        expect: "CLIP",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "cutoff = \"maybe\"\n")],
+        expect: "maybe",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "variant = \"spline\"\n")],
+        expect: "spline",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "n = \"0..=4\"\n")],
+        expect: "n",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "n = \"100..=10\"\n")],
+        expect: "n",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "n = \"1..=70000\"\n")],
+        expect: "n",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[latency]\nmul = 0\n")],
+        expect: "latency.mul",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[latency]\nmul = 9\n")],
+        expect: "latency.mul",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[[square]]\nformat = \"u1.15\"\n")],
+        expect: "square",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[c]\nformat = \"u1.70\"\n")],
+        expect: "c",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[coef]\nform = \"lambert\"\n")],
+        expect: "lambert",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[coef]\nsource = \"guess\"\n")],
+        expect: "guess",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "k = 4\nk = 5\n")],
+        expect: "line",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[t\n")],
+        expect: "line",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "name = 5\n")],
+        expect: "line 1: invalid type: integer",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "name = \"xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx\"\n")],
+        expect: "65 characters",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[out]\nformat = \"u0.0\"\n")],
+        expect: "u0.0",
+    },
+    Case {
+        args: &["check", "--n", "0"],
+        inputs: &[],
+        expect: "n",
+    },
+    Case {
+        args: &["check", "--n", "a..b"],
+        inputs: &[],
+        expect: "n",
+    },
+    Case {
+        args: &["check", "--n", "5..=3"],
+        inputs: &[],
+        expect: "n",
+    },
+    Case {
+        args: &["check", "--n", "1..=99999"],
+        inputs: &[],
+        expect: "n",
+    },
+    Case {
+        args: &["check", "--n", ","],
+        inputs: &[],
+        expect: "n",
+    },
+    Case {
+        args: &["check", "--n", "16,,32"],
+        inputs: &[],
+        expect: "n",
+    },
+    Case {
+        args: &["vectors", "--cases", "random:0", "--out", "{dir}/v"],
+        inputs: &[],
+        expect: "case",
+    },
+    Case {
+        args: &["vectors", "--cases", "random:x", "--out", "{dir}/v"],
+        inputs: &[],
+        expect: "case",
+    },
+    Case {
+        args: &["vectors", "--cases", "corner,bogus", "--out", "{dir}/v"],
+        inputs: &[],
+        expect: "case",
+    },
+    Case {
+        args: &["vectors", "--cases", "random:-1", "--out", "{dir}/v"],
+        inputs: &[],
+        expect: "case",
+    },
+    Case {
+        args: &["vectors", "--cases", "", "--out", "{dir}/v"],
+        inputs: &[],
+        expect: "case",
+    },
+    Case {
+        args: &["sim", "--bubble", "1"],
+        inputs: &[],
+        expect: "probability",
+    },
+    Case {
+        args: &["sim", "--bubble=-0.1"],
+        inputs: &[],
+        expect: "probability",
+    },
+    Case {
+        args: &["sim", "--bubble", "nan"],
+        inputs: &[],
+        expect: "probability",
+    },
+    Case {
+        args: &["sim", "--bubble", "x"],
+        inputs: &[],
+        expect: "probability",
+    },
+    Case {
+        args: &["sim", "--arch", "systolic"],
+        inputs: &[],
+        expect: "systolic",
+    },
+    Case {
+        args: &["sim", "--cycles", "0"],
+        inputs: &[],
+        expect: "--cycles",
+    },
+    Case {
+        args: &["cost", "--target", "asic7nm", "--analytic-only"],
+        inputs: &[],
+        expect: "asic7nm",
+    },
+    Case {
+        args: &["optimize", "--target", "gowin", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "gowin",
+    },
+    Case {
+        args: &["sweep", "--shard", "4/4", "--out", "{dir}/sw"],
+        inputs: &[],
+        expect: "shard",
+    },
+    Case {
+        args: &["sweep", "--shard", "5/4", "--out", "{dir}/sw"],
+        inputs: &[],
+        expect: "shard",
+    },
+    Case {
+        args: &["sweep", "--shard", "1/0", "--out", "{dir}/sw"],
+        inputs: &[],
+        expect: "shard",
+    },
+    Case {
+        args: &["sweep", "--shard", "a/b", "--out", "{dir}/sw"],
+        inputs: &[],
+        expect: "shard",
+    },
+    Case {
+        args: &["sweep", "--shard", "1", "--out", "{dir}/sw"],
+        inputs: &[],
+        expect: "shard",
+    },
+    Case {
+        args: &["hdl", "params", "--format", "vhdl"],
+        inputs: &[],
+        expect: "vhdl",
+    },
+    Case {
+        args: &["cosim", "--sim", "modelsim"],
+        inputs: &[],
+        expect: "modelsim",
+    },
+    Case {
+        args: &["cosim", "--vectors", "{dir}/nothing"],
+        inputs: &[],
+        expect: "manifest.json",
+    },
+    Case {
+        args: &["hdl", "stimulus", "--vectors", "{dir}", "--out", "{dir}/s"],
+        inputs: &[],
+        expect: "manifest.json",
+    },
+    Case {
+        args: &["trace", "compare", "{dir}/a.vcd", "{dir}/b.vcd"],
+        inputs: &[],
+        expect: "a.vcd",
+    },
+    Case {
+        args: &["coef", "--form", "cook_torrance", "--source", "exact", "--n", "16"],
+        inputs: &[],
+        expect: "cook_torrance",
+    },
+    Case {
+        args: &["coef", "--form", "phong", "--source", "oracle", "--n", "16"],
+        inputs: &[],
+        expect: "oracle",
+    },
+    Case {
+        args: &["optimize", "--budget", "shape_total < 1 lsb8", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "budget",
+    },
+    Case {
+        args: &["optimize", "--budget", "correct <= 99%", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "budget",
+    },
+    Case {
+        args: &["optimize", "--budget", "shape_total <= 1 parsecs", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "budget",
+    },
+    Case {
+        args: &["optimize", "--budget", "luts <= 8 on fpga", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "budget",
+    },
+    Case {
+        args: &["optimize", "--budget", "out <= 1 lsb8", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "budget",
+    },
+    Case {
+        args: &["optimize", "--budget", "shape_total <= lsb8", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "budget",
+    },
+    Case {
+        args: &["optimize", "--budget", "shape_total <= 1 lsb8,", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "budget",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("s.toml", "[vary]\nwarp = [1, 2]\n")],
+        expect: "warp",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("s.toml", "[vary]\nk = []\n")],
+        expect: "vary.k",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("s.toml", "[vary]\nk = [9]\n")],
+        expect: "vary.k",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("s.toml", "target = \"asic\"\n[vary]\nk = [4]\n")],
+        expect: "target",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("s.toml", "[vary]\n\"square.frac\" = \"a..=b\"\n")],
+        expect: "vary.square.frac",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("s.toml", "bogus = 1\n")],
+        expect: "bogus",
+    },
+    Case {
+        args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
+        inputs: &[Input::File("sc.toml", "[image]\nwidth = 0\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n")],
+        expect: "width",
+    },
+    Case {
+        args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
+        inputs: &[Input::File("sc.toml", "[image]\nwidth = 100000\nheight = 100000\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n")],
+        expect: "image",
+    },
+    Case {
+        args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
+        inputs: &[Input::File("sc.toml", "[image]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 0\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n")],
+        expect: "n",
+    },
+    Case {
+        args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
+        inputs: &[Input::File("sc.toml", "[image]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n\n[[object]]\nkind = \"mesh\"\nmaterial = \"a\"\nfile = \"missing.obj\"\n")],
+        expect: "missing.obj",
+    },
+    Case {
+        args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
+        inputs: &[Input::File("sc.toml", "not toml at all")],
+        expect: "line",
+    },
 ];
 
 /// How long a case may run before it counts as hung.
