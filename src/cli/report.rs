@@ -461,6 +461,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         + usize::from(paper.delta.reproduced_max)
         + usize::from(paper.delta.reproduced_min);
     let mut out = super::output::stdout();
+    let staged = out_dir.path().to_path_buf();
     out_dir.commit()?;
     writeln!(out, "specfx report: results in {}", args.out.display())?;
     writeln!(
@@ -569,7 +570,9 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     }
     writeln!(out, "  files:")?;
     for p in &written {
-        writeln!(out, "    {}", p.display())?;
+        // Written into the staging directory, now renamed to --out.
+        let rel = p.strip_prefix(&staged).unwrap_or(p);
+        writeln!(out, "    {}", args.out.join(rel).display())?;
     }
     Ok(Outcome::Ok)
 }
