@@ -180,7 +180,8 @@ pub fn corner_codes(
             }
         }
         CutStructure::Scan => {
-            let n_codes = (last - lo + 1).max(0) as u64;
+            let n_codes = u64::try_from((i128::from(last) - i128::from(lo) + 1).max(0))
+                .unwrap_or(u64::MAX);
             if n_codes > MAX_SCAN_CODES {
                 return Err(Error::OutOfRange {
                     what: "the corner-case scan",
@@ -409,7 +410,7 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Vec<(u32,
         set.extend(live_codes(dp, n, &mut cols).into_iter().map(|c| (n, c)));
     }
     if sel.random > 0 {
-        let total = ns.len() as u128 * (hi - lo + 1) as u128;
+        let total = ns.len() as u128 * (i128::from(hi) - i128::from(lo) + 1) as u128;
         let wanted = (set.len() as u128 + u128::from(sel.random)).min(total);
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         while (set.len() as u128) < wanted {

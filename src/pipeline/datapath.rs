@@ -203,11 +203,13 @@ fn sum_bits(a: Format, b: Format) -> u32 {
 /// use specfx::pipeline::first_code_where;
 /// assert_eq!(first_code_where(0..100, |c| c * c >= 50), 8);
 /// assert_eq!(first_code_where(0..5, |_| false), 5);
+/// assert_eq!(first_code_where(i64::MIN..i64::MAX, |c| c >= -3), -3);
 /// ```
 pub fn first_code_where(codes: std::ops::Range<i64>, holds: impl Fn(i64) -> bool) -> i64 {
     let (mut lo, mut hi) = (codes.start, codes.end);
     while lo < hi {
-        let mid = lo + (hi - lo) / 2;
+        // The midpoint in i128: a 64-bit code range would overflow `hi - lo`.
+        let mid = ((i128::from(lo) + i128::from(hi)) >> 1) as i64;
         if holds(mid) {
             hi = mid;
         } else {
