@@ -180,8 +180,8 @@ pub fn corner_codes(
             }
         }
         CutStructure::Scan => {
-            let n_codes = u64::try_from((i128::from(last) - i128::from(lo) + 1).max(0))
-                .unwrap_or(u64::MAX);
+            let n_codes =
+                u64::try_from((i128::from(last) - i128::from(lo) + 1).max(0)).unwrap_or(u64::MAX);
             if n_codes > MAX_SCAN_CODES {
                 return Err(Error::OutOfRange {
                     what: "the corner-case scan",
