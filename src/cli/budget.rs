@@ -244,7 +244,12 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
         }
         None => Some(spread(&ns)),
     };
-    let out_dir = super::output::OutDir::begin(&args.out, "budget", args.force)?;
+    let out_dir = super::output::OutDir::begin(
+        &args.out,
+        "budget",
+        args.force,
+        &super::output::inputs(&args.config, None),
+    )?;
     let report = budget(
         &dp,
         args.budget.as_ref(),

@@ -99,6 +99,10 @@ pub struct CosimArgs {
     /// them signal by signal (`specfx trace compare`; exit code 1 when they differ).
     #[arg(long)]
     vcd: Option<PathBuf>,
+    /// Replace rtl.vcd and model.vcd in the --vcd directory when they are not an earlier
+    /// result of this command.
+    #[arg(long)]
+    force: bool,
     /// Keep the work directory (its path is printed) instead of deleting it.
     #[arg(long)]
     keep: bool,
@@ -120,6 +124,23 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     let sim = choose_simulator(args.sim)?;
     if args.lint && !Simulator::Verilator.installed() {
         bail!("--lint: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator)");
+    }
+    if let Some(dir) = &args.vcd {
+        // An earlier cosim's traces (model.vcd begins with the model's header) are replaced;
+        // other files of those names only with --force; never an input.
+        let mut inputs = super::output::inputs(&args.config, None);
+        if let Some(v) = &args.vectors {
+            inputs.extend(super::output::config_inputs_as(
+                "--vectors",
+                &v.to_string_lossy(),
+            ));
+        }
+        let model = dir.join("model.vcd");
+        let header = Some(specfx::cycle::vcd::VCD_HEADER);
+        super::output::check_file_output(&model, "--vcd", &inputs, header, args.force)?;
+        let earlier = model.is_file();
+        let rtl = dir.join("rtl.vcd");
+        super::output::check_file_output(&rtl, "--vcd", &inputs, None, args.force || earlier)?;
     }
     let hdl = super::cost::hdl_ref_dir(args.hdl_ref.as_deref());
     let rtl = rtl_sources(&hdl)?;

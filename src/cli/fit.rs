@@ -209,7 +209,12 @@ pub fn run(args: &FitArgs) -> Result<Outcome> {
         .map_or("the built-in scene".to_string(), |p| {
             p.display().to_string()
         });
-    let out_dir = super::output::OutDir::begin(&args.out, "fit", args.force)?;
+    let out_dir = super::output::OutDir::begin(
+        &args.out,
+        "fit",
+        args.force,
+        &super::output::inputs(&args.config, args.scene.as_deref()),
+    )?;
     let staged = FitArgs {
         out: out_dir.path().to_path_buf(),
         ..args.clone()

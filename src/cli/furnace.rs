@@ -55,7 +55,12 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
         settings.angles_deg().len(),
         dp.config().name
     );
-    let out_dir = super::output::OutDir::begin(&args.out, "furnace", args.force)?;
+    let out_dir = super::output::OutDir::begin(
+        &args.out,
+        "furnace",
+        args.force,
+        &super::output::inputs(&args.config, None),
+    )?;
     let report = write_furnace(&dp, &settings, out_dir.path())?;
     out_dir.commit()?;
     let out = &args.out;

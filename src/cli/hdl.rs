@@ -62,6 +62,9 @@ struct ParamsArgs {
     /// Write the parameters here instead of printing them.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace an existing output file that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(Debug, Args)]
@@ -72,6 +75,9 @@ struct RomArgs {
     /// Write the module here instead of printing it.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace an existing output file that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
 }
 
 /// The run a stimulus describes: the microarchitecture and the seeded valid/ready patterns
@@ -106,6 +112,9 @@ struct StimulusArgs {
     /// under the RTL's names), to compare with the testbench's dump (`specfx trace compare`).
     #[arg(long)]
     vcd: Option<PathBuf>,
+    /// Replace existing files that are not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
 }
 
 /// Runs `specfx hdl ...`.
@@ -119,13 +128,37 @@ pub fn run(args: &HdlArgs) -> Result<Outcome> {
 
 fn rom(args: &RomArgs) -> Result<Outcome> {
     let dp = super::datapath::load(&args.config, None)?;
-    print_or_write(args.out.as_deref(), &rom_verilog(&dp))
+    let out = Output {
+        path: args.out.as_deref(),
+        inputs: super::output::inputs(&args.config, None),
+        own_header: Some("// specfx_rom: "),
+        force: args.force,
+    };
+    print_or_write(out, &rom_verilog(&dp))
 }
 
-/// Writes `text` to `out`, or prints it.
-fn print_or_write(out: Option<&std::path::Path>, text: &str) -> Result<Outcome> {
-    match out {
-        Some(path) => write_atomic(path, text.as_bytes())?,
+/// Where `hdl params` and `hdl rom` put their text: a file (checked before it is written)
+/// or stdout.
+struct Output<'a> {
+    path: Option<&'a Path>,
+    inputs: Vec<(&'static str, PathBuf)>,
+    own_header: Option<&'static str>,
+    force: bool,
+}
+
+/// Writes `text` to the output's file, or prints it.
+fn print_or_write(out: Output, text: &str) -> Result<Outcome> {
+    match out.path {
+        Some(path) => {
+            super::output::check_file_output(
+                path,
+                "--out",
+                &out.inputs,
+                out.own_header,
+                out.force,
+            )?;
+            write_atomic(path, text.as_bytes())?
+        }
         None => super::output::print_with(|w| {
             use std::io::Write;
             w.write_all(text.as_bytes())
@@ -140,7 +173,22 @@ fn params(args: &ParamsArgs) -> Result<Outcome> {
         None => super::datapath::load(&args.config, None)?,
     };
     let text = render_parameters(&dp, args.arch, args.reset_data, args.format, &args.top);
-    print_or_write(args.out.as_deref(), &text)
+    let inputs = match &args.vectors {
+        Some(dir) => super::output::config_inputs_as("--vectors", &dir.to_string_lossy()),
+        None => super::output::config_inputs_as("--config", &args.config),
+    };
+    let own_header = match args.format {
+        ParamsFormat::Define => Some("// specfx parameters: "),
+        ParamsFormat::Instance => Some("// specfx_top for configuration "),
+        _ => None,
+    };
+    let out = Output {
+        path: args.out.as_deref(),
+        inputs,
+        own_header,
+        force: args.force,
+    };
+    print_or_write(out, &text)
 }
 
 fn bits_file(bits: &[bool]) -> String {
@@ -179,17 +227,21 @@ pub fn write_stimulus(
         bubble,
         stall,
     } = run;
-    let dp = super::datapath::load(&dir.to_string_lossy(), None)?;
-    let rows = super::datapath::vector_inputs(dir)?;
+    let vectors = super::vectordir::open(dir)?;
+    let dp =
+        specfx::pipeline::Datapath::new(vectors.config).context("the manifest's configuration")?;
     let ns = dp.config().n.values();
-    let items: Vec<(usize, i64)> = rows
+    // open() checked that every n is in the manifest's n set.
+    let items: Vec<(usize, i64)> = vectors
+        .inputs
         .iter()
         .map(|&(n, c)| {
-            ns.binary_search(&n).map(|i| (i, c)).map_err(|_| {
-                anyhow::anyhow!("{}: n = {n} is not in the manifest's n set", dir.display())
-            })
+            (
+                ns.binary_search(&n).expect("n checked by vectordir::open"),
+                c,
+            )
         })
-        .collect::<Result<_>>()?;
+        .collect();
     let mut stim = Stimulus::new(seed, bubble, stall);
     // Each vector needs about one offer (1 / (1 - bubble) cycles) and, folded, an initiation
     // interval of accepted outputs (ii / (1 - stall)); twenty times that, plus the latency,
@@ -271,7 +323,36 @@ pub fn write_stimulus(
     })
 }
 
+/// The files `hdl stimulus` writes into its `--out` directory; `stim.json` last, so that a
+/// directory holding it holds an earlier complete stimulus.
+const STIMULUS_FILES: [&str; 4] = [
+    "stim_valid.hex",
+    "stim_ready.hex",
+    "expected_cycle.hex",
+    "stim.json",
+];
+
 fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
+    // The stimulus may go into the vector directory itself, beside (never over) its files;
+    // an earlier stimulus there (its stim.json) is replaced, other files of the same names
+    // only with --force.
+    let inputs = super::output::config_inputs_as("--vectors", &args.vectors.to_string_lossy());
+    let earlier = args.out.join("stim.json").is_file();
+    for name in STIMULUS_FILES {
+        let path = args.out.join(name);
+        super::output::check_file_output(&path, "--out", &inputs, None, args.force || earlier)?;
+    }
+    if let Some(vcd) = &args.vcd {
+        let mut inputs = inputs.clone();
+        inputs.extend(STIMULUS_FILES.map(|f| ("--out", args.out.join(f))));
+        super::output::check_file_output(
+            vcd,
+            "--vcd",
+            &inputs,
+            Some(specfx::cycle::vcd::VCD_HEADER),
+            args.force,
+        )?;
+    }
     let s = write_stimulus(&args.vectors, args.run, &args.out, args.vcd.as_deref())?;
     super::output::outln!(
         "{} vectors over {} cycles ({}, latency {}..{})",

@@ -26,6 +26,7 @@ mod sweep;
 mod throughput;
 mod trace;
 pub mod tradeoff;
+mod vectordir;
 pub mod vectors;
 
 use std::process::ExitCode;

@@ -19,6 +19,10 @@ use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;
 use specfx::pipeline::{Datapath, Variant};
 
+/// The first bytes of the configuration `specfx optimize` writes: a file that begins with
+/// them is an earlier result, replaced without `--force`.
+const OUT_HEADER: &str = "# specfx optimize:";
+
 /// Arguments of `specfx optimize`.
 #[derive(Debug, Args)]
 pub struct OptimizeArgs {
@@ -55,11 +59,21 @@ pub struct OptimizeArgs {
     /// Where to write the configuration found (TOML).
     #[arg(long, default_value = "specfx-optimized.toml")]
     out: PathBuf,
+    /// Replace an existing output file that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
 }
 
 /// Runs `specfx optimize`. Exit code 1 when no configuration meets the budget.
 pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    super::output::check_file_output(
+        &args.out,
+        "--out",
+        &super::output::inputs(&args.config, None),
+        Some(OUT_HEADER),
+        args.force,
+    )?;
     let base = dp.config().clone();
     if let Some(&k) = args.k.values().iter().find(|&&k| !(1..=7).contains(&k)) {
         bail!("--k: expected numbers of squarings in 1..=7, got {k}");
@@ -278,7 +292,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         )?;
     }
     let header = format!(
-        "# specfx optimize: cheapest configuration found for the budget '{}'\n# cost {:.0} {unit} ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
+        "{OUT_HEADER} cheapest configuration found for the budget '{}'\n# cost {:.0} {unit} ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
         r.budget,
         best.cost,
         args.objective,

@@ -14,20 +14,38 @@ pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
     })
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so
-/// an interrupted run never leaves a half-written file under the final name.
+/// Writes `bytes` to `path` through a temporary file in the same directory (a unique
+/// `.<name>.<random>.tmp`, removed on failure) and a rename, so an interrupted run never
+/// leaves a half-written file under the final name. A directory at `path` is refused.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
     let file_name = path
         .file_name()
         .with_context(|| format!("{}: not a file path", path.display()))?;
-    let tmp = match dir {
-        Some(d) => d.join(format!(".{}.tmp", file_name.to_string_lossy())),
-        None => Path::new(&format!(".{}.tmp", file_name.to_string_lossy())).to_path_buf(),
-    };
-    fs::write(&tmp, bytes).with_context(|| format!("cannot write {}", tmp.display()))?;
-    fs::rename(&tmp, path)
-        .with_context(|| format!("cannot rename {} to {}", tmp.display(), path.display()))
+    if path.is_dir() {
+        anyhow::bail!("{}: is a directory, expected a file path", path.display());
+    }
+    let prefix = format!(".{}.", file_name.to_string_lossy());
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        builder.permissions(fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder
+        .tempfile_in(dir)
+        .with_context(|| format!("cannot write into {}", dir.display()))?;
+    tmp.write_all(bytes)
+        .and_then(|()| tmp.flush())
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    tmp.persist(path)
+        .map(|_| ())
+        .map_err(|e| e.error)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Writes a figure as `dir/stem.svg` and `dir/stem.png`, each atomically.
@@ -185,8 +203,15 @@ pub struct OutDir {
 }
 
 impl OutDir {
-    /// Starts writing the result of `command` for `target`.
-    pub fn begin(target: &Path, command: &str, force: bool) -> Result<OutDir> {
+    /// Starts writing the result of `command` for `target`, after checking that it would
+    /// replace none of the command's `inputs` (see [`refuse_over_inputs`]).
+    pub fn begin(
+        target: &Path,
+        command: &str,
+        force: bool,
+        inputs: &[(&str, PathBuf)],
+    ) -> Result<OutDir> {
+        refuse_over_inputs(target, "--out", inputs)?;
         let name = target
             .file_name()
             .with_context(|| format!("{}: expected a directory name", target.display()))?
@@ -306,4 +331,137 @@ fn remove_stale(parent: &Path, name: &str) {
             }
         }
     }
+}
+
+/// The absolute form of `path` with symbolic links resolved as far as it exists: the path
+/// itself when it exists, else its nearest existing ancestor's with the rest appended.
+fn resolve(path: &Path) -> PathBuf {
+    let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut rest = Vec::new();
+    let mut head = abs.as_path();
+    loop {
+        if let Ok(c) = head.canonicalize() {
+            return rest.iter().rev().fold(c, |p: PathBuf, r| p.join(r));
+        }
+        match (head.parent(), head.file_name()) {
+            (Some(parent), Some(name)) => {
+                rest.push(name.to_os_string());
+                head = parent;
+            }
+            _ => return abs,
+        }
+    }
+}
+
+/// Refuses an output that would replace one of the command's inputs: the same file, or a
+/// directory that is or holds an input (a result directory is replaced as a whole). `flag`
+/// names the output (`--out`), each input comes with its flag (`--config`). Holds with
+/// `--force` too: no command ever writes over what it reads.
+pub fn refuse_over_inputs(out: &Path, flag: &str, inputs: &[(&str, PathBuf)]) -> Result<()> {
+    let target = resolve(out);
+    for (input_flag, input) in inputs {
+        if !input.exists() {
+            continue;
+        }
+        let source = resolve(input);
+        if source == target {
+            anyhow::bail!(
+                "{flag} {}: is the input {input_flag} {}; pass another {flag}",
+                out.display(),
+                input.display()
+            );
+        }
+        if source.starts_with(&target) {
+            anyhow::bail!(
+                "{flag} {}: would replace the directory that holds the input {input_flag} {}; pass another {flag}",
+                out.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Checks a single-file output before any work: never one of the inputs (see
+/// [`refuse_over_inputs`]), never a directory, and an existing file only when it is an
+/// earlier result of the same command (it begins with `own_header`, the first bytes the
+/// command writes) or with `force`.
+pub fn check_file_output(
+    out: &Path,
+    flag: &str,
+    inputs: &[(&str, PathBuf)],
+    own_header: Option<&str>,
+    force: bool,
+) -> Result<()> {
+    refuse_over_inputs(out, flag, inputs)?;
+    if out.is_dir() {
+        anyhow::bail!(
+            "{flag} {}: is a directory, expected a file path",
+            out.display()
+        );
+    }
+    if !force && (out.exists() || out.is_symlink()) && !begins_with(out, own_header) {
+        anyhow::bail!(
+            "{flag} {}: already exists and is not an earlier result of this command; pass --force to replace it",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+/// The files a `--config` (or `--vectors`) argument reads: none for a built-in name; the
+/// file it names; for a vector directory (or its `manifest.json`), the manifest and every
+/// file the manifest lists.
+pub fn config_input(arg: &str) -> Vec<PathBuf> {
+    if specfx::pipeline::Config::builtin(arg).is_some() {
+        return Vec::new();
+    }
+    let path = Path::new(arg);
+    let is_vectors = path.is_dir() || path.extension().is_some_and(|e| e == "json");
+    if !is_vectors {
+        return vec![path.to_path_buf()];
+    }
+    let dir = super::vectordir::dir_of(path);
+    let manifest = dir.join("manifest.json");
+    let listed: Vec<PathBuf> = fs::read_to_string(&manifest)
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .and_then(|v| {
+            v.get("sha256").and_then(|h| h.as_object()).map(|h| {
+                h.keys()
+                    .filter(|k| !k.contains('/') && !k.starts_with('.'))
+                    .map(|k| dir.join(k))
+                    .collect()
+            })
+        })
+        .unwrap_or_default();
+    std::iter::once(manifest).chain(listed).collect()
+}
+
+/// Whether the regular file `path` begins with `header`.
+fn begins_with(path: &Path, header: Option<&str>) -> bool {
+    use std::io::Read as _;
+    let Some(header) = header else {
+        return false;
+    };
+    if !path.is_file() {
+        return false;
+    }
+    let mut head = Vec::with_capacity(header.len());
+    fs::File::open(path)
+        .and_then(|f| f.take(header.len() as u64).read_to_end(&mut head))
+        .is_ok_and(|_| head == header.as_bytes())
+}
+
+/// The inputs of a command reading `--config` and an optional `--scene`, for
+/// [`refuse_over_inputs`].
+pub fn inputs(config: &str, scene: Option<&Path>) -> Vec<(&'static str, PathBuf)> {
+    let mut v = config_inputs_as("--config", config);
+    v.extend(scene.map(|p| ("--scene", p.to_path_buf())));
+    v
+}
+
+/// [`config_input`]'s files, each labelled with the flag that named them.
+pub fn config_inputs_as(flag: &'static str, arg: &str) -> Vec<(&'static str, PathBuf)> {
+    config_input(arg).into_iter().map(|p| (flag, p)).collect()
 }

@@ -51,7 +51,12 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
         .map_or("the built-in scene".to_string(), |p| {
             p.display().to_string()
         });
-    let out_dir = super::output::OutDir::begin(&args.out, "render", args.force)?;
+    let out_dir = super::output::OutDir::begin(
+        &args.out,
+        "render",
+        args.force,
+        &super::output::inputs(&args.config, args.scene.as_deref()),
+    )?;
     let (rows, table) = render_scene(&scene, &label, &dp, out_dir.path())?;
     out_dir.commit()?;
     if args.json {

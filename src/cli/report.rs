@@ -228,7 +228,7 @@ fn step(msg: &str) {
 
 /// Runs `specfx report`.
 pub fn run(args: &ReportArgs) -> Result<Outcome> {
-    let out_dir = super::output::OutDir::begin(&args.out, "report", args.force)?;
+    let out_dir = super::output::OutDir::begin(&args.out, "report", args.force, &[])?;
     let dir = out_dir.path();
     let mut written = Vec::new();
 

@@ -56,6 +56,9 @@ pub struct SimArgs {
     /// Cycles in the VCD trace.
     #[arg(long, default_value_t = 500)]
     vcd_cycles: u64,
+    /// Replace an existing output file that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
@@ -67,6 +70,15 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
         bail!("--cycles: expected at least 1, got 0");
     }
     let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    if let Some(path) = &args.vcd {
+        super::output::check_file_output(
+            path,
+            "--vcd",
+            &super::output::inputs(&args.config, None),
+            Some(specfx::cycle::vcd::VCD_HEADER),
+            args.force,
+        )?;
+    }
     let mut stim = Stimulus::new(args.seed, args.bubble, args.stall);
     let trace_cycles = if args.vcd.is_some() {
         args.vcd_cycles

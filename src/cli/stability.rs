@@ -189,7 +189,17 @@ pub fn run(args: &StabilityArgs) -> Result<Outcome> {
     if !(1..=24).contains(&grid.c_bits) {
         bail!("--c-bits: expected 1..=24, got {}", grid.c_bits);
     }
-    let out_dir = super::output::OutDir::begin(&args.out, "stability", args.force)?;
+    let out_dir = super::output::OutDir::begin(
+        &args.out,
+        "stability",
+        args.force,
+        &args
+            .config
+            .iter()
+            .flat_map(|c| super::output::config_input(c))
+            .map(|p| ("--config", p))
+            .collect::<Vec<_>>(),
+    )?;
     let report = stability(out_dir.path(), &paths, &grid)?;
     out_dir.commit()?;
     if args.json {

@@ -161,6 +161,10 @@ fn value(dp: &Datapath, t: &CycleTrace, source: Source, width: u32) -> Option<Wo
     Some(Word::new(raw, width))
 }
 
+/// The first bytes of every trace [`write_vcd`] writes (a simulator's dump begins with
+/// `$date` or a comment): how a command recognises its own earlier trace before replacing it.
+pub const VCD_HEADER: &str = "$timescale 1 ns $end\n$scope module tb_specfx $end\n";
+
 /// Writes a trace of `arch` as VCD (GTKWave opens it) under the RTL's names: see the module
 /// documentation.
 ///

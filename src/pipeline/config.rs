@@ -34,6 +34,7 @@ impl Variant {
 
 /// A stage's output quantization: its format, rounding mode and overflow mode.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StageSpec {
     /// The stage's output format.
     pub format: Format,
@@ -45,6 +46,7 @@ pub struct StageSpec {
 
 /// A format alone, for the input and the exact subtraction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FormatSpec {
     /// The format.
     pub format: Format,
@@ -52,6 +54,7 @@ pub struct FormatSpec {
 
 /// The energy-conserving coefficient: which one, and the format it is stored in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CoefSpec {
     /// The normalisation form.
     pub form: Form,
@@ -65,6 +68,7 @@ pub struct CoefSpec {
 
 /// The per-n constants of the minimax variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct MinimaxSpec {
     /// The format of the slope A(n).
     pub a_format: Format,
@@ -76,6 +80,7 @@ pub struct MinimaxSpec {
 
 /// Register latencies of the operations in the cycle-level model (`docs/cycle.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LatencySpec {
     /// Registers after the clamp-and-subtract (pipelined only).
     pub sub: u32,
@@ -87,6 +92,7 @@ pub struct LatencySpec {
 
 /// A complete datapath configuration. See `docs/arithmetic.md` for the arithmetic it implies.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Config {
     /// A name for reports and manifests.
     pub name: String,
