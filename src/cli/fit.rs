@@ -557,7 +557,7 @@ fn fit_markdown(r: &FitReport) -> String {
     };
     let mut s = format!(
         "# specfx fit: {}\n\nBudget against the f64 cos^n image: `{}`{}.\n\nProved on every input the scene produces: {} (pixel, light) inputs over {} covered pixels, each evaluated bit-accurately by the fitted datapath and the image re-rendered through the renderer.\n\n",
-        r.scene.replace(['<', '>', '`', '*', '_', '[', ']'], " "),
+        specfx::report::doc::md_escape(&r.scene),
         r.budget,
         if r.default_budget {
             " (the default: no worse than the generic datapath renders this scene)"

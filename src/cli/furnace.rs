@@ -49,18 +49,18 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
     let dp = super::datapath::load(&args.config, None)?;
     let settings = FurnaceSettings::new(&dp, args.n.as_ref(), angles)
         .with_context(|| format!("config {}", args.config))?;
-    eprintln!(
-        "furnace: 6 forms x {} exponents x {} angles, 4 paths, datapath {}",
-        settings.ns().len(),
-        settings.angles_deg().len(),
-        dp.config().name
-    );
     let out_dir = super::output::OutDir::begin(
         &args.out,
         "furnace",
         args.force,
         &super::output::inputs(&args.config, None),
     )?;
+    eprintln!(
+        "furnace: 6 forms x {} exponents x {} angles, 4 paths, datapath {}",
+        settings.ns().len(),
+        settings.angles_deg().len(),
+        dp.config().name
+    );
     let report = write_furnace(&dp, &settings, out_dir.path())?;
     out_dir.commit()?;
     let out = &args.out;

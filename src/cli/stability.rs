@@ -52,6 +52,23 @@ pub struct StabilityArgs {
     json: bool,
 }
 
+/// `name`, or `name-2`, `name-3` ... : the first that no path of `paths` has (compared
+/// without case, since the names become file names, on file systems that may ignore case).
+fn unique_name(name: &str, paths: &[MapPath]) -> String {
+    let taken = |candidate: &str| {
+        paths
+            .iter()
+            .any(|p| p.name().eq_ignore_ascii_case(candidate))
+    };
+    if !taken(name) {
+        return name.to_string();
+    }
+    (2..)
+        .map(|i| format!("{name}-{i}"))
+        .find(|c| !taken(c))
+        .expect("some suffix is free")
+}
+
 fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
     let defaults = default_paths();
     let floats: Vec<FloatPath> = FloatPath::default_set();
@@ -85,7 +102,16 @@ fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
     } else {
         for arg in &args.config {
             let dp = super::datapath::load(arg, None)?;
-            paths.push(MapPath::Fixed(Box::new(dp.config().clone())));
+            let mut config = dp.config().clone();
+            let name = unique_name(&config.name, &paths);
+            if name != config.name {
+                eprintln!(
+                    "stability: another path is already named '{}'; --config {arg} is shown as '{name}'",
+                    config.name
+                );
+                config.name = name;
+            }
+            paths.push(MapPath::Fixed(Box::new(config)));
         }
     }
     if paths.is_empty() {

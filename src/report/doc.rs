@@ -34,8 +34,43 @@ pub enum Block {
     },
 }
 
+/// Escapes text for Markdown outside its `code` spans: `&`, `<` and `>` as entities (no raw
+/// HTML such as `<script>` gets through), `\\`, `[` and `]` with a backslash (no links or
+/// images). Code spans are kept as they are: Markdown shows their content literally.
+///
+/// # Examples
+/// ```
+/// use specfx::report::doc::md_escape;
+/// assert_eq!(md_escape("<img onerror=x> [a](b) `<b>`"), "&lt;img onerror=x&gt; \\[a\\](b) `<b>`");
+/// ```
+pub fn md_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for (i, part) in s.split('`').enumerate() {
+        if i > 0 {
+            out.push('`');
+        }
+        if i % 2 == 1 {
+            out.push_str(part);
+            continue;
+        }
+        for ch in part.chars() {
+            match ch {
+                '&' => out.push_str("&amp;"),
+                '<' => out.push_str("&lt;"),
+                '>' => out.push_str("&gt;"),
+                '\\' | '[' | ']' => {
+                    out.push('\\');
+                    out.push(ch);
+                }
+                _ => out.push(ch),
+            }
+        }
+    }
+    out
+}
+
 fn md_cell(s: &str) -> String {
-    s.replace('|', "\\|")
+    md_escape(s).replace('|', "\\|")
 }
 
 /// Renders a document as GitHub-flavoured Markdown; figures link their SVG file.
@@ -60,9 +95,9 @@ pub fn write_markdown(w: &mut impl Write, doc: &[Block]) -> io::Result<()> {
         }
         match block {
             Block::Heading(level, text) => {
-                writeln!(w, "{} {text}", "#".repeat(usize::from(*level)))?;
+                writeln!(w, "{} {}", "#".repeat(usize::from(*level)), md_escape(text))?;
             }
-            Block::Paragraph(text) => writeln!(w, "{text}")?,
+            Block::Paragraph(text) => writeln!(w, "{}", md_escape(text))?,
             Block::Table { header, rows } => {
                 let line = |cells: &[String]| {
                     let cells: Vec<String> = cells.iter().map(|c| md_cell(c)).collect();
@@ -75,10 +110,10 @@ pub fn write_markdown(w: &mut impl Write, doc: &[Block]) -> io::Result<()> {
                 }
             }
             Block::Figure { stem, caption } => {
-                writeln!(w, "![{caption}]({stem}.svg)")?;
+                writeln!(w, "![{}]({stem}.svg)", md_escape(caption))?;
             }
             Block::Image { src, caption } => {
-                writeln!(w, "![{caption}]({src})")?;
+                writeln!(w, "![{}]({src})", md_escape(caption))?;
             }
         }
     }

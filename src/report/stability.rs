@@ -644,9 +644,20 @@ pub fn write_overshoot_csv(w: &mut impl Write, r: &StabilityReport) -> io::Resul
     Ok(())
 }
 
-/// The file stem of a path's heat map.
+/// The file stem of a path's heat map: `heatmap_<name>`, any character outside
+/// `A-Za-z0-9_-.+` replaced by `_` (names are unique, see `specfx stability`).
 pub fn heatmap_stem(path: &str) -> String {
-    format!("heatmap_{path}")
+    let safe: String = path
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '+') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("heatmap_{safe}")
 }
 
 /// The stability report as a document: summary, regions, special inputs, overshoot, figures.
