@@ -148,7 +148,7 @@ pub fn render_scene(
     let table = table_markdown(&rows, r.bits);
     let md = format!(
         "# Render of {} through {}\n\nImages: `f64_cos_n.png` (f64 cos^n, classic coefficient), `f64_model.png` (the f64 model of the datapath's algorithm and coefficient), `datapath.png` (bit-accurate, the fragment's cosine quantized to {}); differences in display LSBs `diff_vs_cos_n.png`, `diff_vs_f64_model.png`, and FLIP maps `flip_vs_cos_n.png`, `flip_vs_f64_model.png`.\n\n\"vs cos^n\" is the total error the viewer sees: the approximation of cos^n by the datapath's algorithm (large near highlights of high n) plus its quantization; \"vs f64 model\" is the quantization alone.\n\n{table}",
-        specfx::report::doc::md_escape(&label),
+        specfx::report::doc::md_escape(label),
         dp.config().name,
         dp.config().c.format,
     );
