@@ -47,11 +47,7 @@ radius = 1.0
 "#;
 
 fn run_in(dir: &Path, args: &[&str]) -> Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_specfx"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the specfx binary runs")
+    common::specfx_in(dir, args)
 }
 
 fn stderr(o: &Output) -> String {

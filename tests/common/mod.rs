@@ -3,9 +3,20 @@
 use std::process::{Command, Output};
 
 /// Runs the built `specfx` binary with `args` and returns its output.
+#[allow(dead_code)]
 pub fn specfx(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_specfx"))
         .args(args)
+        .output()
+        .expect("the specfx binary runs")
+}
+
+/// Runs the built `specfx` binary with `args` in the working directory `dir`.
+#[allow(dead_code)]
+pub fn specfx_in(dir: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args(args)
+        .current_dir(dir)
         .output()
         .expect("the specfx binary runs")
 }
