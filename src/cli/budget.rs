@@ -73,11 +73,12 @@ pub fn spread(ns: &[u32]) -> Vec<u32> {
 
 /// Runs gappa on one script; `Ok(None)` when gappa is not installed.
 fn run_gappa(script: &str) -> Result<Option<String>> {
-    let child = Command::new("gappa")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn();
+    let child = super::child::spawn(
+        Command::new("gappa")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped()),
+    );
     let mut child = match child {
         Ok(c) => c,
         Err(e) if e.kind() == ErrorKind::NotFound => return Ok(None),
@@ -89,7 +90,7 @@ fn run_gappa(script: &str) -> Result<Option<String>> {
         .expect("piped stdin")
         .write_all(script.as_bytes())
         .context("cannot write to gappa")?;
-    let out = child.wait_with_output().context("gappa did not finish")?;
+    let out = super::child::wait(child).context("gappa did not finish")?;
     // gappa prints its results on stderr.
     let mut text = String::from_utf8_lossy(&out.stderr).into_owned();
     text.push_str(&String::from_utf8_lossy(&out.stdout));

@@ -148,10 +148,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     if !tb.is_file() {
         bail!("{}: the testbench is missing", tb.display());
     }
-    let work = tempfile::Builder::new()
-        .prefix("specfx-cosim.")
-        .tempdir()
-        .context("cannot create a work directory")?;
+    let work = super::child::work_dir("cosim").context("cannot create a work directory")?;
     let wd = work.path();
 
     // The vectors: given, or written for --config.
@@ -218,7 +215,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
                     .map(|(k, v)| format!("-G{k}={v}")),
             )
             .args(&rtl);
-        let o = cmd.output().context("cannot run verilator")?;
+        let o = super::child::output(&mut cmd).context("cannot run verilator")?;
         if !o.status.success() || !o.stderr.is_empty() {
             eprint!("{}", String::from_utf8_lossy(&o.stderr));
             eprintln!("cosim: lint failed");
@@ -333,9 +330,7 @@ fn simulate(
     vcd: bool,
 ) -> Result<String> {
     let run = |cmd: &mut Command, what: &str| -> Result<std::process::Output> {
-        let o = cmd
-            .current_dir(wd)
-            .output()
+        let o = super::child::output(cmd.current_dir(wd))
             .with_context(|| format!("cannot run {what}"))?;
         Ok(o)
     };

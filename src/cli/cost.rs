@@ -114,7 +114,7 @@ pub fn run_yosys(
     target: Target,
     hdl_ref: &Path,
 ) -> Result<(YosysCost, String, String)> {
-    let work = tempfile::tempdir().context("cannot create a temporary directory")?;
+    let work = super::child::work_dir("yosys").context("cannot create a temporary directory")?;
     std::fs::write(
         work.path().join("specfx_params.vh"),
         params_header(dp, arch),
@@ -126,7 +126,7 @@ pub fn run_yosys(
 
 /// Runs yosys on the configuration's constant ROM (`specfx_rom`, generated).
 pub fn run_yosys_rom(dp: &Datapath, target: Target) -> Result<(YosysCost, String, String)> {
-    let work = tempfile::tempdir().context("cannot create a temporary directory")?;
+    let work = super::child::work_dir("yosys").context("cannot create a temporary directory")?;
     let file = work.path().join("specfx_rom.v");
     std::fs::write(&file, rom_verilog(dp))?;
     yosys_in(work.path(), &[file], "specfx_rom", target).context("yosys failed on the constant ROM")
@@ -139,19 +139,18 @@ fn yosys_in(
     top: &str,
     target: Target,
 ) -> Result<(YosysCost, String, String)> {
-    let version = Command::new("yosys")
-        .arg("-V")
-        .output()
+    let version = super::child::output(Command::new("yosys").arg("-V"))
         .context("yosys not found: install it (Debian: apt-get install yosys)")?;
     let version = String::from_utf8_lossy(&version.stdout).trim().to_string();
     let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
     let script = yosys_script(target, &files, &work.display().to_string(), top);
     std::fs::write(work.join("cost.ys"), &script)?;
-    let out = Command::new("yosys")
-        .args(["-q", "-s", "cost.ys"])
-        .current_dir(work)
-        .output()
-        .context("cannot run yosys")?;
+    let out = super::child::output(
+        Command::new("yosys")
+            .args(["-q", "-s", "cost.ys"])
+            .current_dir(work),
+    )
+    .context("cannot run yosys")?;
     if !out.status.success() {
         let err = String::from_utf8_lossy(&out.stderr);
         let first = err

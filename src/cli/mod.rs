@@ -6,6 +6,7 @@
 pub mod budget;
 mod calibrate;
 mod check;
+mod child;
 mod cosim;
 pub mod cost;
 mod datapath;

@@ -42,16 +42,14 @@ pub struct TimingArgs {
 
 /// Runs `tool` with `args` in `dir`; a missing tool is one clear line.
 fn run_tool(tool: &str, args: &[String], dir: &Path) -> Result<std::process::Output> {
-    Command::new(tool)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .map_err(|e| match e.kind() {
+    super::child::output(Command::new(tool).args(args).current_dir(dir)).map_err(|e| {
+        match e.kind() {
             std::io::ErrorKind::NotFound => {
                 anyhow::anyhow!("{tool} not found: install it (Debian: apt-get install {tool})")
             }
             _ => anyhow::Error::new(e).context(format!("cannot run {tool}")),
-        })
+        }
+    })
 }
 
 /// The first line of a tool's complaint that says something.
@@ -71,7 +69,7 @@ fn first_error(out: &std::process::Output, log: Option<&str>) -> String {
 /// report. A design nextpnr cannot place (more DSPs or logic than the device has) gives a
 /// [`Timing`] without Fmax and with its over-limit flags, not an error.
 pub fn run_timing(dp: &Datapath, arch: Arch, device: Device, hdl_ref: &Path) -> Result<Timing> {
-    let work = tempfile::tempdir().context("cannot create a temporary directory")?;
+    let work = super::child::work_dir("pnr").context("cannot create a temporary directory")?;
     let dir = work.path();
     // A missing nextpnr is reported before yosys spends seconds on synthesis.
     run_tool("nextpnr-ice40", &["--version".into()], dir)?;

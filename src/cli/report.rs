@@ -305,18 +305,15 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         b.push(b'\n');
         Ok(())
     })?);
-    let yosys_present = std::process::Command::new("yosys")
-        .arg("-V")
-        .output()
+    let yosys_present = super::child::output(std::process::Command::new("yosys").arg("-V"))
         .is_ok_and(|o| o.status.success());
     let mut costs = Vec::new();
     if yosys_present {
         step("synthesising baseline with yosys (ice40, both architectures)");
         let hdl = super::cost::hdl_ref_dir(None);
-        let nextpnr_present = std::process::Command::new("nextpnr-ice40")
-            .arg("--version")
-            .output()
-            .is_ok_and(|o| o.status.success());
+        let nextpnr_present =
+            super::child::output(std::process::Command::new("nextpnr-ice40").arg("--version"))
+                .is_ok_and(|o| o.status.success());
         for arch in specfx::cycle::Arch::ALL {
             let mut c =
                 super::cost::cost_report(&dp, arch, specfx::hdl::cost::Target::Ice40, &hdl, false)?;

@@ -1,0 +1,167 @@
+//! External tools (yosys, nextpnr, gappa, the simulators) run as children that end with the
+//! command: each in its own process group, killed by the interrupt handler on Ctrl-C or
+//! SIGTERM and by the kernel when specfx itself dies (even by SIGKILL); their work
+//! directories are removed then too, or by the next run when specfx was killed.
+
+use std::io;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::Mutex;
+
+/// Process groups of running children (each child leads its own group).
+static GROUPS: Mutex<Vec<i32>> = Mutex::new(Vec::new());
+
+/// Work directories of this process, removed on interrupt.
+static WORK_DIRS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// The prefix of every work directory: `specfx-<tag>-<pid>-`, so a later run can tell the
+/// ones of dead processes.
+const PREFIX: &str = "specfx-";
+
+/// Prepares `cmd` to run as a child that ends with specfx: its own process group (a terminal's
+/// Ctrl-C reaches specfx, which ends the group), and on Linux a parent-death signal, so that a
+/// SIGKILLed specfx takes the child with it.
+fn prepare(cmd: &mut Command) {
+    use std::os::unix::process::CommandExt as _;
+    cmd.process_group(0);
+    #[cfg(target_os = "linux")]
+    // SAFETY: prctl is async-signal-safe; the closure touches no memory of the parent.
+    unsafe {
+        cmd.pre_exec(|| {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL as libc::c_ulong) != 0 {
+                return Err(io::Error::last_os_error());
+            }
+            // The parent may have died before prctl: then nobody would end this child.
+            if libc::getppid() == 1 {
+                return Err(io::Error::other("specfx ended before its child started"));
+            }
+            Ok(())
+        });
+    }
+}
+
+/// Runs `cmd` to completion like [`Command::output`], as a child that ends with specfx.
+pub fn output(cmd: &mut Command) -> io::Result<Output> {
+    cmd.stdin(std::process::Stdio::null());
+    cmd.stdout(std::process::Stdio::piped());
+    cmd.stderr(std::process::Stdio::piped());
+    wait(spawn(cmd)?)
+}
+
+/// Spawns `cmd` (its stdio as set by the caller) as a child that ends with specfx; finish it
+/// with [`wait`].
+pub fn spawn(cmd: &mut Command) -> io::Result<std::process::Child> {
+    prepare(cmd);
+    let child = cmd.spawn()?;
+    if let Ok(mut g) = GROUPS.lock() {
+        g.push(child.id() as i32);
+    }
+    Ok(child)
+}
+
+/// Waits for a child of [`spawn`] (or [`output`]) and collects its output.
+pub fn wait(child: std::process::Child) -> io::Result<Output> {
+    let pid = child.id() as i32;
+    if let Ok(mut g) = GROUPS.lock() {
+        if !g.contains(&pid) {
+            g.push(pid);
+        }
+    }
+    let out = child.wait_with_output();
+    if let Ok(mut g) = GROUPS.lock() {
+        g.retain(|&p| p != pid);
+    }
+    out
+}
+
+/// A work directory for a tool, `$TMPDIR/specfx-<tag>-<pid>-XXXXXX`, removed when dropped, on
+/// interrupt, or (when specfx was killed) by the next call. The directories of processes that
+/// no longer run are removed first.
+pub fn work_dir(tag: &str) -> io::Result<WorkDir> {
+    let tmp = std::env::temp_dir();
+    remove_stale(&tmp);
+    let dir = tempfile::Builder::new()
+        .prefix(&format!("{PREFIX}{tag}-{}-", std::process::id()))
+        .tempdir_in(&tmp)?;
+    if let Ok(mut w) = WORK_DIRS.lock() {
+        w.push(dir.path().to_path_buf());
+    }
+    Ok(WorkDir(Some(dir)))
+}
+
+/// A work directory of [`work_dir`].
+pub struct WorkDir(Option<tempfile::TempDir>);
+
+impl WorkDir {
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        self.0.as_ref().expect("a live work directory").path()
+    }
+
+    /// Keeps the directory (`--keep`): returns its path; it is no longer removed.
+    pub fn keep(mut self) -> PathBuf {
+        let dir = self.0.take().expect("a live work directory");
+        forget(dir.path());
+        dir.keep()
+    }
+}
+
+impl Drop for WorkDir {
+    fn drop(&mut self) {
+        if let Some(d) = self.0.take() {
+            forget(d.path());
+        }
+    }
+}
+
+fn forget(path: &Path) {
+    if let Ok(mut w) = WORK_DIRS.lock() {
+        w.retain(|p| p != path);
+    }
+}
+
+/// Removes `specfx-<tag>-<pid>-*` directories whose process no longer runs.
+fn remove_stale(tmp: &Path) {
+    let Ok(entries) = std::fs::read_dir(tmp) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(rest) = name.strip_prefix(PREFIX) else {
+            continue;
+        };
+        // <tag>-<pid>-<random>: the pid is the second field from the end.
+        let mut fields = rest.rsplitn(3, '-');
+        let (Some(_random), Some(pid), Some(_tag)) = (fields.next(), fields.next(), fields.next())
+        else {
+            continue;
+        };
+        let Ok(pid) = pid.parse::<u32>() else {
+            continue;
+        };
+        if pid != std::process::id()
+            && !Path::new(&format!("/proc/{pid}")).exists()
+            && e.path().is_dir()
+        {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
+}
+
+/// Ends every running child's process group and removes every work directory: called by the
+/// interrupt handler before specfx exits.
+pub fn end_all() {
+    if let Ok(groups) = GROUPS.lock() {
+        for &pgid in groups.iter() {
+            // SAFETY: killpg only sends a signal.
+            unsafe {
+                libc::killpg(pgid, libc::SIGKILL);
+            }
+        }
+    }
+    if let Ok(dirs) = WORK_DIRS.lock() {
+        for d in dirs.iter() {
+            let _ = std::fs::remove_dir_all(d);
+        }
+    }
+}
