@@ -513,3 +513,23 @@ fn markdown_outputs_carry_no_raw_html_from_user_strings() {
     );
     assert_refused(&o, "name: expected", "a name with markup");
 }
+
+#[test]
+fn tradeoff_replaces_only_its_own_earlier_result() {
+    let work = tempfile::tempdir().unwrap();
+    let dir = work.path();
+    std::fs::create_dir(dir.join("mine")).unwrap();
+    std::fs::write(dir.join("mine/notes.txt"), "keep me\n").unwrap();
+    let o = run_in(dir, &["tradeoff", "--n", "16..=32", "--out", "mine"]);
+    assert_refused(
+        &o,
+        "mine already exists and is not an earlier `specfx tradeoff` result",
+        "tradeoff",
+    );
+    assert_eq!(std::fs::read_dir(dir.join("mine")).unwrap().count(), 1);
+    for _ in 0..2 {
+        let o = run_in(dir, &["tradeoff", "--n", "16..=32", "--out", "t"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    assert!(dir.join("t/tradeoff.csv").is_file());
+}

@@ -24,6 +24,9 @@ pub struct TradeoffArgs {
     /// Output directory.
     #[arg(long, default_value = "specfx-tradeoff")]
     out: PathBuf,
+    /// Replace an existing output directory that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
     /// Exponents.
     #[arg(long, default_value = "16..=1024")]
     n: NSet,
@@ -156,7 +159,9 @@ pub fn tradeoff(
 
 /// Runs `specfx tradeoff`.
 pub fn run(args: &TradeoffArgs) -> Result<Outcome> {
-    let figures = tradeoff(&args.out, &args.n, args.yosys)?;
+    let out_dir = super::output::OutDir::begin(&args.out, "tradeoff", args.force, &[])?;
+    let figures = tradeoff(out_dir.path(), &args.n, args.yosys)?;
+    out_dir.commit()?;
     if args.json {
         print_json(&figures)?;
     } else {
