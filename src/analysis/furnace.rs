@@ -622,6 +622,16 @@ fn curves_of(
 /// `coef.form` replaced by the form and the n set by the settings' exponents; when that
 /// configuration does not validate, the form records the error and has no datapath curves.
 pub fn furnace(dp: &Datapath, settings: &FurnaceSettings) -> FurnaceReport {
+    furnace_with_progress(dp, settings, &|_, _| {})
+}
+
+/// [`furnace`], calling `progress(done, total)` as each (form, exponent) pair of the `total`
+/// finishes (from the worker threads, in any order; the report is the same).
+pub fn furnace_with_progress(
+    dp: &Datapath,
+    settings: &FurnaceSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> FurnaceReport {
     let cfg = dp.config();
     let ns_set = NSet::from_values(&settings.ns).expect("validated exponents form a set");
     let form_datapaths: Vec<Result<Datapath, String>> = Form::ALL
@@ -636,16 +646,20 @@ pub fn furnace(dp: &Datapath, settings: &FurnaceSettings) -> FurnaceReport {
     let tasks: Vec<(usize, u32)> = (0..Form::ALL.len())
         .flat_map(|fi| settings.ns.iter().map(move |&n| (fi, n)))
         .collect();
+    let done = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<Vec<Curve>> = tasks
         .par_iter()
         .map(|&(fi, n)| {
-            curves_of(
+            let curves = curves_of(
                 dp,
                 form_datapaths[fi].as_ref().ok(),
                 Form::ALL[fi],
                 n,
                 &settings.angles_deg,
-            )
+            );
+            let now = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(now, tasks.len());
+            curves
         })
         .collect();
     let mut forms: Vec<FormFurnace> = Form::ALL
@@ -820,6 +834,23 @@ mod tests {
                 assert!((got - want).abs() < 1e-13, "{form} x={x}: {got} vs {want}");
             }
         }
+    }
+
+    #[test]
+    fn progress_counts_every_form_and_exponent_once() {
+        // 6 forms x 2 exponents = 12 pairs, each reported once, the last at 12 of 12.
+        let dp = Datapath::new(crate::pipeline::Config::baseline()).unwrap();
+        let settings =
+            FurnaceSettings::new(&dp, Some(&"16,64".parse().unwrap()), vec![0.0]).unwrap();
+        let seen = std::sync::Mutex::new(Vec::new());
+        let report = furnace_with_progress(&dp, &settings, &|done, total| {
+            seen.lock().unwrap().push((done, total));
+        });
+        let mut seen = seen.into_inner().unwrap();
+        seen.sort();
+        let want: Vec<(usize, usize)> = (1..=12).map(|d| (d, 12)).collect();
+        assert_eq!(seen, want);
+        assert_eq!(report.forms.len(), 6);
     }
 
     #[test]

@@ -103,6 +103,7 @@ fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Re
         .iter()
         .filter_map(|&n| dp.constants_for(n).map(|nc| (n, gappa::job(dp, nc))))
         .collect();
+    let bar = super::progress::Progress::new("gappa", "exponents", jobs.len() as u64);
     let results: Vec<Result<Option<(u32, f64, String)>>> = jobs
         .par_iter()
         .map(|(n, job)| {
@@ -133,7 +134,9 @@ fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Re
                 Err(why) => (*n, f64::NAN, why.to_string()),
             }))
         })
+        .inspect(|_| bar.inc(1))
         .collect();
+    bar.finish();
     let out_lsb = report.out_lsb;
     let mut failures = Vec::new();
     for r in results {
@@ -177,7 +180,7 @@ pub fn budget(
     dir: &Path,
 ) -> Result<BudgetReport> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    eprintln!(
+    log::info!(
         "budget: {}: attributing the error of every input to each source",
         dp.config().name
     );
@@ -185,7 +188,7 @@ pub fn budget(
         analyse(dp, budget).map_err(|e| anyhow!("config {}: {e}", dp.config().name))?;
     match gappa_n {
         Some(ns) => {
-            eprintln!("budget: proving bounds with gappa for n = {ns:?}");
+            log::info!("budget: proving bounds with gappa for n = {ns:?}");
             add_formal_bounds(dp, &mut report, ns)?;
         }
         None => report.formal_note = Some("gappa was not run (--no-gappa).".into()),

@@ -98,7 +98,11 @@ fn collect(args: &CalibrateArgs, target: Target, hdl_ref: &Path) -> Result<()> {
     }
     std::fs::create_dir_all(&args.data)
         .with_context(|| format!("cannot create {}", args.data.display()))?;
-    let bar = super::output::progress(todo.len() as u64, &format!("yosys {}", target.name()));
+    let bar = super::progress::Progress::new(
+        &format!("calibrate {}", target.name()),
+        "configurations",
+        todo.len() as u64,
+    );
     let file = std::sync::Mutex::new(
         std::fs::OpenOptions::new()
             .create(true)
@@ -139,7 +143,11 @@ fn collect(args: &CalibrateArgs, target: Target, hdl_ref: &Path) -> Result<()> {
             file.lock()
                 .expect("no writer panics")
                 .write_all(line.as_bytes())?;
-            bar.step(&format!("configuration {index}"));
+            log::debug!(
+                "calibrate {}: configuration {index} synthesised",
+                target.name()
+            );
+            bar.inc(1);
             Ok(r)
         })
         .collect();

@@ -6,7 +6,6 @@
 //! (`-P` for Icarus, `-G` for Verilator), so the co-simulation exercises the same top a
 //! cocotb, VUnit or FuseSoC flow instantiates.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -205,7 +204,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     );
 
     if args.lint {
-        eprintln!("cosim: verilator --lint-only -Wall (specfx_top + rtl)");
+        log::info!("cosim: verilator --lint-only -Wall (specfx_top + rtl)");
         let mut cmd = Command::new("verilator");
         cmd.args(["--lint-only", "-Wall", "--top-module", "specfx_top"])
             .args(
@@ -217,13 +216,13 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             .args(&rtl);
         let o = super::child::output(&mut cmd).context("cannot run verilator")?;
         if !o.status.success() || !o.stderr.is_empty() {
-            eprint!("{}", String::from_utf8_lossy(&o.stderr));
-            eprintln!("cosim: lint failed");
+            log::error!("{}", String::from_utf8_lossy(&o.stderr).trim_end());
+            log::error!("cosim: lint failed");
             return Ok(Outcome::CheckFailed);
         }
     }
 
-    eprintln!(
+    log::info!(
         "cosim: {}, {}, {} vectors ({}), {} stimulus cycles (seed {}, bubble {}, stall {}){}",
         sim.name(),
         args.run.arch,
@@ -247,12 +246,12 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     }
     if args.keep {
         let kept = work.keep();
-        eprintln!("cosim: work directory {}", kept.display());
+        log::info!("cosim: work directory {}", kept.display());
     }
     let verdict = match parse_log(&log) {
         Ok(v) => v,
         Err(e) => {
-            eprintln!("cosim: FAIL: {e}");
+            log::error!("cosim: FAIL: {e}");
             return Ok(Outcome::CheckFailed);
         }
     };
@@ -261,11 +260,11 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     }
     super::output::outln!("{} passed, {} failed", verdict.passed, verdict.failed)?;
     if verdict.failed != 0 {
-        eprintln!("cosim: FAIL ({}, {})", sim.name(), args.run.arch);
+        log::error!("cosim: FAIL ({}, {})", sim.name(), args.run.arch);
         return Ok(Outcome::CheckFailed);
     }
     if verdict.passed == 0 {
-        eprintln!("cosim: FAIL: nothing was checked");
+        log::error!("cosim: FAIL: nothing was checked");
         return Ok(Outcome::CheckFailed);
     }
     if let Some(dir) = &args.vcd {
@@ -274,7 +273,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             super::trace::compare_files(&model, &rtl)?,
             Outcome::CheckFailed
         ) {
-            eprintln!(
+            log::error!(
                 "cosim: FAIL: the model's and the RTL's traces differ ({}, {})",
                 sim.name(),
                 args.run.arch
@@ -334,7 +333,6 @@ fn simulate(
             .with_context(|| format!("cannot run {what}"))?;
         Ok(o)
     };
-    let quiet = !std::io::stderr().is_terminal();
     match sim {
         Simulator::Icarus => {
             let mut cmd = Command::new("iverilog");
@@ -355,9 +353,7 @@ fn simulate(
                 + &String::from_utf8_lossy(&o.stderr))
         }
         Simulator::Verilator => {
-            if !quiet {
-                eprintln!("cosim: building with verilator (a minute or less)");
-            }
+            log::info!("cosim: building with verilator (a minute or less)");
             let mut cmd = Command::new("verilator");
             cmd.args([
                 "--binary",

@@ -233,7 +233,7 @@ pub fn run(args: &FitArgs) -> Result<Outcome> {
                     use std::io::Write as _;
                     write!(w, "{}", summary(&report))
                 })?;
-                eprintln!("fit: wrote {}", args.out.display());
+                log::info!("fit: wrote {}", args.out.display());
             }
             Ok(Outcome::Ok)
         }
@@ -264,7 +264,7 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
     }
     let generic = generic_datapath(&args.config, scene)?;
     let form = generic.config().coef.form;
-    eprintln!(
+    log::info!(
         "fit: tracing {}x{} ({} materials, n = {:?})",
         scene.image.width,
         scene.image.height,
@@ -280,7 +280,7 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
         Some(b) => (b.clone(), false),
         None => (ImageBudget::no_worse_than(scene, &generic_figures), true),
     };
-    eprintln!(
+    log::info!(
         "fit: generic datapath {} on the scene: max {} LSB, {:.2}% differing, FLIP {:.5}; budget '{}'",
         generic.config().name,
         generic_all.max_lsb,
@@ -291,7 +291,7 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
     let mut base: Config = generic.config().clone();
     base.n = NSet::from_values(&scene.exponents())?;
     let floors = floors(&judge, &base, &budget, args.start_frac);
-    let progress = |line: &str| eprintln!("fit: {line}");
+    let progress = |line: &str| log::info!("fit: {line}");
     let found = fit_search(
         &judge,
         &base,
@@ -344,7 +344,7 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
         generic: image_error(&generic_r, 2, 0, None, &flip_generic),
         fitted: fitted_all,
     });
-    eprintln!("fit: costing the generic and the fitted datapath");
+    log::info!("fit: costing the generic and the fitted datapath");
     let yosys = !args.analytic_only;
     let report = FitReport {
         scene: label.to_string(),

@@ -10,7 +10,7 @@ use clap::Args;
 use super::output::{print_json, write_atomic, write_figure};
 use super::Outcome;
 use specfx::analysis::furnace::{
-    furnace, parse_angles, FurnaceReport, FurnaceSettings, DEFAULT_ANGLES,
+    furnace_with_progress, parse_angles, FurnaceReport, FurnaceSettings, DEFAULT_ANGLES,
 };
 use specfx::nset::NSet;
 use specfx::report::doc::write_markdown;
@@ -55,7 +55,7 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
         args.force,
         &super::output::inputs(&args.config, None),
     )?;
-    eprintln!(
+    log::info!(
         "furnace: 6 forms x {} exponents x {} angles, 4 paths, datapath {}",
         settings.ns().len(),
         settings.angles_deg().len(),
@@ -72,7 +72,7 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
             use std::io::Write as _;
             write!(w, "{}", summary_text(&summary))
         })?;
-        eprintln!("furnace: wrote {}", out.display());
+        log::info!("furnace: wrote {}", out.display());
     }
     Ok(Outcome::Ok)
 }
@@ -84,7 +84,12 @@ pub fn write_furnace(
     settings: &FurnaceSettings,
     out: &std::path::Path,
 ) -> Result<FurnaceReport> {
-    let report = furnace(dp, settings);
+    let bar = super::progress::Progress::new("furnace", "form-exponent pairs", 0);
+    let report = furnace_with_progress(dp, settings, &|done, total| {
+        bar.set_len(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish();
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     for (i, f) in report.forms.iter().enumerate() {
         let svg = chart_svg(&report, i).map_err(anyhow::Error::msg)?;

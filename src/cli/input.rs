@@ -43,6 +43,7 @@ pub fn read_bytes(path: &Path, what: &str, max: u64) -> Result<Vec<u8>> {
     if bytes.len() as u64 > max {
         bail!("{what}: expected at most {max} bytes, it grew while being read");
     }
+    log::debug!("read {} ({} bytes)", path.display(), bytes.len());
     Ok(bytes)
 }
 

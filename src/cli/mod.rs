@@ -14,10 +14,12 @@ pub mod fit;
 pub mod furnace;
 mod hdl;
 mod input;
+mod logging;
 mod optimize;
 mod output;
 mod paper;
 mod pnr;
+mod progress;
 mod reference;
 pub mod render;
 mod report;
@@ -40,6 +42,17 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Print only results, warnings and errors: no progress, no informational lines.
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
+    quiet: bool,
+    /// Print details on stderr: files read and written, how long each step took (twice:
+    /// everything, also from the libraries used).
+    #[arg(short, long, global = true, action = clap::ArgAction::Count)]
+    verbose: u8,
+    /// Colour in help and messages: auto (on a terminal, unless NO_COLOR is set), always or
+    /// never.
+    #[arg(long, global = true, value_name = "WHEN", default_value = "auto")]
+    color: clap::ColorChoice,
 }
 
 #[derive(Debug, Subcommand)]
@@ -288,7 +301,11 @@ pub enum Outcome {
 /// Parses the arguments, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
     output::install_interrupt_handler();
+    // Colour is decided before parsing: clap's own help and errors honour it too.
+    let color = logging::color_flag(std::env::args_os());
+    let no_color = logging::no_color(std::env::var_os("NO_COLOR").as_deref());
     let cli = match command()
+        .color(logging::clap_color(color, no_color))
         .try_get_matches()
         .and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m))
     {
@@ -306,6 +323,15 @@ pub fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    logging::init(
+        logging::Verbosity::from_flags(cli.quiet, cli.verbose),
+        cli.color,
+    );
+    log::debug!(
+        "specfx {}: {} threads",
+        env!("CARGO_PKG_VERSION"),
+        rayon::current_num_threads()
+    );
     let result = match cli.command {
         Command::Report(args) => report::run(&args),
         Command::Paper(args) => paper::run(&args),
@@ -332,6 +358,7 @@ pub fn main() -> ExitCode {
         Command::Completions(args) => completions(&args),
         Command::Man(args) => man(&args),
     };
+    log::debug!("finished in {:.3}s", logging::elapsed().as_secs_f64());
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,
         Ok(Outcome::CheckFailed) => ExitCode::from(1),

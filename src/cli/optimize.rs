@@ -2,11 +2,8 @@
 
 use std::path::PathBuf;
 
-use std::io::IsTerminal;
-
 use anyhow::{bail, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use super::output::write_atomic;
 use super::Outcome;
@@ -108,7 +105,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             other => bail!("--variants: expected plain, minimax or both, got '{other}'"),
         })
         .collect::<Result<_>>()?;
-    eprintln!(
+    log::info!(
         "optimize: f64 floor of {} algorithms (k in {}, {})",
         args.k.len() * variants.len(),
         args.k,
@@ -118,14 +115,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     budget.arch = arch;
     let floors = algorithm_floors(&base, &budget, args.k.values(), &variants, args.start_frac);
     let reachable = floors.iter().filter(|f| f.reachable).count();
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = ProgressBar::new(reachable as u64);
-        b.set_style(
-            ProgressStyle::with_template("optimize {bar:40} {pos}/{len} algorithms, eta {eta}")
-                .expect("valid template"),
-        );
-        b
-    });
+    let bar = super::progress::Progress::new("optimize", "algorithms", reachable as u64);
     let done = |a: Algorithm, r: &SearchResult| {
         let line = format!(
             "optimize: k = {}, {}: {}",
@@ -138,13 +128,8 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                     b.cost, args.objective
                 ))
         );
-        match &bar {
-            Some(b) => {
-                b.println(line);
-                b.inc(1);
-            }
-            None => eprintln!("{line}"),
-        }
+        log::info!("{line}");
+        bar.inc(1);
     };
     let synth = |dp: &Datapath,
                  arch: Arch,
@@ -172,9 +157,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         &done,
     )
     .map_err(anyhow::Error::msg)?;
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    bar.finish();
     super::output::outln!(
         "optimize: budget '{}', {} exhaustive checks",
         r.budget,

@@ -18,6 +18,7 @@ pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
 /// `.<name>.<random>.tmp`, removed on failure) and a rename, so an interrupted run never
 /// leaves a half-written file under the final name. A directory at `path` is refused.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    log::debug!("writing {} ({} bytes)", path.display(), bytes.len());
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -119,53 +120,6 @@ pub fn print_json(value: &impl serde::Serialize) -> Result<()> {
         buf.push(b'\n');
         Ok(())
     })
-}
-
-/// A progress bar on a terminal (`label`, position, ETA); elsewhere a line per step on stderr.
-pub struct Progress {
-    bar: Option<indicatif::ProgressBar>,
-    label: String,
-    len: u64,
-    pos: std::sync::atomic::AtomicU64,
-}
-
-/// Starts a [`Progress`] of `len` steps.
-pub fn progress(len: u64, label: &str) -> Progress {
-    use std::io::IsTerminal;
-    let bar = io::stderr().is_terminal().then(|| {
-        let b = indicatif::ProgressBar::new(len);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(&format!(
-                "{label} {{bar:40}} {{pos}}/{{len}} eta {{eta}}"
-            ))
-            .expect("valid template"),
-        );
-        b
-    });
-    Progress {
-        bar,
-        label: label.to_string(),
-        len,
-        pos: std::sync::atomic::AtomicU64::new(0),
-    }
-}
-
-impl Progress {
-    /// One step done; `what` names it on the line printed off a terminal.
-    pub fn step(&self, what: &str) {
-        let pos = self.pos.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-        match &self.bar {
-            Some(b) => b.inc(1),
-            None => eprintln!("{}: {what} ({pos}/{})", self.label, self.len),
-        }
-    }
-
-    /// Clears the bar.
-    pub fn finish(&self) {
-        if let Some(b) = &self.bar {
-            b.finish_and_clear();
-        }
-    }
 }
 
 /// The name of the marker file every result directory holds: it says which specfx command
@@ -290,6 +244,7 @@ impl OutDir {
                 )
             });
         }
+        log::debug!("{} complete", self.target.display());
         self.done = true;
         self.unregister();
         if had_old {

@@ -5,7 +5,6 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use super::output::{print_json, print_with, write_atomic};
@@ -154,11 +153,7 @@ fn write_table(path: &std::path::Path, n_max: u32) -> Result<Outcome> {
     let jobs: Vec<(u32, u32)> = K_RANGE
         .flat_map(|k| (1..=n_max).map(move |n| (k, n)))
         .collect();
-    let bar = ProgressBar::with_draw_target(Some(jobs.len() as u64), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("minimax fits {bar:40} {pos}/{len} eta {eta}")
-            .expect("valid template"),
-    );
+    let bar = super::progress::Progress::new("minimax", "fits", jobs.len() as u64);
     let fits: Vec<MinimaxFit> = jobs
         .par_iter()
         .map(|&(k, n)| {
@@ -167,13 +162,13 @@ fn write_table(path: &std::path::Path, n_max: u32) -> Result<Outcome> {
             f
         })
         .collect();
-    bar.finish_and_clear();
+    bar.finish();
     let mut text = String::new();
     writeln!(text, "{TABLE_HEADER}").expect("write to String");
     for f in &fits {
         writeln!(text, "{}", f.csv_row()).expect("write to String");
     }
     write_atomic(path, text.as_bytes())?;
-    eprintln!("wrote {} fits to {}", fits.len(), path.display());
+    log::info!("minimax: wrote {} fits to {}", fits.len(), path.display());
     Ok(Outcome::Ok)
 }

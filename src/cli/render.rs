@@ -1,12 +1,10 @@
 //! `specfx render`: renders a scene (the built-in one by default) with three specular paths
 //! and writes each picture, difference heat maps and the per-material error table.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use super::output::{print_json, write_atomic};
 use super::Outcome;
@@ -66,7 +64,7 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
             use std::io::Write as _;
             write!(w, "{table}")
         })?;
-        eprintln!("render: wrote {}", args.out.display());
+        log::info!("render: wrote {}", args.out.display());
     }
     Ok(Outcome::Ok)
 }
@@ -95,7 +93,7 @@ pub fn render_scene(
     out: &Path,
 ) -> Result<(Vec<MaterialRow>, String)> {
     let (w, h) = (scene.image.width, scene.image.height);
-    eprintln!(
+    log::info!(
         "render: {w}x{h}, {} objects, {} lights, datapath {}",
         scene.objects.len(),
         scene.lights.len(),
@@ -160,26 +158,13 @@ pub fn render_scene(
     Ok((rows, table))
 }
 
-/// Traces a scene, with a progress bar on a terminal.
+/// Traces a scene, showing its progress in rows.
 pub fn trace_with_progress(scene: &Scene) -> Fragments {
-    let h = scene.image.height;
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = ProgressBar::new(u64::from(h));
-        b.set_style(
-            ProgressStyle::with_template("trace {bar:40} {pos}/{len} rows, eta {eta}")
-                .expect("valid template"),
-        );
-        b
+    let bar = super::progress::Progress::new("trace", "rows", u64::from(scene.image.height));
+    let frags = trace(scene, &|done: usize, _rows: usize| {
+        bar.set_position(done as u64)
     });
-    let progress = |done: usize, _rows: usize| {
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
-        }
-    };
-    let frags = trace(scene, &progress);
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    bar.finish();
     frags
 }
 

@@ -222,8 +222,57 @@ fn write_index(
     writeln!(w, "</ul></body></html>")
 }
 
-fn step(msg: &str) {
-    eprintln!("specfx report: {msg}");
+/// The report's steps: a line each on stderr, a bar over them on a terminal (a line every
+/// tenth elsewhere), and with `-v` how long each took.
+struct Steps {
+    bar: super::progress::Progress,
+    current: Option<(String, std::time::Instant)>,
+}
+
+impl Steps {
+    /// Every run of the report takes these steps (place and route adds unnumbered ones).
+    const COUNT: u64 = 12;
+
+    fn new() -> Steps {
+        Steps {
+            bar: super::progress::Progress::new("report", "steps", Steps::COUNT),
+            current: None,
+        }
+    }
+
+    /// Ends the step under way and starts the next, logged at `level`.
+    fn start_at(&mut self, level: log::Level, msg: &str) {
+        self.end_current();
+        log::log!(level, "specfx report: {msg}");
+        self.bar.set_message(msg.to_string());
+        self.current = Some((msg.to_string(), std::time::Instant::now()));
+    }
+
+    /// Ends the step under way and starts the next.
+    fn start(&mut self, msg: &str) {
+        self.start_at(log::Level::Info, msg);
+    }
+
+    /// A part of the step under way, logged and shown but not counted.
+    fn part(&self, msg: &str) {
+        log::info!("specfx report: {msg}");
+        self.bar.set_message(msg.to_string());
+    }
+
+    fn end_current(&mut self) {
+        if let Some((msg, start)) = self.current.take() {
+            log::debug!(
+                "specfx report: {:.3}s for: {msg}",
+                start.elapsed().as_secs_f64()
+            );
+            self.bar.inc(1);
+        }
+    }
+
+    fn finish(mut self) {
+        self.end_current();
+        self.bar.finish();
+    }
 }
 
 /// Runs `specfx report`.
@@ -231,8 +280,9 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     let out_dir = super::output::OutDir::begin(&args.out, "report", args.force, &[])?;
     let dir = out_dir.path();
     let mut written = Vec::new();
+    let mut steps = Steps::new();
 
-    step("reproducing the paper's claims");
+    steps.start("reproducing the paper's claims");
     let paper = reproduce();
     written.push(emit(dir, "paper.txt", |b| write_paper_table(b, &paper))?);
     written.push(emit(dir, "paper.json", |b| {
@@ -241,7 +291,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         Ok(())
     })?);
 
-    step("measuring every reference method against cos^n, n = 16..=1024");
+    steps.start("measuring every reference method against cos^n, n = 16..=1024");
     let ns: Vec<u32> = (16..=1024).collect();
     let methods = report_methods();
     let errs = max_errors(&methods, &ns);
@@ -253,7 +303,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         write_coefficients(b, &all_n, 4)
     })?);
 
-    step("checking baseline exhaustively: every input code, n = 16..=1024");
+    steps.start("checking baseline exhaustively: every input code, n = 16..=1024");
     let dp = specfx::pipeline::Datapath::new(specfx::pipeline::Config::baseline())?;
     let checked = specfx::analysis::check::check(&dp).map_err(anyhow::Error::msg)?;
     written.push(emit(dir, "check_baseline.txt", |b| {
@@ -264,7 +314,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         b.push(b'\n');
         Ok(())
     })?);
-    step("writing baseline's golden vectors (corner cases and 1000 random)");
+    steps.start("writing baseline's golden vectors (corner cases and 1000 random)");
     let vectors_dir = dir.join("vectors_baseline");
     let selection: specfx::golden::CaseSelection = "corner,random:1000".parse()?;
     let (n_vectors, _) = super::vectors::write_dir(
@@ -277,7 +327,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     )?;
     written.push(vectors_dir.clone());
 
-    step("simulating baseline's cycle-level model (both architectures, 20000 cycles)");
+    steps.start("simulating baseline's cycle-level model (both architectures, 20000 cycles)");
     let mut sims = Vec::new();
     for arch in specfx::cycle::Arch::ALL {
         let mut stim = specfx::cycle::sim::Stimulus::new(1, 0.1, 0.1);
@@ -309,7 +359,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         .is_ok_and(|o| o.status.success());
     let mut costs = Vec::new();
     if yosys_present {
-        step("synthesising baseline with yosys (ice40, both architectures)");
+        steps.start("synthesising baseline with yosys (ice40, both architectures)");
         let hdl = super::cost::hdl_ref_dir(None);
         let nextpnr_present =
             super::child::output(std::process::Command::new("nextpnr-ice40").arg("--version"))
@@ -325,7 +375,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
                 specfx::hdl::pnr::Device::Up5k,
             );
             if nextpnr_present {
-                step(&format!(
+                steps.part(&format!(
                     "placing and routing baseline ({arch}) on an iCE40 UP5K with nextpnr"
                 ));
                 c.timing = Some(super::pnr::run_timing(
@@ -344,10 +394,13 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             Ok(())
         })?);
     } else {
-        step("yosys not found: skipping the synthesis cost (apt-get install yosys)");
+        steps.start_at(
+            log::Level::Warn,
+            "yosys not found: skipping the synthesis cost (apt-get install yosys)",
+        );
     }
 
-    step("error budget of baseline (attribution per stage, gappa bounds if installed)");
+    steps.start("error budget of baseline (attribution per stage, gappa bounds if installed)");
     let budget_dir = dir.join("budget_baseline");
     let ns: Vec<u32> = dp.constants().iter().map(|c| c.n).collect();
     let budget = super::budget::budget(&dp, None, Some(&super::budget::spread(&ns)), &budget_dir)?;
@@ -355,7 +408,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     written.push(budget_dir.join("budget.md"));
     written.push(budget_dir.join("budget.json"));
 
-    step("speed against accuracy of every method (the trade-off charts)");
+    steps.start("speed against accuracy of every method (the trade-off charts)");
     let tradeoff_dir = dir.join("tradeoff");
     let figures = super::tradeoff::tradeoff(
         &tradeoff_dir,
@@ -369,7 +422,8 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         written.push(tradeoff_dir.join(format!("{stem}.png")));
     }
 
-    step("mapping where every method and datapath fails (n = 1..=4096, theta 0..90 degrees)");
+    steps
+        .start("mapping where every method and datapath fails (n = 1..=4096, theta 0..90 degrees)");
     let stability_dir = dir.join("stability");
     let stability = super::stability::stability(
         &stability_dir,
@@ -388,7 +442,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         written.push(stability_dir.join(f));
     }
 
-    step("rendering the built-in scene through baseline (three specular paths, FLIP)");
+    steps.start("rendering the built-in scene through baseline (three specular paths, FLIP)");
     let scene = specfx::scene::Scene::default_scene();
     let scene_ns = specfx::nset::NSet::from_values(&scene.exponents())?;
     let mut scene_cfg = specfx::pipeline::Config::baseline();
@@ -401,7 +455,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         written.push(render_dir.join(f));
     }
 
-    step("fitting a datapath to the built-in scene (default budget: no worse than baseline per material)");
+    steps.start("fitting a datapath to the built-in scene (default budget: no worse than baseline per material)");
     let fit_dir = dir.join("fit");
     let fit = super::fit::fit_scene(
         &scene,
@@ -413,7 +467,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         written.push(fit_dir.join(f));
     }
 
-    step("white furnace of every normalised form");
+    steps.start("white furnace of every normalised form");
     let furnace_dir = dir.join("furnace");
     let furnace_dp = specfx::pipeline::Datapath::new(specfx::pipeline::Config::baseline())?;
     let settings = specfx::analysis::furnace::FurnaceSettings::new(
@@ -431,6 +485,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         written.push(furnace_dir.join(format!("{stem}.svg")));
     }
 
+    steps.finish();
     written.push(emit(dir, "index.html", |b| {
         let results = Results {
             paper: &paper,

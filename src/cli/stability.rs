@@ -1,13 +1,11 @@
 //! `specfx stability`: maps where every method and datapath fails, with heat maps and tables.
 
 use std::fs;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use super::output::{print_json, write_atomic, write_chart, write_figure};
 use super::Outcome;
@@ -105,7 +103,7 @@ fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
             let mut config = dp.config().clone();
             let name = unique_name(&config.name, &paths);
             if name != config.name {
-                eprintln!(
+                log::warn!(
                     "stability: another path is already named '{}'; --config {arg} is shown as '{name}'",
                     config.name
                 );
@@ -123,33 +121,12 @@ fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
 /// Maps every path of `paths` over `grid` and writes the report into `dir`; returns the report.
 pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<StabilityReport> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = ProgressBar::new(0);
-        b.set_style(
-            ProgressStyle::with_template("stability {bar:40} {pos}/{len} exponents, eta {eta}")
-                .expect("valid template"),
-        );
-        b
-    });
-    let last_tenth = Mutex::new(0usize);
-    let progress = |done: usize, total: usize| match &bar {
-        Some(b) => {
-            b.set_length(total as u64);
-            b.set_position(done as u64);
-        }
-        None => {
-            let tenth = done * 10 / total.max(1);
-            let mut last = last_tenth.lock().expect("progress lock");
-            if tenth > *last {
-                *last = tenth;
-                eprintln!(
-                    "stability: {}% ({done}/{total} path-exponent columns)",
-                    tenth * 10
-                );
-            }
-        }
+    let bar = super::progress::Progress::new("stability", "path-exponent columns", 0);
+    let progress = |done: usize, total: usize| {
+        bar.set_len(total as u64);
+        bar.set_position(done as u64);
     };
-    eprintln!(
+    log::info!(
         "stability: {} paths, n = {}, c in steps of 2^-{}, tolerance {}",
         paths.len(),
         grid.n,
@@ -157,10 +134,8 @@ pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<Stability
         grid.tol
     );
     let report = analyse(paths, grid, &progress)?;
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    eprintln!("stability: writing heat maps and tables");
+    bar.finish();
+    log::info!("stability: writing heat maps and tables");
     let tol = grid.tol.value;
     for m in &report.maps {
         write_figure(

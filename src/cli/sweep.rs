@@ -2,12 +2,11 @@
 
 use std::collections::BTreeMap;
 use std::fs::{self, OpenOptions};
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 
 use super::output::write_atomic;
@@ -106,45 +105,29 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
     let total = (0..info.n_points)
         .filter(|i| i % shard_count == shard_index)
         .count();
-    eprintln!(
+    log::info!(
         "sweep: {} points in the space, {total} in this shard, {} already done",
         info.n_points,
         total - todo.len()
     );
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = ProgressBar::new(total as u64);
-        b.set_style(
-            ProgressStyle::with_template("sweep {bar:40} {pos}/{len} eta {eta} {msg}")
-                .expect("valid template"),
-        );
-        b.set_position((total - todo.len()) as u64);
-        b
-    });
+    let bar = super::progress::Progress::new("sweep", "points", total as u64)
+        .resumed_at((total - todo.len()) as u64);
     let mut log = OpenOptions::new()
         .create(true)
         .append(true)
         .open(dir.join("points.jsonl"))
         .with_context(|| format!("cannot open {}", dir.join("points.jsonl").display()))?;
-    for (k, &index) in todo.iter().enumerate() {
+    for &index in &todo {
         let p = evaluate(&info.space, index);
         let mut line = serde_json::to_string(&p)?;
         line.push('\n');
         log.write_all(line.as_bytes())?;
         log.flush()?;
-        match &bar {
-            Some(b) => b.inc(1),
-            None => eprintln!(
-                "sweep: point {index} done ({}/{}): {}",
-                total - todo.len() + k + 1,
-                total,
-                p.values
-            ),
-        }
+        log::debug!("sweep: point {index} done: {}", p.values);
+        bar.inc(1);
         done.insert(index, p);
     }
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    bar.finish();
     let mut points: Vec<PointResult> = done.into_values().collect();
     specfx::analysis::sweep::mark_pareto(&mut points);
     if let Some(named) = &args.yosys {
@@ -193,7 +176,7 @@ fn synthesise_front(
         if let std::collections::btree_map::Entry::Vacant(slot) = known.entry(p.index) {
             let (cfg, arch) = space.point(p.index).map_err(anyhow::Error::msg)?;
             let dp = specfx::pipeline::Datapath::new(cfg)?;
-            eprintln!(
+            log::info!(
                 "sweep: synthesising Pareto point {} with yosys ({target})",
                 p.index
             );

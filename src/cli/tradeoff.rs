@@ -56,10 +56,10 @@ pub fn tradeoff(
     };
     let mut figures = Vec::new();
     for (name, method) in f64_methods() {
-        eprintln!("tradeoff: {name}");
+        log::info!("tradeoff: {name}");
         figures.push(f64_figures(&name, method, ns_v, &mut time_it));
     }
-    eprintln!("tradeoff: powi");
+    log::info!("tradeoff: powi");
     figures.insert(1, powi_figures(ns_v, &mut time_it));
     let configs = [8, 12, 16]
         .into_iter()
@@ -68,10 +68,10 @@ pub fn tradeoff(
     for mut cfg in configs {
         cfg.n = ns.clone();
         let dp = Datapath::new(cfg)?;
-        eprintln!("tradeoff: {}", dp.config().name);
+        log::info!("tradeoff: {}", dp.config().name);
         let mut f = fixed_figures(&dp, &mut time_it);
         if let Some(target) = yosys {
-            eprintln!(
+            log::info!(
                 "tradeoff: synthesising {} with yosys ({target})",
                 dp.config().name
             );

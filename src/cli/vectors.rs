@@ -2,12 +2,11 @@
 
 use std::collections::BTreeMap;
 use std::fs::{self, File};
-use std::io::{BufWriter, IsTerminal, Write};
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use super::Outcome;
 use specfx::golden::{
@@ -106,28 +105,20 @@ pub fn write_dir(
         .iter()
         .map(|p| open(&p.file_name()))
         .collect::<Result<_>>()?;
-    let bar = (std::io::stderr().is_terminal() && cases.len() > 200_000).then(|| {
-        let b = ProgressBar::new(cases.len() as u64);
-        b.set_style(
-            ProgressStyle::with_template("vectors {bar:40} {pos}/{len} eta {eta}")
-                .expect("valid template"),
-        );
-        b
-    });
+    // A few hundred thousand vectors take a moment; fewer are not worth a line.
+    let bar = if cases.len() > 200_000 {
+        super::progress::Progress::new("vectors", "vectors", cases.len() as u64)
+    } else {
+        super::progress::Progress::off("vectors", "vectors", cases.len() as u64)
+    };
     let coverage = {
         let mut writers: Vec<&mut dyn Write> =
             hex.iter_mut().map(|w| w as &mut dyn Write).collect();
-        let mut progress = |done: u64| {
-            if let Some(b) = &bar {
-                b.set_position(done);
-            }
-        };
+        let mut progress = |done: u64| bar.set_position(done);
         write_vectors(dp, &cases, &mut csv, &mut writers, &mut progress)
             .with_context(|| format!("cannot write vectors to {}", partial.display()))?
     };
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    bar.finish();
     let mut sha256 = BTreeMap::new();
     let (digest, mut w) = csv.finish();
     w.flush()?;
@@ -161,5 +152,10 @@ pub fn write_dir(
     }
     fs::rename(&partial, out)
         .with_context(|| format!("cannot rename {} to {}", partial.display(), out.display()))?;
+    log::debug!(
+        "vectors: wrote {} (vectors.csv, {} $readmemh files, manifest.json)",
+        out.display(),
+        manifest.ports.len()
+    );
     Ok((cases.len() as u64, coverage))
 }
