@@ -655,6 +655,84 @@ fn stimulus_finds_the_input_columns_by_name() {
     assert!(err.contains("in_n") && err.lines().count() == 1, "{err}");
 }
 
+/// `vectors.csv` is read as CSV (the csv crate): cells quoted without need read as the plain
+/// ones; a cell that is not an integer and a short row each get one line naming the file, the
+/// line and the column.
+#[test]
+fn stimulus_reads_vectors_csv_as_csv() {
+    let dir = temp_dir();
+    let (d, _, _) = vectors(dir.path(), "v", &["--n", "16,100", "--cases", "corner"]);
+    let stim = |vectors: &Path, out: &str| -> std::process::Output {
+        specfx(&[
+            "hdl",
+            "stimulus",
+            "--vectors",
+            vectors.to_str().unwrap(),
+            "--out",
+            dir.path().join(out).to_str().unwrap(),
+        ])
+    };
+    let o = stim(&d, "s1");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let copy = dir.path().join("copy");
+    std::fs::create_dir_all(&copy).unwrap();
+    for entry in std::fs::read_dir(&d).unwrap() {
+        let e = entry.unwrap();
+        std::fs::copy(e.path(), copy.join(e.file_name())).unwrap();
+    }
+    let text = std::fs::read_to_string(d.join("vectors.csv")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[0].starts_with("in_c:"), "{}", lines[0]);
+    let quoted: String = lines
+        .iter()
+        .map(|l| {
+            l.split(',')
+                .map(|c| format!("\"{c}\""))
+                .collect::<Vec<_>>()
+                .join(",")
+                + "\r\n"
+        })
+        .collect();
+    std::fs::write(copy.join("vectors.csv"), quoted).unwrap();
+    let o = stim(&copy, "s2");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["stim_valid.hex", "expected_cycle.hex", "stim.json"] {
+        assert_eq!(
+            std::fs::read(dir.path().join("s1").join(f)).unwrap(),
+            std::fs::read(dir.path().join("s2").join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    // Line 3 (the second vector): in_c, the first column, is not an integer.
+    let mut bad: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    let rest = bad[2].split_once(',').unwrap().1.to_string();
+    bad[2] = format!("x1,{rest}");
+    std::fs::write(copy.join("vectors.csv"), bad.join("\n") + "\n").unwrap();
+    let o = stim(&copy, "s3");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("vectors.csv line 3 column 1: expected an integer in_c, got 'x1'"),
+        "{err}"
+    );
+    // Line 4 holds three cells only.
+    let mut short: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    let columns = lines[0].split(',').count();
+    short[3] = short[3].split(',').take(3).collect::<Vec<_>>().join(",");
+    std::fs::write(copy.join("vectors.csv"), short.join("\n") + "\n").unwrap();
+    let o = stim(&copy, "s4");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains(&format!(
+            "vectors.csv line 4: expected {columns} fields as in the header, got 3"
+        )),
+        "{err}"
+    );
+}
+
 #[test]
 fn a_bad_order_is_refused() {
     let dir = temp_dir();

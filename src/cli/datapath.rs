@@ -63,22 +63,28 @@ pub fn config_from_manifest(path: &Path) -> Result<Config> {
     })
 }
 
-/// The (n, c_raw) pairs of a vector directory, in file order, from its `vectors.csv`: the
-/// columns of the ports `in_n` and `in_c`, found by name in the header (cells
-/// `<port>:<format>`), wherever they are.
+/// The (n, c_raw) pairs of a vector directory, in file order, from its `vectors.csv` (read
+/// with the csv crate): the columns of the ports `in_n` and `in_c`, found by name in the
+/// header (cells `<port>:<format>`), wherever they are. A bad file gets one line naming the
+/// file, the line and the column.
 pub fn vector_inputs(dir: &Path) -> Result<Vec<(u32, i64)>> {
     let file = dir.join("vectors.csv");
-    let text = std::fs::read_to_string(&file)
-        .with_context(|| format!("cannot read {}", file.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .unwrap_or("")
-        .split(',')
-        .map(|cell| cell.split_once(':').map_or(cell, |(name, _)| name))
+    let text = std::fs::read(&file).with_context(|| format!("cannot read {}", file.display()))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(text.as_slice());
+    let header: Vec<String> = reader
+        .headers()
+        .map_err(|e| csv_error(&file, &e))?
+        .iter()
+        .map(|cell| {
+            cell.split_once(':')
+                .map_or(cell, |(name, _)| name)
+                .to_string()
+        })
         .collect();
     let column = |port: &str| -> Result<usize> {
-        header.iter().position(|&h| h == port).with_context(|| {
+        header.iter().position(|h| h == port).with_context(|| {
             format!(
                 "{}: no column '{port}' in the header (cells <port>:<format>; written by an older specfx? write the vectors again)",
                 file.display()
@@ -87,26 +93,43 @@ pub fn vector_inputs(dir: &Path) -> Result<Vec<(u32, i64)>> {
     };
     let (i_n, i_c) = (column("in_n")?, column("in_c")?);
     let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let fields: Vec<&str> = line.split(',').collect();
+    for record in reader.records() {
+        let record = record.map_err(|e| csv_error(&file, &e))?;
+        let line = record.position().map_or(0, |p| p.line());
         let parse = |j: usize, port: &str| -> Result<i64> {
-            fields
-                .get(j)
-                .and_then(|x| x.parse::<i64>().ok())
-                .with_context(|| {
-                    format!(
-                        "{} line {}: expected an integer {port} in column {}, got '{line}'",
-                        file.display(),
-                        i + 2,
-                        j + 1
-                    )
-                })
+            let cell = record.get(j).unwrap_or("");
+            cell.parse::<i64>().map_err(|_| {
+                anyhow::anyhow!(
+                    "{} line {line} column {}: expected an integer {port}, got '{cell}'",
+                    file.display(),
+                    j + 1
+                )
+            })
         };
         let n = parse(i_n, "in_n")?;
         let c = parse(i_c, "in_c")?;
         rows.push((u32::try_from(n).unwrap_or(0), c));
     }
     Ok(rows)
+}
+
+/// A csv crate error while reading `file` as one line: the file, the line and what is wrong.
+fn csv_error(file: &Path, e: &csv::Error) -> anyhow::Error {
+    let line = e.position().map_or(0, |p| p.line());
+    match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => anyhow::anyhow!(
+            "{} line {line}: expected {expected_len} fields as in the header, got {len}",
+            file.display()
+        ),
+        csv::ErrorKind::Utf8 { err, .. } => anyhow::anyhow!(
+            "{} line {line} column {}: not UTF-8",
+            file.display(),
+            err.field() + 1
+        ),
+        _ => anyhow::anyhow!("{} line {line}: {e}", file.display()),
+    }
 }
 
 /// Parses a set of numbers of squarings (`--k`): the n-set notation (`4`, `3..=5`, `1,4,7`)
