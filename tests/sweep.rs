@@ -72,7 +72,7 @@ fn shards_merged_equal_the_one_shot_sweep() {
     let col = header.iter().position(|&h| h == "pareto").unwrap();
     // The cost columns name their target and unit.
     assert!(header.contains(&"ice40_luts") && header.contains(&"ice40_dsps"));
-    // (the values column is quoted and holds no comma: k=..;..)
+    // (the values column holds no comma, k=..;.., so it is not quoted)
     assert!(
         csv.lines()
             .skip(1)

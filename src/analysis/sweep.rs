@@ -473,49 +473,6 @@ pub fn mark_pareto(points: &mut [PointResult]) {
     }
 }
 
-/// The CSV of a sweep: one row per point, in index order; the cost columns are named with the
-/// target and unit (`ice40_luts,ice40_dsps,ice40_ffs`, `generic_gates,..`).
-pub fn write_csv(
-    w: &mut impl std::io::Write,
-    points: &[PointResult],
-    target: Target,
-) -> std::io::Result<()> {
-    let t = target.name().replace('-', "_");
-    let unit = target.logic_unit().to_lowercase();
-    writeln!(
-        w,
-        "index,values,invalid,shape_total_max_abs,shape_quant_max_abs,out_max_ulp,out_correctly_rounded,monotonic,{t}_{unit},{t}_dsps,{t}_ffs,register_bits,multiplier_bits,latency,initiation_interval,pareto,yosys_{t}_{unit},yosys_{t}_ffs,yosys_{t}_dsps"
-    )?;
-    let f = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
-    let u = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
-    for p in points {
-        writeln!(
-            w,
-            "{},\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            p.index,
-            p.values,
-            p.invalid.as_deref().unwrap_or("").replace('"', "'"),
-            f(p.shape_total_max_abs),
-            f(p.shape_quant_max_abs),
-            f(p.out_max_ulp),
-            f(p.out_correctly_rounded),
-            p.monotonic.map_or(String::new(), |m| m.to_string()),
-            u(p.luts),
-            u(p.dsps),
-            u(p.ffs),
-            u(p.register_bits),
-            u(p.multiplier_bits),
-            u(p.latency),
-            u(p.initiation_interval),
-            p.pareto,
-            u(p.yosys_luts),
-            u(p.yosys_ffs),
-            u(p.yosys_dsps)
-        )?;
-    }
-    Ok(())
-}
-
 /// Parses `I/N` (0 <= I < N).
 ///
 /// # Examples

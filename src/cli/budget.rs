@@ -19,6 +19,7 @@ use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
 use specfx::report::budget::{charts, document};
 use specfx::report::doc::{write_html, write_markdown};
+use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx budget`.
 #[derive(Debug, Args)]
@@ -264,20 +265,25 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
     if args.json {
         print_json(&report)?;
     } else {
-        let mut out = super::output::stdout();
         let a = &report.attribution;
-        writeln!(
-            out,
-            "{:<10} {:>8} {:>12} {:>10} {:>12}",
-            "source", "format", "max |err|", "max LSB", "RMS"
-        )?;
+        let mut table = TextTable::new(&[
+            ("source", Align::Left),
+            ("format", Align::Left),
+            ("max |err|", Align::Right),
+            ("max LSB", Align::Right),
+            ("RMS", Align::Right),
+        ]);
         for s in a.sources.iter().chain(std::iter::once(&a.total)) {
-            writeln!(
-                out,
-                "{:<10} {:>8} {:>12.3e} {:>10.3} {:>12.3e}",
-                s.source, s.format, s.max_abs, s.max_ulp, s.rms
-            )?;
+            table.row([
+                s.source.to_string(),
+                s.format.to_string(),
+                format!("{:.3e}", s.max_abs),
+                format!("{:.3}", s.max_ulp),
+                format!("{:.3e}", s.rms),
+            ]);
         }
+        let mut out = super::output::stdout();
+        table.write(&mut out, super::terminal::table_width())?;
         writeln!(
             out,
             "sum of parts {:.3e}, residual {:.3e}",

@@ -16,6 +16,7 @@ use super::Outcome;
 use specfx::hdl::calibrate::{calibration, fit, read_records, sample, Calibration, Record};
 use specfx::hdl::cost::{Features, Target};
 use specfx::pipeline::Datapath;
+use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx calibrate`.
 #[derive(Debug, Args)]
@@ -191,12 +192,14 @@ pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
     if args.json {
         print_json(&fits)?;
     } else {
-        print_with(|w| write_fits(w, &fits))?;
+        print_with(|w| write_fits(w, &fits, super::terminal::table_width()))?;
     }
     Ok(Outcome::Ok)
 }
 
-fn write_fits(w: &mut impl Write, fits: &[TargetFit]) -> std::io::Result<()> {
+/// The fits as text: per target the fit error and the coefficient table, fitted into `width`
+/// characters (`None`: as wide as its content).
+fn write_fits(w: &mut impl Write, fits: &[TargetFit], width: Option<u16>) -> std::io::Result<()> {
     for f in fits {
         let (a, b) = (&f.fitted, &f.committed);
         writeln!(
@@ -216,25 +219,25 @@ fn write_fits(w: &mut impl Write, fits: &[TargetFit]) -> std::io::Result<()> {
             100.0 * a.error.ff_median_rel,
             100.0 * a.error.dsp_exact,
         )?;
-        writeln!(
-            w,
-            "  {:<22} {:>12} {:>12}",
-            "coefficient", "fitted", "committed"
-        )?;
+        let mut table = TextTable::new(&[
+            ("coefficient", Align::Left),
+            ("fitted", Align::Right),
+            ("committed", Align::Right),
+        ])
+        .indent(2);
         for (i, name) in Features::LOGIC_NAMES.iter().enumerate() {
-            writeln!(
-                w,
-                "  {:<22} {:>12.6} {:>12.6}",
-                name, a.coefficients.logic[i], b.coefficients.logic[i]
-            )?;
+            table.row([
+                name.to_string(),
+                format!("{:.6}", a.coefficients.logic[i]),
+                format!("{:.6}", b.coefficients.logic[i]),
+            ]);
         }
-        writeln!(
-            w,
-            "  {:<22} {:>12.6} {:>12.6}",
-            "ffs_per_register_bit",
-            a.coefficients.ff_per_register_bit,
-            b.coefficients.ff_per_register_bit
-        )?;
+        table.row([
+            "ffs_per_register_bit".to_string(),
+            format!("{:.6}", a.coefficients.ff_per_register_bit),
+            format!("{:.6}", b.coefficients.ff_per_register_bit),
+        ]);
+        table.write(w, width)?;
     }
     Ok(())
 }

@@ -30,7 +30,7 @@ pub fn run(args: &CheckArgs) -> Result<Outcome> {
     if args.json {
         print_json(&report)?;
     } else {
-        print_with(|buf| write_check_table(buf, &report))?;
+        print_with(|buf| write_check_table(buf, &report, super::terminal::table_width()))?;
     }
     Ok(Outcome::Ok)
 }

@@ -16,6 +16,7 @@ use specfx::hdl::cost::{
 use specfx::hdl::params_header;
 use specfx::hdl::rom::{constant_rom, rom_verilog, ConstantRom};
 use specfx::pipeline::Datapath;
+use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx cost`.
 #[derive(Debug, Args)]
@@ -204,51 +205,69 @@ pub fn cost_report(
     })
 }
 
-/// Renders the report as text.
-pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Result<()> {
+/// Renders the report as text, its tables fitted into `width` characters (`None`: as wide as
+/// their content).
+pub fn write_cost(
+    w: &mut impl std::io::Write,
+    r: &CostReport,
+    width: Option<u16>,
+) -> std::io::Result<()> {
     let a = &r.analytic;
     writeln!(
         w,
         "cost {}, {}, target {}: latency {} cycles, initiation interval {}",
         r.config, r.arch, r.target, a.latency, a.initiation_interval
     )?;
-    writeln!(
-        w,
-        "  {:<18} {:>10} {:>10} {:>8}",
-        "", "analytic", "yosys", "ratio"
-    )?;
     let opt = |x: Option<u64>| x.map_or("-".to_string(), |v| v.to_string());
     let rat = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2}"));
-    writeln!(
-        w,
-        "  {:<18} {:>10} {:>10} {:>8}",
-        a.logic_unit,
-        a.luts,
+    let mut table = TextTable::new(&[
+        ("", Align::Left),
+        ("analytic", Align::Right),
+        ("yosys", Align::Right),
+        ("ratio", Align::Right),
+    ])
+    .indent(2);
+    table.row([
+        a.logic_unit.to_string(),
+        a.luts.to_string(),
         opt(r.luts),
-        rat(r.lut_ratio)
-    )?;
-    writeln!(
-        w,
-        "  {:<18} {:>10} {:>10} {:>8}",
-        "flip-flops",
-        a.ffs,
+        rat(r.lut_ratio),
+    ]);
+    table.row([
+        "flip-flops".to_string(),
+        a.ffs.to_string(),
         opt(r.ffs),
-        rat(r.ff_ratio)
-    )?;
-    writeln!(
-        w,
-        "  {:<18} {:>10} {:>10}",
-        "DSP blocks",
-        a.dsps,
-        opt(r.dsps)
-    )?;
+        rat(r.ff_ratio),
+    ]);
+    table.row([
+        "DSP blocks".to_string(),
+        a.dsps.to_string(),
+        opt(r.dsps),
+        String::new(),
+    ]);
     if let Some(y) = &r.yosys {
-        writeln!(w, "  {:<18} {:>10} {:>10}", "carry cells", "-", y.carries)?;
-        writeln!(w, "  {:<18} {:>10} {:>10}", "cells", "-", y.cells)?;
+        table.row([
+            "carry cells".to_string(),
+            "-".into(),
+            y.carries.to_string(),
+            String::new(),
+        ]);
+        table.row([
+            "cells".to_string(),
+            "-".into(),
+            y.cells.to_string(),
+            String::new(),
+        ]);
         if let Some(t) = y.transistors {
-            writeln!(w, "  {:<18} {:>10} {:>10}", "transistors (CMOS)", "-", t)?;
+            table.row([
+                "transistors (CMOS)".to_string(),
+                "-".into(),
+                t.to_string(),
+                String::new(),
+            ]);
         }
     }
+    table.write(w, width)?;
     let cal = specfx::hdl::calibrate::calibration(r.target);
     writeln!(
         w,
@@ -302,7 +321,7 @@ pub fn write_cost(w: &mut impl std::io::Write, r: &CostReport) -> std::io::Resul
     }
     if let Some(t) = &r.timing {
         writeln!(w, "timing (nextpnr place and route on the {}):", t.device)?;
-        super::pnr::write_timing(w, t)?;
+        super::pnr::write_timing(w, t, width)?;
     }
     if let Some(v) = &r.yosys_version {
         writeln!(w, "  {v}")?;
@@ -332,7 +351,7 @@ pub fn run(args: &CostArgs) -> Result<Outcome> {
     if args.json {
         print_json(&r)?;
     } else {
-        print_with(|w| write_cost(w, &r))?;
+        print_with(|w| write_cost(w, &r, super::terminal::table_width()))?;
     }
     Ok(Outcome::Ok)
 }

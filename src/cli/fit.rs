@@ -17,6 +17,7 @@ use specfx::hdl::rom::{constant_rom, rom_verilog};
 use specfx::nset::NSet;
 use specfx::pipeline::{Config, Datapath};
 use specfx::report::scene::{heatmap_png, path_png};
+use specfx::report::table::{Align, TextTable};
 use specfx::scene::fit::{
     fit_search, floors, objective, FitSearch, Floor, ImageBudget, SceneFigures, SceneJudge,
 };
@@ -497,6 +498,43 @@ fn floors_markdown(floors: &[Floor]) -> String {
     s
 }
 
+/// The floors as a terminal table (the same columns as [`floors_markdown`]).
+fn floors_table(floors: &[Floor]) -> TextTable {
+    let mut t = TextTable::new(&[
+        ("k", Align::Right),
+        ("variant", Align::Left),
+        ("f64 floor: max LSB", Align::Right),
+        ("mean LSB", Align::Right),
+        ("differing", Align::Right),
+        ("FLIP", Align::Right),
+        ("meets the budget", Align::Left),
+    ]);
+    for f in floors {
+        let (k, variant) = (f.k.to_string(), f.variant.name().to_string());
+        match (f.figures.as_ref().map(|e| &e.all), &f.reason) {
+            (Some(e), _) => t.row([
+                k,
+                variant,
+                e.max_lsb.to_string(),
+                format!("{:.4}", e.mean_lsb),
+                format!("{:.2}%", 100.0 * e.differing),
+                format!("{:.5}", e.flip_mean),
+                if f.meets { "yes" } else { "no" }.to_string(),
+            ]),
+            (None, reason) => t.row([
+                k,
+                variant,
+                "-".into(),
+                "-".into(),
+                "-".into(),
+                "-".into(),
+                format!("not valid: {}", reason.as_deref().unwrap_or("")),
+            ]),
+        }
+    }
+    t
+}
+
 /// Prints why nothing fits: the floors, the closest point and what would meet.
 fn print_no_fit(
     floors: &[Floor],
@@ -509,10 +547,7 @@ fn print_no_fit(
     super::output::outln!(
         "the f64 floor of each algorithm (its image without quantization, against cos^n):"
     )?;
-    super::output::print_with(|w| {
-        use std::io::Write as _;
-        write!(w, "{}", floors_markdown(floors))
-    })?;
+    super::output::print_with(|w| floors_table(floors).write(w, super::terminal::table_width()))?;
     let best_floor = floors
         .iter()
         .filter_map(|f| f.figures.as_ref().map(|e| (f, budget.excess(scene, e))))

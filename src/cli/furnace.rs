@@ -15,7 +15,7 @@ use specfx::analysis::furnace::{
 use specfx::nset::NSet;
 use specfx::report::doc::write_markdown;
 use specfx::report::furnace::{
-    chart_png, chart_stem, chart_svg, document, summary_text, write_csv,
+    chart_png, chart_stem, chart_svg, document, write_csv, write_summary,
 };
 
 /// Arguments of `specfx furnace`.
@@ -68,10 +68,7 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
     if args.json {
         print_json(&summary)?;
     } else {
-        super::output::print_with(|w| {
-            use std::io::Write as _;
-            write!(w, "{}", summary_text(&summary))
-        })?;
+        super::output::print_with(|w| write_summary(w, &summary, super::terminal::table_width()))?;
         log::info!("furnace: wrote {}", out.display());
     }
     Ok(Outcome::Ok)

@@ -26,6 +26,7 @@ mod report;
 mod sim;
 pub mod stability;
 mod sweep;
+mod terminal;
 mod throughput;
 mod trace;
 pub mod tradeoff;

@@ -15,6 +15,7 @@ use specfx::cycle::Arch;
 use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;
 use specfx::pipeline::{Datapath, Variant};
+use specfx::report::table::{Align, TextTable};
 
 /// The first bytes of the configuration `specfx optimize` writes: a file that begins with
 /// them is an earlier result, replaced without `--force`.
@@ -167,36 +168,52 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         super::output::outln!("no configuration in the space meets the budget")?;
         super::output::outln!("the f64 floor of each algorithm (its own error against cos^n before any quantization):")?;
         let normalised = r.budget.bounds.iter().any(|b| b.metric.is_normalised());
+        let mut columns = vec![
+            ("k", Align::Right),
+            ("variant", Align::Left),
+            ("shape_total floor", Align::Right),
+            ("lsb8", Align::Right),
+        ];
+        if normalised {
+            columns.extend([
+                ("out_rel floor", Align::Right),
+                ("effective bits", Align::Right),
+            ]);
+        }
+        columns.push(("", Align::Left));
+        let mut table = TextTable::new(&columns).indent(2);
         for f in &r.floors {
             let a = f.algorithm;
+            let mut row = vec![a.k.to_string(), a.variant.name().to_string()];
             match (f.shape_total, &f.reason) {
-                (Some(x), _) => super::output::outln!(
-                    "  k = {} {:<8} shape_total floor {:.3e} ({:.2} lsb8){}{}",
-                    a.k,
-                    a.variant.name(),
-                    x,
-                    x / specfx::analysis::LSB8,
-                    match f.norm_rel {
-                        Some(r) if normalised => format!(
-                            ", out_rel floor {r:.3e} ({:.1} effective bits)",
-                            specfx::analysis::check::effective_bits(r)
-                        ),
-                        _ => String::new(),
-                    },
-                    if f.reachable {
-                        ""
-                    } else {
-                        ": beyond the budget"
+                (Some(x), _) => {
+                    row.push(format!("{x:.3e}"));
+                    row.push(format!("{:.2}", x / specfx::analysis::LSB8));
+                    if normalised {
+                        match f.norm_rel {
+                            Some(r) => {
+                                row.push(format!("{r:.3e}"));
+                                row.push(format!(
+                                    "{:.1}",
+                                    specfx::analysis::check::effective_bits(r)
+                                ));
+                            }
+                            None => row.extend(["-".to_string(), "-".to_string()]),
+                        }
                     }
-                )?,
-                (None, reason) => super::output::outln!(
-                    "  k = {} {:<8} not valid: {}",
-                    a.k,
-                    a.variant.name(),
-                    reason.as_deref().unwrap_or("")
-                )?,
+                    row.push(if f.reachable { "" } else { "beyond the budget" }.to_string());
+                }
+                (None, reason) => {
+                    row.extend(["-".to_string(), "-".to_string()]);
+                    if normalised {
+                        row.extend(["-".to_string(), "-".to_string()]);
+                    }
+                    row.push(format!("not valid: {}", reason.as_deref().unwrap_or("")));
+                }
             }
+            table.row(row);
         }
+        super::output::print_with(|w| table.write(w, super::terminal::table_width()))?;
         if let Some(f) = r
             .floors
             .iter()
@@ -344,15 +361,21 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     super::output::outln!(
         "  analytic cost, {arch} (the model `specfx cost --analytic-only` prints):"
     )?;
-    super::output::outln!("    {:<8} {:>28} {:>28}", "target", "this", "paper's")?;
+    let mut table = TextTable::new(&[
+        ("target", Align::Left),
+        ("this", Align::Right),
+        ("paper's", Align::Right),
+    ])
+    .indent(4);
     for target in specfx::hdl::cost::REPORTED_TARGETS {
         let a = analytic_cost(&dp, arch, target);
         let p = analytic_cost(&paper, arch, target);
         let show = |c: &specfx::hdl::cost::AnalyticCost| {
             format!("{} {} {} DSPs {} FFs", c.luts, c.logic_unit, c.dsps, c.ffs)
         };
-        super::output::outln!("    {:<8} {:>28} {:>28}", target.name(), show(&a), show(&p))?;
+        table.row([target.name().to_string(), show(&a), show(&p)]);
     }
+    super::output::print_with(|w| table.write(w, super::terminal::table_width()))?;
     super::output::outln!("why minimal (within this search, not over every possible datapath):")?;
     for m in &r.minimality {
         super::output::outln!("  {m}")?;

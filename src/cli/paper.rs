@@ -22,7 +22,7 @@ pub fn run(args: &PaperArgs) -> Result<Outcome> {
     if args.json {
         print_json(&r)?;
     } else {
-        print_with(|buf| write_paper_table(buf, &r))?;
+        print_with(|buf| write_paper_table(buf, &r, super::terminal::table_width()))?;
     }
     Ok(Outcome::Ok)
 }

@@ -18,6 +18,7 @@ use specfx::hdl::pnr::{
     SynthCells, Timing,
 };
 use specfx::pipeline::Datapath;
+use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx timing`.
 #[derive(Debug, Args)]
@@ -121,8 +122,13 @@ pub fn run_timing(dp: &Datapath, arch: Arch, device: Device, hdl_ref: &Path) -> 
     Ok(Timing::new(dp, arch, device, report.as_ref(), cells))
 }
 
-/// Renders the timing as text.
-pub fn write_timing(w: &mut impl std::io::Write, t: &Timing) -> std::io::Result<()> {
+/// Renders the timing as text, its table fitted into `width` characters (`None`: as wide as its
+/// content).
+pub fn write_timing(
+    w: &mut impl std::io::Write,
+    t: &Timing,
+    width: Option<u16>,
+) -> std::io::Result<()> {
     writeln!(
         w,
         "timing {}, {}, {} ({}): latency {} cycles, initiation interval {}",
@@ -183,21 +189,22 @@ pub fn write_timing(w: &mut impl std::io::Write, t: &Timing) -> std::io::Result<
     )?;
     let rows = utilisation_rows(&t.utilisation);
     if !rows.is_empty() {
-        writeln!(
-            w,
-            "  {:<16} {:>8} {:>10} {:>6}",
-            "resource", "used", "available", "%"
-        )?;
+        let mut table = TextTable::new(&[
+            ("resource", Align::Left),
+            ("used", Align::Right),
+            ("available", Align::Right),
+            ("%", Align::Right),
+        ])
+        .indent(2);
         for u in rows {
-            writeln!(
-                w,
-                "  {:<16} {:>8} {:>10} {:>5.1}%",
-                u.resource,
-                u.used,
-                u.available,
-                100.0 * u.used as f64 / u.available as f64
-            )?;
+            table.row([
+                u.resource.to_string(),
+                u.used.to_string(),
+                u.available.to_string(),
+                format!("{:.1}%", 100.0 * u.used as f64 / u.available as f64),
+            ]);
         }
+        table.write(w, width)?;
     }
     for flag in &t.over_limit {
         writeln!(w, "  OVER LIMIT: {flag}")?;
@@ -213,7 +220,7 @@ pub fn run(args: &TimingArgs) -> Result<Outcome> {
     if args.json {
         print_json(&t)?;
     } else {
-        print_with(|w| write_timing(w, &t))?;
+        print_with(|w| write_timing(w, &t, super::terminal::table_width()))?;
     }
     // A design that does not fit the device is a failed check (exit code 1), not an error.
     Ok(if t.fits && t.over_limit.is_empty() {

@@ -1,6 +1,5 @@
 //! `specfx coef` and `specfx minimax`: the reference models on the command line.
 
-use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
@@ -11,8 +10,9 @@ use super::output::{print_json, print_with, write_atomic};
 use super::Outcome;
 use specfx::nset::NSet;
 use specfx::reference::lobe::{m_of_k, K_RANGE};
-use specfx::reference::minimax::{self, MinimaxFit, TABLE_HEADER, TABLE_N_MAX};
+use specfx::reference::minimax::{self, MinimaxFit, TABLE_N_MAX};
 use specfx::reference::normalisation::{coefficient, CoefSource, Form};
+use specfx::report::csv::write_minimax_table;
 
 fn parse_k(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
@@ -134,14 +134,7 @@ pub fn run_minimax(args: &MinimaxArgs) -> Result<Outcome> {
     if args.json {
         print_json(&fits)?;
     } else {
-        print_with(|buf| {
-            use std::io::Write;
-            writeln!(buf, "{TABLE_HEADER}")?;
-            for f in &fits {
-                writeln!(buf, "{}", f.csv_row())?;
-            }
-            Ok(())
-        })?;
+        print_with(|buf| write_minimax_table(buf, &fits))?;
     }
     Ok(Outcome::Ok)
 }
@@ -163,12 +156,9 @@ fn write_table(path: &std::path::Path, n_max: u32) -> Result<Outcome> {
         })
         .collect();
     bar.finish();
-    let mut text = String::new();
-    writeln!(text, "{TABLE_HEADER}").expect("write to String");
-    for f in &fits {
-        writeln!(text, "{}", f.csv_row()).expect("write to String");
-    }
-    write_atomic(path, text.as_bytes())?;
+    let mut text = Vec::new();
+    write_minimax_table(&mut text, &fits)?;
+    write_atomic(path, &text)?;
     log::info!("minimax: wrote {} fits to {}", fits.len(), path.display());
     Ok(Outcome::Ok)
 }

@@ -10,10 +10,11 @@ use super::output::{print_json, write_atomic};
 use super::Outcome;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
-use specfx::report::scene::{flip_png, heatmap_png, path_png, table_markdown, MaterialRow};
+use specfx::report::scene::{
+    flip_png, heatmap_png, path_png, table_markdown, write_inputs_csv, write_table, MaterialRow,
+};
 use specfx::scene::render::{
-    difference, flip_errors, image_error, render_fragments, trace, Fragments, InputsOfN,
-    INPUT_BINS, PATHS,
+    difference, flip_errors, image_error, render_fragments, trace, Fragments, InputsOfN, PATHS,
 };
 use specfx::scene::Scene;
 
@@ -55,14 +56,13 @@ pub fn run(args: &RenderArgs) -> Result<Outcome> {
         args.force,
         &super::output::inputs(&args.config, args.scene.as_deref()),
     )?;
-    let (rows, table) = render_scene(&scene, &label, &dp, out_dir.path())?;
+    let (rows, _markdown) = render_scene(&scene, &label, &dp, out_dir.path())?;
     out_dir.commit()?;
     if args.json {
         print_json(&rows)?;
     } else {
         super::output::print_with(|w| {
-            use std::io::Write as _;
-            write!(w, "{table}")
+            write_table(w, &rows, scene.image.bits, super::terminal::table_width())
         })?;
         log::info!("render: wrote {}", args.out.display());
     }
@@ -168,29 +168,11 @@ pub fn trace_with_progress(scene: &Scene) -> Fragments {
     frags
 }
 
-/// The datapath inputs as CSV: per n the count, code and c range, and the histogram of c.
+/// The datapath inputs as CSV ([`specfx::report::scene::write_inputs_csv`]).
 pub fn inputs_csv(inputs: &[InputsOfN], lsb: f64) -> String {
-    let mut csv = String::from("n,count,code_min,code_max,c_min,c_max");
-    for i in 0..INPUT_BINS {
-        csv.push_str(&format!(",h{i:02}"));
-    }
-    csv.push('\n');
-    for e in inputs {
-        csv.push_str(&format!(
-            "{},{},{},{},{},{}",
-            e.n,
-            e.count,
-            e.code_min,
-            e.code_max,
-            e.code_min as f64 * lsb,
-            e.code_max as f64 * lsb
-        ));
-        for h in &e.histogram {
-            csv.push_str(&format!(",{h}"));
-        }
-        csv.push('\n');
-    }
-    csv
+    let mut csv = Vec::new();
+    write_inputs_csv(&mut csv, inputs, lsb).expect("writing into memory cannot fail");
+    String::from_utf8(csv).expect("the CSV is UTF-8")
 }
 
 /// Reads a scene file (meshes relative to it), or the built-in scene.

@@ -12,6 +12,7 @@ use specfx::analysis::methods::{max_errors, report_methods};
 use specfx::analysis::paper::reproduce;
 use specfx::report::csv::{write_coefficients, write_method_errors};
 use specfx::report::paper::write_paper_table;
+use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx report`.
 #[derive(Debug, Args)]
@@ -284,7 +285,9 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
 
     steps.start("reproducing the paper's claims");
     let paper = reproduce();
-    written.push(emit(dir, "paper.txt", |b| write_paper_table(b, &paper))?);
+    written.push(emit(dir, "paper.txt", |b| {
+        write_paper_table(b, &paper, None)
+    })?);
     written.push(emit(dir, "paper.json", |b| {
         serde_json::to_writer_pretty(&mut *b, &paper).map_err(std::io::Error::other)?;
         b.push(b'\n');
@@ -307,7 +310,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     let dp = specfx::pipeline::Datapath::new(specfx::pipeline::Config::baseline())?;
     let checked = specfx::analysis::check::check(&dp).map_err(anyhow::Error::msg)?;
     written.push(emit(dir, "check_baseline.txt", |b| {
-        specfx::report::check::write_check_table(b, &checked)
+        specfx::report::check::write_check_table(b, &checked, None)
     })?);
     written.push(emit(dir, "check_baseline.json", |b| {
         serde_json::to_writer_pretty(&mut *b, &checked).map_err(std::io::Error::other)?;
@@ -389,7 +392,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         }
         written.push(emit(dir, "cost_baseline.txt", |b| {
             for c in &costs {
-                super::cost::write_cost(b, c)?;
+                super::cost::write_cost(b, c, None)?;
             }
             Ok(())
         })?);
@@ -613,13 +616,22 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         "  furnace: 6 forms, {flagged} reflectance values above 1 (details: furnace/furnace.md)"
     )?;
     writeln!(out, "  max |error| against cos^n over n = 16..=1024:")?;
+    let mut table = TextTable::new(&[
+        ("method", Align::Left),
+        ("max |error|", Align::Right),
+        ("at n", Align::Right),
+        ("c", Align::Right),
+    ])
+    .indent(4);
     for e in &errs {
-        writeln!(
-            out,
-            "    {:<14} {:.3e}  (n = {}, c = {:.6})",
-            e.method, e.max_abs_err, e.argmax_n, e.argmax_c
-        )?;
+        table.row([
+            e.method.to_string(),
+            format!("{:.3e}", e.max_abs_err),
+            e.argmax_n.to_string(),
+            format!("{:.6}", e.argmax_c),
+        ]);
     }
+    table.write(&mut out, super::terminal::table_width())?;
     writeln!(out, "  files:")?;
     for p in &written {
         // Written into the staging directory, now renamed to --out.

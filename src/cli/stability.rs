@@ -18,6 +18,7 @@ use specfx::report::stability::{
     document, heatmap_png, heatmap_stem, heatmap_svg, overshoot_chart, overview_png, overview_svg,
     write_overshoot_csv, write_regions_csv, write_special_csv,
 };
+use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx stability`.
 #[derive(Debug, Args)]
@@ -207,12 +208,15 @@ pub fn run(args: &StabilityArgs) -> Result<Outcome> {
         print_json(&report)?;
         return Ok(Outcome::Ok);
     }
-    let mut out = super::output::stdout();
-    writeln!(
-        out,
-        "{:<16} {:>9} {:>11} {:>6} {:>8}  failing regions",
-        "path", "precision", "max |err|", "at n", "theta"
-    )?;
+    let mut table = TextTable::new(&[
+        ("path", Align::Left),
+        ("precision", Align::Left),
+        ("max |err|", Align::Right),
+        ("at n", Align::Right),
+        ("theta", Align::Right),
+        ("failing regions", Align::Left),
+    ])
+    .gap_before(5, 1);
     for m in &report.maps {
         let failing: Vec<String> = m
             .regions
@@ -220,21 +224,21 @@ pub fn run(args: &StabilityArgs) -> Result<Outcome> {
             .filter(|g| g.fails)
             .map(|g| format!("{} (n {}..={})", g.kind, g.n_min, g.n_max))
             .collect();
-        writeln!(
-            out,
-            "{:<16} {:>9} {:>11.3e} {:>6} {:>8.3}  {}",
-            m.path,
-            m.precision,
-            m.max_abs_err,
-            m.worst_n,
-            m.worst_c.clamp(-1.0, 1.0).acos().to_degrees(),
+        table.row([
+            m.path.clone(),
+            m.precision.clone(),
+            format!("{:.3e}", m.max_abs_err),
+            m.worst_n.to_string(),
+            format!("{:.3}", m.worst_c.clamp(-1.0, 1.0).acos().to_degrees()),
             if failing.is_empty() {
                 "none".to_string()
             } else {
                 failing.join(", ")
-            }
-        )?;
+            },
+        ]);
     }
+    let mut out = super::output::stdout();
+    table.write(&mut out, super::terminal::table_width())?;
     writeln!(
         out,
         "written to {} (stability.html, stability.md, stability.json, regions.csv, heat maps)",

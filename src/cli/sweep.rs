@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::output::write_atomic;
 use super::Outcome;
-use specfx::analysis::sweep::{evaluate, mark_pareto, parse_shard, write_csv, PointResult, Space};
+use specfx::analysis::sweep::{evaluate, mark_pareto, parse_shard, PointResult, Space};
 
 /// Arguments of `specfx sweep`.
 #[derive(Debug, Args)]
@@ -232,7 +232,7 @@ fn write_results(
 ) -> Result<()> {
     mark_pareto(points);
     let mut csv = Vec::new();
-    write_csv(&mut csv, points, target)?;
+    specfx::report::sweep::write_csv(&mut csv, points, target)?;
     write_atomic(&dir.join("sweep.csv"), &csv)?;
     let mut json = serde_json::to_vec_pretty(&points)?;
     json.push(b'\n');

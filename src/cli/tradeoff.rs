@@ -13,10 +13,11 @@ use specfx::analysis::tradeoff::{
     f64_figures, f64_methods, fixed_config, fixed_figures, fixed_minimax_config, powi_figures,
     MethodFigures, YosysFigures,
 };
-use specfx::hdl::cost::Target;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
-use specfx::report::tradeoff::{cost_chart, per_n_chart, speed_chart, CostAxis};
+use specfx::report::tradeoff::{
+    cost_chart, per_n_chart, speed_chart, write_csv, write_speed_csv, write_table, CostAxis,
+};
 
 /// Arguments of `specfx tradeoff`.
 #[derive(Debug, Args)]
@@ -88,37 +89,7 @@ pub fn tradeoff(
         figures.push(f);
     }
     let mut csv = Vec::new();
-    writeln!(
-        csv,
-        "method,kind,max_abs_err,max_err_lsb8,mean_abs_err,multipliers,ice40_luts,ice40_dsps,ice40_ffs,xilinx_luts,xilinx_dsps,xilinx_ffs,generic_gates,generic_ffs,latency,yosys_target,yosys_luts,yosys_dsps,yosys_ffs"
-    )?;
-    let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
-    let cost = |f: &MethodFigures, t: Target| f.costs.iter().find(|c| c.target == t).copied();
-    for f in &figures {
-        writeln!(
-            csv,
-            "{},{},{:e},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            f.method,
-            f.kind,
-            f.max_abs_err,
-            f.max_abs_err / specfx::analysis::LSB8,
-            f.mean_abs_err,
-            opt(f.multipliers.map(u64::from)),
-            opt(cost(f, Target::Ice40).map(|c| c.luts)),
-            opt(cost(f, Target::Ice40).map(|c| c.dsps)),
-            opt(cost(f, Target::Ice40).map(|c| c.ffs)),
-            opt(cost(f, Target::Xilinx).map(|c| c.luts)),
-            opt(cost(f, Target::Xilinx).map(|c| c.dsps)),
-            opt(cost(f, Target::Xilinx).map(|c| c.ffs)),
-            opt(cost(f, Target::Generic).map(|c| c.luts)),
-            opt(cost(f, Target::Generic).map(|c| c.ffs)),
-            opt(f.latency),
-            f.yosys.as_ref().map_or("", |y| y.target.as_str()),
-            opt(f.yosys.as_ref().map(|y| y.luts)),
-            opt(f.yosys.as_ref().map(|y| y.dsps)),
-            opt(f.yosys.as_ref().map(|y| y.ffs))
-        )?;
-    }
+    write_csv(&mut csv, &figures)?;
     write_atomic(&dir.join("tradeoff.csv"), &csv)?;
     let mut json = serde_json::to_vec_pretty(&figures)?;
     json.push(b'\n');
@@ -128,14 +99,7 @@ pub fn tradeoff(
     }
     // Wall-clock measurements of this run, apart: every other file is the same on every run.
     let mut speed = Vec::new();
-    writeln!(speed, "method,kind,evals_per_s,max_abs_err")?;
-    for f in &figures {
-        writeln!(
-            speed,
-            "{},{},{:e},{:e}",
-            f.method, f.kind, f.evals_per_s, f.max_abs_err
-        )?;
-    }
+    write_speed_csv(&mut speed, &figures)?;
     write_atomic(&dir.join("measured_speed.csv"), &speed)?;
     write_chart(dir, "measured_speed_accuracy", &speed_chart(&figures))?;
     write_chart(
@@ -166,35 +130,7 @@ pub fn run(args: &TradeoffArgs) -> Result<Outcome> {
         print_json(&figures)?;
     } else {
         let mut out = super::output::stdout();
-        writeln!(
-            out,
-            "{:<16} {:>6} {:>11} {:>11} {:>12} {:>5} {:>22} {:>7}",
-            "method",
-            "kind",
-            "max |err|",
-            "mean |err|",
-            "Meval/s",
-            "mult",
-            "ice40 LUTs+DSPs (an.)",
-            "latency"
-        )?;
-        for f in &figures {
-            writeln!(
-                out,
-                "{:<16} {:>6} {:>11.3e} {:>11.3e} {:>12.1} {:>5} {:>22} {:>7}",
-                f.method,
-                f.kind,
-                f.max_abs_err,
-                f.mean_abs_err,
-                f.evals_per_s / 1e6,
-                f.multipliers.map_or("-".into(), |m| m.to_string()),
-                f.costs
-                    .iter()
-                    .find(|c| c.target == Target::Ice40)
-                    .map_or("-".into(), |c| format!("{} + {}", c.luts, c.dsps)),
-                f.latency.map_or("-".into(), |m| m.to_string())
-            )?;
-        }
+        write_table(&mut out, &figures, super::terminal::table_width())?;
         writeln!(out, "written to {}", args.out.display())?;
     }
     Ok(Outcome::Ok)

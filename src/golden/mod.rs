@@ -15,6 +15,7 @@ use sha2::{Digest, Sha256};
 use crate::fixed::Format;
 use crate::pipeline::fast::EventCounts;
 use crate::pipeline::{Config, Datapath, ProbeColumns, Variant};
+use crate::report::csv::CsvWriter;
 
 pub use cases::{CaseSelection, Order};
 
@@ -249,9 +250,9 @@ fn push_decimal(buf: &mut Vec<u8>, v: i64) {
 /// Rows evaluated and written together by [`write_vectors`].
 const WRITE_CHUNK: usize = 1 << 16;
 
-/// Writes every vector, in the order of `cases`: the CSV to `csv` (the [`csv_header`] line,
-/// then one row of decimal raw codes per vector) and each port's words to `hex[i]` (in
-/// [`ports`] order), and returns what the vectors cover. `progress` is called with the number
+/// Writes every vector, in the order of `cases`: the CSV to `csv` (through the csv crate: the
+/// [`csv_header`] line, then one row of decimal raw codes per vector) and each port's words to
+/// `hex[i]` (in [`ports`] order), and returns what the vectors cover. `progress` is called with the number
 /// of vectors written so far.
 ///
 /// The cases are taken in chunks of 65536; each chunk's cases are grouped by n and each group
@@ -286,13 +287,14 @@ pub fn write_vectors(
 ) -> io::Result<Coverage> {
     let ports = ports(dp);
     assert_eq!(ports.len(), hex.len(), "one writer per port");
-    writeln!(csv, "{}", csv_header(dp))?;
+    let mut csv = CsvWriter::new(csv);
+    csv.record(csv_columns(dp).iter().map(CsvColumn::header))?;
     let mut coverage = CoverageCounter::new(dp);
     let n_stages = dp.stages().len();
     let mut cols = ProbeColumns::default();
     let mut written = 0u64;
-    // The chunk's text: the CSV rows, and each port's words.
-    let mut csv_text: Vec<u8> = Vec::new();
+    // A CSV cell's digits, and each port's words of the chunk.
+    let mut cell: Vec<u8> = Vec::with_capacity(24);
     let mut hex_text: Vec<Vec<u8>> = vec![Vec::new(); ports.len()];
     // values[i * n_stages + stage_idx]: the chunk's probes, in the order of the chunk.
     let mut values: Vec<i64> = Vec::new();
@@ -319,7 +321,6 @@ pub fn write_vectors(
                 }
             }
         }
-        csv_text.clear();
         for text in &mut hex_text {
             text.clear();
         }
@@ -329,7 +330,7 @@ pub fn write_vectors(
                 .expect("cases are drawn from the configuration's n set");
             let row = &values[i * n_stages..(i + 1) * n_stages];
             coverage.add_row(n, row);
-            for (port_idx, (port, text)) in ports.iter().zip(&mut hex_text).enumerate() {
+            for (port, text) in ports.iter().zip(&mut hex_text) {
                 let raw = match port.source {
                     Source::C => c,
                     Source::N => i64::from(n),
@@ -339,22 +340,21 @@ pub fn write_vectors(
                     Source::Threshold => nc.threshold.unwrap_or(0),
                     Source::Stage(stage_idx) => row[stage_idx],
                 };
-                if port_idx > 0 {
-                    csv_text.push(b',');
-                }
-                push_decimal(&mut csv_text, raw);
+                cell.clear();
+                push_decimal(&mut cell, raw);
+                csv.field(&cell)?;
                 push_hex_word(text, raw, port.width);
                 text.push(b'\n');
             }
-            csv_text.push(b'\n');
+            csv.end_record()?;
         }
-        csv.write_all(&csv_text)?;
         for (text, w) in hex_text.iter().zip(hex.iter_mut()) {
             w.write_all(text)?;
         }
         written += chunk.len() as u64;
         progress(written);
     }
+    csv.finish()?;
     Ok(coverage.finish())
 }
 

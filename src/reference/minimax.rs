@@ -44,12 +44,16 @@ pub struct MinimaxFit {
 }
 
 impl MinimaxFit {
-    /// The CSV row of this fit, in [`TABLE_HEADER`] order, with shortest round-trip floats.
-    pub fn csv_row(&self) -> String {
-        format!(
-            "{},{},{:e},{:e},{:e},{:e}",
-            self.k, self.n, self.a, self.b, self.max_abs_err, self.plain_max_abs_err
-        )
+    /// The CSV fields of this fit, in [`TABLE_HEADER`] order, with shortest round-trip floats.
+    pub fn csv_fields(&self) -> [String; 6] {
+        [
+            self.k.to_string(),
+            self.n.to_string(),
+            format!("{:e}", self.a),
+            format!("{:e}", self.b),
+            format!("{:e}", self.max_abs_err),
+            format!("{:e}", self.plain_max_abs_err),
+        ]
     }
 }
 
@@ -270,45 +274,72 @@ pub fn table() -> &'static [MinimaxFit] {
     TABLE.get_or_init(|| parse_table(TABLE_CSV).expect("data/minimax.csv is well formed"))
 }
 
-/// Parses the CSV text of a table (header [`TABLE_HEADER`]); an error names the line.
+/// Parses the CSV text of a table (header [`TABLE_HEADER`]); an error names the line and the
+/// column.
+///
+/// # Examples
+/// ```
+/// use specfx::reference::minimax::parse_table;
+/// let t = parse_table("k,n,a,b,max_abs_err,plain_max_abs_err\n4,16,1.5,-0.5,1e-3,2e-3\n").unwrap();
+/// assert_eq!((t[0].k, t[0].n, t[0].a), (4, 16, 1.5));
+/// let e = parse_table("k,n,a,b,max_abs_err,plain_max_abs_err\n4,16,x,-0.5,1e-3,2e-3\n");
+/// assert!(e.unwrap_err().to_string().contains("line 2 column 3"));
+/// ```
 pub fn parse_table(text: &str) -> Result<Vec<MinimaxFit>, crate::error::Error> {
     let fail = |problem: String| crate::error::Error::Config {
         key: "minimax table".into(),
         problem,
     };
-    let mut lines = text.lines();
-    match lines.next() {
-        Some(h) if h == TABLE_HEADER => {}
-        other => {
-            return Err(fail(format!(
-                "expected header '{TABLE_HEADER}', got {other:?}"
-            )))
-        }
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(text.as_bytes());
+    let header = reader
+        .headers()
+        .map_err(|e| fail(format!("line 1: {e}")))?
+        .iter()
+        .collect::<Vec<_>>()
+        .join(",");
+    if header != TABLE_HEADER {
+        return Err(fail(format!(
+            "line 1: expected header '{TABLE_HEADER}', got '{header}'"
+        )));
     }
-    lines
-        .enumerate()
-        .map(|(i, line)| {
-            let bad = || {
-                fail(format!(
-                    "line {}: expected 6 comma-separated numbers, got '{line}'",
-                    i + 2
-                ))
-            };
-            let f: Vec<&str> = line.split(',').collect();
-            if f.len() != 6 {
-                return Err(bad());
+    let mut fits = Vec::new();
+    for record in reader.records() {
+        let record = record.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            match e.kind() {
+                csv::ErrorKind::UnequalLengths { len, .. } => fail(format!(
+                    "line {line}: expected 6 comma-separated numbers, got {len} fields"
+                )),
+                _ => fail(format!("line {line}: {e}")),
             }
-            let float = |s: &str| s.parse::<f64>().map_err(|_| bad());
-            Ok(MinimaxFit {
-                k: f[0].parse().map_err(|_| bad())?,
-                n: f[1].parse().map_err(|_| bad())?,
-                a: float(f[2])?,
-                b: float(f[3])?,
-                max_abs_err: float(f[4])?,
-                plain_max_abs_err: float(f[5])?,
-            })
-        })
-        .collect()
+        })?;
+        let line = record.position().map_or(0, |p| p.line());
+        let field = |j: usize| -> Result<&str, crate::error::Error> {
+            record
+                .get(j)
+                .ok_or_else(|| fail(format!("line {line}: expected 6 fields")))
+        };
+        let bad = |j: usize, what: &str| {
+            fail(format!(
+                "line {line} column {}: expected {what}, got '{}'",
+                j + 1,
+                record.get(j).unwrap_or("")
+            ))
+        };
+        let int = |j: usize| field(j)?.parse::<u32>().map_err(|_| bad(j, "an integer"));
+        let float = |j: usize| field(j)?.parse::<f64>().map_err(|_| bad(j, "a number"));
+        fits.push(MinimaxFit {
+            k: int(0)?,
+            n: int(1)?,
+            a: float(2)?,
+            b: float(3)?,
+            max_abs_err: float(4)?,
+            plain_max_abs_err: float(5)?,
+        });
+    }
+    Ok(fits)
 }
 
 /// The cached minimax constants for (n, k).

@@ -1,11 +1,18 @@
-//! Renders an exhaustive accuracy check as a readable table.
+//! Renders an exhaustive accuracy check as a readable table (comfy-table, through
+//! [`TextTable`]).
 
 use std::io::{self, Write};
 
 use crate::analysis::check::CheckReport;
+use crate::report::table::{Align, TextTable};
 
-/// Writes the table of a [`CheckReport`].
-pub fn write_check_table(w: &mut impl Write, r: &CheckReport) -> io::Result<()> {
+/// Writes the table of a [`CheckReport`]: the per-stage table fitted into `width` characters
+/// (`None`: as wide as its content; see [`TextTable::write`]), the rest as lines of text.
+pub fn write_check_table(
+    w: &mut impl Write,
+    r: &CheckReport,
+    width: Option<u16>,
+) -> io::Result<()> {
     writeln!(
         w,
         "check {}: n = {} ({} exponents) x {} input codes up to 1.0 = {} evaluations",
@@ -19,53 +26,53 @@ pub fn write_check_table(w: &mut impl Write, r: &CheckReport) -> io::Result<()> 
         )?;
     }
     writeln!(w, "errors against the f64 value of the same algorithm:")?;
-    writeln!(
-        w,
-        "  {:<5} {:<7} {:>10} {:>10} {:>10} {:>9} {:>8} {:>8}  {:<22} {:>6} {:>6} {:>6}",
-        "stage",
-        "format",
-        "max |err|",
-        "mean err",
-        "rms err",
-        "max ulp",
-        "correct",
-        "faithful",
-        "worst input",
-        "sat",
-        "wrap",
-        "zero"
-    )?;
+    let mut table = TextTable::new(&[
+        ("stage", Align::Left),
+        ("format", Align::Left),
+        ("max |err|", Align::Right),
+        ("mean err", Align::Right),
+        ("rms err", Align::Right),
+        ("max ulp", Align::Right),
+        ("correct", Align::Right),
+        ("faithful", Align::Right),
+        ("worst input", Align::Left),
+        ("sat", Align::Right),
+        ("wrap", Align::Right),
+        ("zero", Align::Right),
+    ])
+    .indent(2)
+    .gap_before(8, 1)
+    .note_indent(8);
     for s in &r.stages {
-        writeln!(
-            w,
-            "  {:<5} {:<7} {:>10.3e} {:>10.2e} {:>10.3e} {:>9.4} {:>7.3}% {:>7.3}%  {:<22} {:>6} {:>6} {:>6}",
-            s.stage,
-            s.format,
-            s.max_abs_err,
-            s.mean_err,
-            s.rms_err,
-            s.max_ulp,
-            100.0 * s.correctly_rounded,
-            100.0 * s.faithfully_rounded,
+        table.row([
+            s.stage.clone(),
+            s.format.clone(),
+            format!("{:.3e}", s.max_abs_err),
+            format!("{:.2e}", s.mean_err),
+            format!("{:.3e}", s.rms_err),
+            format!("{:.4}", s.max_ulp),
+            format!("{:.3}%", 100.0 * s.correctly_rounded),
+            format!("{:.3}%", 100.0 * s.faithfully_rounded),
             format!("n={} c_raw={}", s.worst.n, s.worst.c_raw),
-            s.saturated,
-            s.wrapped,
-            s.zeroed
-        )?;
+            s.saturated.to_string(),
+            s.wrapped.to_string(),
+            s.zeroed.to_string(),
+        ]);
         // The explanation of a figure sits beside it.
         for note in r
             .notes
             .iter()
             .filter(|n| n.starts_with(&format!("{} ", s.stage)))
         {
-            writeln!(w, "        ^ {note}")?;
+            table.note(format!("^ {note}"));
         }
         if s.stage == "out" {
             if let Some(line) = effective_bits(s) {
-                writeln!(w, "        ^ {line}")?;
+                table.note(format!("^ {line}"));
             }
         }
     }
+    table.write(w, width)?;
     writeln!(
         w,
         "normalised lobe (before the coefficient), max |error| (lsb8 = 2^-8 = 3.906e-3, one step of an 8-bit display at the lobe's peak):"

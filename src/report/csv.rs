@@ -1,9 +1,99 @@
+//! CSV output through the `csv` crate ([`CsvWriter`]: every file specfx writes as CSV), and the
 //! CSV renderings of reference results: per-n method errors and normalisation coefficients.
+//!
+//! Numbers are formatted to text by the callers (`{:e}`, `{}`: shortest round-trip), so the
+//! writer only decides quoting: a field is quoted when it holds a comma, a quote (doubled) or a
+//! line break, and written as it is otherwise. Lines end in `\n`; every record has as many
+//! fields as the first.
 
 use std::io::{self, Write};
 
 use crate::analysis::methods::MethodErrors;
+use crate::reference::minimax::{MinimaxFit, TABLE_HEADER};
 use crate::reference::normalisation::{coefficient, CoefSource, Form};
+
+/// A CSV writer over any `io::Write` in specfx's dialect (see the module docs).
+///
+/// # Examples
+/// ```
+/// use specfx::report::csv::CsvWriter;
+/// let mut out = Vec::new();
+/// let mut w = CsvWriter::new(&mut out);
+/// w.record(["name", "value"]).unwrap();
+/// w.record(["a,b", "say \"hi\""]).unwrap();
+/// w.record(["plain", "1e-3"]).unwrap();
+/// w.finish().unwrap();
+/// assert_eq!(
+///     String::from_utf8(out).unwrap(),
+///     "name,value\n\"a,b\",\"say \"\"hi\"\"\"\nplain,1e-3\n"
+/// );
+/// ```
+pub struct CsvWriter<W: Write> {
+    inner: ::csv::Writer<W>,
+}
+
+impl<W: Write> CsvWriter<W> {
+    /// A writer into `w`, with specfx's dialect.
+    pub fn new(w: W) -> Self {
+        CsvWriter {
+            inner: ::csv::WriterBuilder::new()
+                .terminator(::csv::Terminator::Any(b'\n'))
+                .quote_style(::csv::QuoteStyle::Necessary)
+                .flexible(false)
+                .from_writer(w),
+        }
+    }
+
+    /// Writes one record (the header is the first).
+    ///
+    /// # Errors
+    /// The underlying writer's error; a record whose length differs from the first's (a
+    /// programming error) as `InvalidInput`.
+    pub fn record<I, T>(&mut self, fields: I) -> io::Result<()>
+    where
+        I: IntoIterator<Item = T>,
+        T: AsRef<[u8]>,
+    {
+        self.inner.write_record(fields).map_err(into_io)
+    }
+
+    /// Writes one field of the current record; [`CsvWriter::end_record`] ends it. For writers
+    /// that produce fields one at a time without collecting them.
+    pub fn field(&mut self, field: impl AsRef<[u8]>) -> io::Result<()> {
+        self.inner.write_field(field).map_err(into_io)
+    }
+
+    /// Ends the record begun by [`CsvWriter::field`].
+    pub fn end_record(&mut self) -> io::Result<()> {
+        self.inner.write_record(None::<&[u8]>).map_err(into_io)
+    }
+
+    /// Flushes what is buffered into the underlying writer and returns it.
+    pub fn finish(self) -> io::Result<W> {
+        self.inner.into_inner().map_err(|e| e.into_error())
+    }
+}
+
+/// The csv crate's error as an `io::Error`, keeping an I/O error's kind (a broken pipe stays
+/// one).
+fn into_io(e: ::csv::Error) -> io::Error {
+    let message = e.to_string();
+    match e.into_kind() {
+        ::csv::ErrorKind::Io(io) => io,
+        _ => io::Error::new(io::ErrorKind::InvalidInput, message),
+    }
+}
+
+/// Writes a minimax table: the [`TABLE_HEADER`] line, then one row per fit (the format of
+/// `data/minimax.csv`, which [`crate::reference::minimax::parse_table`] reads).
+pub fn write_minimax_table(w: &mut impl Write, fits: &[MinimaxFit]) -> io::Result<()> {
+    let mut csv = CsvWriter::new(w);
+    csv.record(TABLE_HEADER.split(','))?;
+    for f in fits {
+        csv.record(f.csv_fields())?;
+    }
+    csv.finish().map(drop)
+}
 
 /// Writes one row per exponent: `n`, then one column per method (max |error| over c).
 pub fn write_method_errors(
@@ -11,35 +101,87 @@ pub fn write_method_errors(
     ns: &[u32],
     errs: &[MethodErrors],
 ) -> io::Result<()> {
-    write!(w, "n")?;
-    for e in errs {
-        write!(w, ",{}", e.method)?;
-    }
-    writeln!(w)?;
+    let mut csv = CsvWriter::new(w);
+    csv.record(std::iter::once("n".to_string()).chain(errs.iter().map(|e| e.method.to_string())))?;
     for (i, n) in ns.iter().enumerate() {
-        write!(w, "{n}")?;
-        for e in errs {
-            write!(w, ",{:e}", e.per_n[i])?;
-        }
-        writeln!(w)?;
+        csv.record(
+            std::iter::once(n.to_string()).chain(errs.iter().map(|e| format!("{:e}", e.per_n[i]))),
+        )?;
     }
-    Ok(())
+    csv.finish().map(drop)
 }
 
 /// Writes `form,n,classic,paper,exact` rows (exact for m = 2^k) for every form and exponent.
 pub fn write_coefficients(w: &mut impl Write, ns: &[u32], k: u32) -> io::Result<()> {
-    writeln!(w, "form,n,classic,paper,exact_m{}", 1u32 << k)?;
+    let mut csv = CsvWriter::new(w);
+    csv.record([
+        "form".to_string(),
+        "n".into(),
+        "classic".into(),
+        "paper".into(),
+        format!("exact_m{}", 1u32 << k),
+    ])?;
     for form in Form::ALL {
         for &n in ns {
             let nf = f64::from(n);
-            writeln!(
-                w,
-                "{form},{n},{:e},{:e},{:e}",
-                coefficient(form, CoefSource::Classic, nf, k),
-                coefficient(form, CoefSource::Paper, nf, k),
-                coefficient(form, CoefSource::Exact, nf, k)
-            )?;
+            csv.record([
+                form.to_string(),
+                n.to_string(),
+                format!("{:e}", coefficient(form, CoefSource::Classic, nf, k)),
+                format!("{:e}", coefficient(form, CoefSource::Paper, nf, k)),
+                format!("{:e}", coefficient(form, CoefSource::Exact, nf, k)),
+            ])?;
         }
     }
-    Ok(())
+    csv.finish().map(drop)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::minimax::parse_table;
+
+    /// What `specfx minimax --write` writes, the library reads back bit for bit.
+    #[test]
+    fn a_minimax_table_round_trips() {
+        let fits = [
+            MinimaxFit {
+                n: 16,
+                k: 4,
+                a: 1.0000000000000002,
+                b: -0.1,
+                max_abs_err: 1e-300,
+                plain_max_abs_err: 3.0e-3,
+            },
+            MinimaxFit {
+                n: 4096,
+                k: 7,
+                a: 32.5,
+                b: -31.5,
+                max_abs_err: 0.0,
+                plain_max_abs_err: f64::MIN_POSITIVE,
+            },
+        ];
+        let mut out = Vec::new();
+        write_minimax_table(&mut out, &fits).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        assert!(text.starts_with("k,n,a,b,max_abs_err,plain_max_abs_err\n4,16,1.0000000000000002e0,-1e-1,1e-300,3e-3\n"), "{text}");
+        assert_eq!(parse_table(&text).unwrap(), fits);
+    }
+
+    /// A bad table names the line and the column.
+    #[test]
+    fn a_bad_minimax_table_names_line_and_column() {
+        let head = "k,n,a,b,max_abs_err,plain_max_abs_err\n";
+        let e = parse_table(&format!("{head}4,16,1,2,3,4\n4,17,1,2\n")).unwrap_err();
+        assert!(e.to_string().contains("line 3: expected 6"), "{e}");
+        let e = parse_table(&format!("{head}4,16,1,2,3,4\n4,-17,1,2,3,4\n")).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("line 3 column 2: expected an integer, got '-17'"),
+            "{e}"
+        );
+        let e = parse_table("k,n\n").unwrap_err();
+        assert!(e.to_string().contains("line 1: expected header"), "{e}");
+    }
 }

@@ -13,7 +13,9 @@ use crate::report::chart::{
     draw_chart, draw_sample, encode_png, register_font, render_error, Chart, Dash, Marker, RefLine,
     Series, OKABE_ITO,
 };
+use crate::report::csv::CsvWriter;
 use crate::report::doc::Block;
+use crate::report::table::{Align, TextTable};
 
 /// The file stem of a form's chart: `furnace_<form>`.
 pub fn chart_stem(form: crate::reference::normalisation::Form) -> String {
@@ -22,21 +24,22 @@ pub fn chart_stem(form: crate::reference::normalisation::Form) -> String {
 
 /// Writes every reflectance as CSV: `form,n,path,theta_deg,rho`, one row per value.
 pub fn write_csv(w: &mut impl Write, r: &FurnaceReport) -> io::Result<()> {
-    writeln!(w, "form,n,path,theta_deg,rho")?;
+    let mut csv = CsvWriter::new(w);
+    csv.record(["form", "n", "path", "theta_deg", "rho"])?;
     for f in &r.forms {
         for c in &f.curves {
             for (theta, rho) in r.angles_deg.iter().zip(&c.rho) {
-                writeln!(
-                    w,
-                    "{},{},{},{theta},{rho}",
-                    f.form.name(),
-                    c.n,
-                    c.path.name()
-                )?;
+                csv.record([
+                    f.form.name().to_string(),
+                    c.n.to_string(),
+                    c.path.name().to_string(),
+                    theta.to_string(),
+                    rho.to_string(),
+                ])?;
             }
         }
     }
-    Ok(())
+    csv.finish().map(drop)
 }
 
 /// Below this, `|rho - 1|` is the quadratures' round-off and is shown as `< 1e-11`.
@@ -224,19 +227,28 @@ pub fn document(r: &FurnaceReport) -> Vec<Block> {
     doc
 }
 
-/// One line per form: the worst reflectance and the flags.
-pub fn summary_text(summary: &[FormSummary]) -> String {
-    let mut s = String::new();
+/// The terminal summary: one row per form with its worst reflectance and the flags, fitted
+/// into `width` characters (`None`: as wide as its content; see [`TextTable::write`]).
+pub fn write_summary(
+    w: &mut impl Write,
+    summary: &[FormSummary],
+    width: Option<u16>,
+) -> io::Result<()> {
+    let mut table = TextTable::new(&[
+        ("form", Align::Left),
+        ("max rho", Align::Right),
+        ("at", Align::Left),
+        ("flags", Align::Left),
+    ]);
     for f in summary {
-        let worst = f.worst.map_or("no values".to_string(), |w| {
-            format!(
-                "max rho {:.6} ({}, n = {}, {} deg)",
-                w.rho,
-                w.path.name(),
-                w.n,
-                w.theta_deg
-            )
-        });
+        let (rho, at) = f
+            .worst
+            .map_or(("-".to_string(), "no values".to_string()), |w| {
+                (
+                    format!("{:.6}", w.rho),
+                    format!("{}, n = {}, {} deg", w.path.name(), w.n, w.theta_deg),
+                )
+            });
         let flags = if f.n_flagged_values == 0 {
             "no flags".to_string()
         } else {
@@ -250,12 +262,14 @@ pub fn summary_text(summary: &[FormSummary]) -> String {
         } else {
             ""
         };
-        s.push_str(&format!(
-            "{:<24} {worst}; {flags}{unavailable}\n",
-            f.form.name()
-        ));
+        table.row([
+            f.form.name().to_string(),
+            rho,
+            at,
+            format!("{flags}{unavailable}"),
+        ]);
     }
-    s
+    table.write(w, width)
 }
 
 /// How each path is drawn: an Okabe-Ito colour and a dash pattern of its own, so that lines

@@ -1,4 +1,5 @@
-//! Renders results as text tables, CSV and charts into any writer or buffer; never opens files.
+//! Renders results as text tables (comfy-table), CSV (the csv crate) and charts into any writer or
+//! buffer; never opens files.
 pub mod budget;
 pub mod chart;
 pub mod check;
@@ -9,4 +10,5 @@ pub mod paper;
 pub mod scene;
 pub mod stability;
 pub mod sweep;
+pub mod table;
 pub mod tradeoff;

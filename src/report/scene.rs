@@ -1,11 +1,16 @@
 //! The images of `specfx render`: each path's picture as PNG, difference heat maps in display
-//! LSBs with a colour bar, and the per-material error table.
+//! LSBs with a colour bar, the per-material error table (Markdown and terminal) and the CSV of
+//! the datapath's inputs.
+
+use std::io::{self, Write};
 
 use plotters::prelude::*;
 
 use crate::error::Error;
 use crate::report::chart::{encode_png, encode_png_depth, register_font, render_error};
-use crate::scene::render::{ImageError, Rendered};
+use crate::report::csv::CsvWriter;
+use crate::report::table::{Align, TextTable};
+use crate::scene::render::{ImageError, InputsOfN, Rendered, INPUT_BINS};
 
 /// One path's picture as PNG: 8 bits per channel, or for 10-bit images 16 bits per channel
 /// holding the 10-bit codes scaled to the full range (`code * 65535 / 1023`, rounded).
@@ -155,6 +160,83 @@ pub struct MaterialRow {
     pub quant: ImageError,
 }
 
+/// What the table's figures mean, after it.
+fn table_legend(bits: u32) -> String {
+    format!("Errors are in display LSBs of the {bits}-bit sRGB image (the largest channel difference of a pixel); \"differing\" is the share of the material's pixels where any channel differs; FLIP is the mean of NVIDIA's FLIP (LDR, 67 pixels per degree) over the material's pixels.")
+}
+
+/// Writes the table for the terminal, fitted into `width` characters (`None`: as wide as its
+/// content; see [`TextTable::write`]), and what its figures mean.
+pub fn write_table(
+    w: &mut impl Write,
+    rows: &[MaterialRow],
+    bits: u32,
+    width: Option<u16>,
+) -> io::Result<()> {
+    let mut table = TextTable::new(&[
+        ("material", Align::Left),
+        ("n", Align::Right),
+        ("pixels", Align::Right),
+        ("max vs cos^n", Align::Right),
+        ("mean vs cos^n", Align::Right),
+        ("differing vs cos^n", Align::Right),
+        ("FLIP vs cos^n", Align::Right),
+        ("max vs f64 model", Align::Right),
+        ("mean vs f64 model", Align::Right),
+        ("differing vs f64 model", Align::Right),
+        ("FLIP vs f64 model", Align::Right),
+    ]);
+    for r in rows {
+        table.row([
+            r.material.clone(),
+            if r.n == 0 {
+                "-".to_string()
+            } else {
+                r.n.to_string()
+            },
+            r.total.pixels.to_string(),
+            r.total.max_lsb.to_string(),
+            format!("{:.4}", r.total.mean_lsb),
+            format!("{:.2}%", 100.0 * r.total.differing),
+            format!("{:.5}", r.total.flip_mean),
+            r.quant.max_lsb.to_string(),
+            format!("{:.4}", r.quant.mean_lsb),
+            format!("{:.2}%", 100.0 * r.quant.differing),
+            format!("{:.5}", r.quant.flip_mean),
+        ]);
+    }
+    table.write(w, width)?;
+    writeln!(w)?;
+    writeln!(w, "{}", table_legend(bits))
+}
+
+/// Writes the datapath's inputs as CSV: per n the count, code and c range, and the histogram
+/// of c in [`INPUT_BINS`] bins (`h00`, `h01`, ..).
+pub fn write_inputs_csv(w: &mut impl Write, inputs: &[InputsOfN], lsb: f64) -> io::Result<()> {
+    let mut csv = CsvWriter::new(w);
+    csv.record(
+        ["n", "count", "code_min", "code_max", "c_min", "c_max"]
+            .map(String::from)
+            .into_iter()
+            .chain((0..INPUT_BINS).map(|i| format!("h{i:02}"))),
+    )?;
+    for e in inputs {
+        csv.record(
+            [
+                e.n.to_string(),
+                e.count.to_string(),
+                e.code_min.to_string(),
+                e.code_max.to_string(),
+                (e.code_min as f64 * lsb).to_string(),
+                (e.code_max as f64 * lsb).to_string(),
+            ]
+            .into_iter()
+            .chain(e.histogram.iter().map(|h| h.to_string())),
+        )?;
+    }
+    csv.finish().map(drop)
+}
+
 /// The table as Markdown (names are escaped for Markdown and HTML).
 pub fn table_markdown(rows: &[MaterialRow], bits: u32) -> String {
     let mut s = "| material | n | pixels | max vs cos^n | mean vs cos^n | differing vs cos^n | FLIP vs cos^n | max vs f64 model | mean vs f64 model | differing vs f64 model | FLIP vs f64 model |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n".to_string();
@@ -189,8 +271,6 @@ pub fn table_markdown(rows: &[MaterialRow], bits: u32) -> String {
             r.quant.flip_mean,
         ));
     }
-    s.push_str(&format!(
-        "\nErrors are in display LSBs of the {bits}-bit sRGB image (the largest channel difference of a pixel); \"differing\" is the share of the material's pixels where any channel differs; FLIP is the mean of NVIDIA's FLIP (LDR, 67 pixels per degree) over the material's pixels.\n"
-    ));
+    s.push_str(&format!("\n{}\n", table_legend(bits)));
     s
 }

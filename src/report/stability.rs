@@ -12,6 +12,7 @@ use crate::analysis::stability::{
     Kind, PathMap, StabilityReport, HEAT_ROWS, OVERSHOOT_J_MAX, SPECIAL_N,
 };
 use crate::report::chart::{lsb8, register_font, style, Chart, Dash, Series};
+use crate::report::csv::CsvWriter;
 use crate::report::doc::Block;
 use plotters::element::DashedPathElement;
 
@@ -575,73 +576,83 @@ fn deg(c: f64) -> f64 {
 
 /// Writes the region table as CSV: one row per path and kind.
 pub fn write_regions_csv(w: &mut impl Write, r: &StabilityReport) -> io::Result<()> {
-    writeln!(
-        w,
-        "path,precision,kind,fails,samples,failing,n_min,n_max,c_min,c_max,theta_min_deg,theta_max_deg,worst_abs_err,worst_n,worst_c,stages"
-    )?;
+    let mut csv = CsvWriter::new(w);
+    csv.record([
+        "path",
+        "precision",
+        "kind",
+        "fails",
+        "samples",
+        "failing",
+        "n_min",
+        "n_max",
+        "c_min",
+        "c_max",
+        "theta_min_deg",
+        "theta_max_deg",
+        "worst_abs_err",
+        "worst_n",
+        "worst_c",
+        "stages",
+    ])?;
     for m in &r.maps {
         for g in &m.regions {
-            writeln!(
-                w,
-                "{},{},{},{},{},{},{},{},{:e},{:e},{:.4},{:.4},{:e},{},{:e},{}",
-                m.path,
-                m.precision,
-                g.kind,
-                g.fails,
-                g.samples,
-                g.failing,
-                g.n_min,
-                g.n_max,
-                g.c_min,
-                g.c_max,
-                deg(g.c_max),
-                deg(g.c_min),
-                g.worst_abs_err,
-                g.worst_n,
-                g.worst_c,
-                g.stages.join(" ")
-            )?;
+            csv.record([
+                m.path.to_string(),
+                m.precision.to_string(),
+                g.kind.to_string(),
+                g.fails.to_string(),
+                g.samples.to_string(),
+                g.failing.to_string(),
+                g.n_min.to_string(),
+                g.n_max.to_string(),
+                format!("{:e}", g.c_min),
+                format!("{:e}", g.c_max),
+                format!("{:.4}", deg(g.c_max)),
+                format!("{:.4}", deg(g.c_min)),
+                format!("{:e}", g.worst_abs_err),
+                g.worst_n.to_string(),
+                format!("{:e}", g.worst_c),
+                g.stages.join(" "),
+            ])?;
         }
     }
-    Ok(())
+    csv.finish().map(drop)
 }
 
 /// Writes the special-input outcomes as CSV.
 pub fn write_special_csv(w: &mut impl Write, r: &StabilityReport) -> io::Result<()> {
-    writeln!(w, "path,input,n,output,verdict")?;
+    let mut csv = CsvWriter::new(w);
+    csv.record(["path", "input", "n", "output", "verdict"])?;
     for s in &r.special {
-        writeln!(
-            w,
-            "{},{},{},{},{}",
-            s.path,
-            s.input,
-            s.n,
-            s.output,
-            s.verdict.name()
-        )?;
+        csv.record([
+            s.path.to_string(),
+            s.input.to_string(),
+            s.n.to_string(),
+            s.output.to_string(),
+            s.verdict.name().to_string(),
+        ])?;
     }
-    Ok(())
+    csv.finish().map(drop)
 }
 
 /// Writes the overshoot thresholds as CSV: one row per n, one column per float path (empty
 /// where no j up to the maximum overshoots).
 pub fn write_overshoot_csv(w: &mut impl Write, r: &StabilityReport) -> io::Result<()> {
-    write!(w, "n")?;
-    for o in &r.overshoot {
-        write!(w, ",{}", o.path)?;
-    }
-    writeln!(w)?;
+    let mut csv = CsvWriter::new(w);
+    csv.record(
+        std::iter::once("n".to_string()).chain(r.overshoot.iter().map(|o| o.path.to_string())),
+    )?;
     for (i, &n) in r.grid.n.values().iter().enumerate() {
-        write!(w, "{n}")?;
-        for o in &r.overshoot {
-            match o.per_n[i].1 {
-                Some(j) => write!(w, ",{j}")?,
-                None => write!(w, ",")?,
-            }
-        }
-        writeln!(w)?;
+        csv.record(
+            std::iter::once(n.to_string()).chain(
+                r.overshoot
+                    .iter()
+                    .map(|o| o.per_n[i].1.map_or(String::new(), |j| j.to_string())),
+            ),
+        )?;
     }
-    Ok(())
+    csv.finish().map(drop)
 }
 
 /// The file stem of a path's heat map: `heatmap_<name>`, any character outside

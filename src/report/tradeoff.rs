@@ -1,10 +1,122 @@
-//! The trade-off charts: error against each target's hardware cost (the hardware question),
-//! accuracy against software speed, and the error against n.
+//! The trade-off's CSV files and terminal table, and its charts: error against each target's
+//! hardware cost (the hardware question), accuracy against software speed, and the error
+//! against n.
+
+use std::io::{self, Write};
 
 use crate::analysis::tradeoff::MethodFigures;
 use crate::analysis::LSB8;
 use crate::hdl::cost::{CostFigures, Target};
 use crate::report::chart::{front_2d, Chart, Dash, Marker, RefLine, Series};
+use crate::report::csv::CsvWriter;
+use crate::report::table::{Align, TextTable};
+
+/// A method's analytic cost on a target, if it has one.
+fn cost_on(f: &MethodFigures, t: Target) -> Option<CostFigures> {
+    f.costs.iter().find(|c| c.target == t).copied()
+}
+
+/// Writes `tradeoff.csv`: one row per method, its errors (also in lsb8), multipliers, the
+/// analytic cost on each target, the latency and yosys's figures (empty cells where a method
+/// has none). Nothing measured: the same bytes on every run.
+pub fn write_csv(w: &mut impl Write, figures: &[MethodFigures]) -> io::Result<()> {
+    let mut csv = CsvWriter::new(w);
+    csv.record([
+        "method",
+        "kind",
+        "max_abs_err",
+        "max_err_lsb8",
+        "mean_abs_err",
+        "multipliers",
+        "ice40_luts",
+        "ice40_dsps",
+        "ice40_ffs",
+        "xilinx_luts",
+        "xilinx_dsps",
+        "xilinx_ffs",
+        "generic_gates",
+        "generic_ffs",
+        "latency",
+        "yosys_target",
+        "yosys_luts",
+        "yosys_dsps",
+        "yosys_ffs",
+    ])?;
+    let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
+    for f in figures {
+        csv.record([
+            f.method.clone(),
+            f.kind.to_string(),
+            format!("{:e}", f.max_abs_err),
+            format!("{:e}", f.max_abs_err / LSB8),
+            format!("{:e}", f.mean_abs_err),
+            opt(f.multipliers.map(u64::from)),
+            opt(cost_on(f, Target::Ice40).map(|c| c.luts)),
+            opt(cost_on(f, Target::Ice40).map(|c| c.dsps)),
+            opt(cost_on(f, Target::Ice40).map(|c| c.ffs)),
+            opt(cost_on(f, Target::Xilinx).map(|c| c.luts)),
+            opt(cost_on(f, Target::Xilinx).map(|c| c.dsps)),
+            opt(cost_on(f, Target::Xilinx).map(|c| c.ffs)),
+            opt(cost_on(f, Target::Generic).map(|c| c.luts)),
+            opt(cost_on(f, Target::Generic).map(|c| c.ffs)),
+            opt(f.latency),
+            f.yosys.as_ref().map_or(String::new(), |y| y.target.clone()),
+            opt(f.yosys.as_ref().map(|y| y.luts)),
+            opt(f.yosys.as_ref().map(|y| y.dsps)),
+            opt(f.yosys.as_ref().map(|y| y.ffs)),
+        ])?;
+    }
+    csv.finish().map(drop)
+}
+
+/// Writes `measured_speed.csv`: each method's evaluations per second measured in the run,
+/// beside its max error (the only trade-off file that changes from run to run).
+pub fn write_speed_csv(w: &mut impl Write, figures: &[MethodFigures]) -> io::Result<()> {
+    let mut csv = CsvWriter::new(w);
+    csv.record(["method", "kind", "evals_per_s", "max_abs_err"])?;
+    for f in figures {
+        csv.record([
+            f.method.clone(),
+            f.kind.to_string(),
+            format!("{:e}", f.evals_per_s),
+            format!("{:e}", f.max_abs_err),
+        ])?;
+    }
+    csv.finish().map(drop)
+}
+
+/// Writes the terminal table of the trade-off, fitted into `width` characters (`None`: as wide
+/// as its content; see [`TextTable::write`]).
+pub fn write_table(
+    w: &mut impl Write,
+    figures: &[MethodFigures],
+    width: Option<u16>,
+) -> io::Result<()> {
+    let mut table = TextTable::new(&[
+        ("method", Align::Left),
+        ("kind", Align::Left),
+        ("max |err|", Align::Right),
+        ("mean |err|", Align::Right),
+        ("Meval/s", Align::Right),
+        ("mult", Align::Right),
+        ("ice40 LUTs+DSPs (an.)", Align::Right),
+        ("latency", Align::Right),
+    ]);
+    let dash = |x: Option<String>| x.unwrap_or_else(|| "-".into());
+    for f in figures {
+        table.row([
+            f.method.clone(),
+            f.kind.to_string(),
+            format!("{:.3e}", f.max_abs_err),
+            format!("{:.3e}", f.mean_abs_err),
+            format!("{:.1}", f.evals_per_s / 1e6),
+            dash(f.multipliers.map(|m| m.to_string())),
+            dash(cost_on(f, Target::Ice40).map(|c| format!("{} + {}", c.luts, c.dsps))),
+            dash(f.latency.map(|l| l.to_string())),
+        ]);
+    }
+    table.write(w, width)
+}
 
 /// A hardware cost axis of the trade-off.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
