@@ -50,17 +50,7 @@ pub fn config_from_manifest(path: &Path) -> Result<Config> {
         path.to_path_buf()
     };
     let text = super::input::read_text(&file, &file.display().to_string())?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", file.display()))?;
-    let config = value
-        .get("config")
-        .with_context(|| format!("{}: no key 'config'", file.display()))?;
-    serde_json::from_value(config.clone()).with_context(|| {
-        format!(
-            "{}: key 'config' is not a specfx configuration",
-            file.display()
-        )
-    })
+    specfx::golden::manifest_config(&text).with_context(|| file.display().to_string())
 }
 
 /// The (n, c_raw) pairs of a vector directory, in file order, from its `vectors.csv`: the
