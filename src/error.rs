@@ -11,16 +11,40 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, Error
             .unwrap_or(1);
         Error::Toml {
             line,
-            message: e.message().replace('\n', " ").trim().to_string(),
+            message: one_line(e.message()),
         }
     })
+}
+
+/// User text shown in a message: control characters (line breaks, tabs, escapes) are written
+/// as Rust escapes (`\n`, `\u{1b}`), and so are the Unicode line and paragraph separators, so
+/// that a message stays on one line and shows what was given.
+pub(crate) struct OneLine<'a>(pub &'a str);
+
+impl std::fmt::Display for OneLine<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use std::fmt::Write;
+        for c in self.0.chars() {
+            if c.is_control() || matches!(c, '\u{2028}' | '\u{2029}') {
+                write!(f, "{}", c.escape_debug())?;
+            } else {
+                f.write_char(c)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A parser's message on one line: line breaks become spaces, surrounding space is dropped.
+pub(crate) fn one_line(message: &str) -> String {
+    message.replace(['\n', '\r'], " ").trim().to_string()
 }
 
 /// Errors from parsing and validating user input. Arithmetic never fails.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum Error {
     /// A name (form, cutoff, source, ...) that is not one of the known ones.
-    #[error("unknown {what} '{got}': expected {expected}")]
+    #[error("unknown {what} '{}': expected {expected}", OneLine(.got))]
     UnknownName {
         /// What kind of name was expected.
         what: &'static str,
@@ -30,7 +54,7 @@ pub enum Error {
         got: String,
     },
     /// A number outside its allowed range.
-    #[error("{what} must be {expected}, got {got}")]
+    #[error("{what} must be {}, got {}", OneLine(.expected), OneLine(.got))]
     OutOfRange {
         /// What the number is.
         what: &'static str,
@@ -43,7 +67,7 @@ pub enum Error {
     #[error(transparent)]
     Fixed(#[from] FixedError),
     /// A configuration key whose value cannot be used.
-    #[error("{key}: {problem}")]
+    #[error("{}: {}", OneLine(.key), OneLine(.problem))]
     Config {
         /// The key, e.g. `t.format` or `square[2].rounding`.
         key: String,
@@ -68,8 +92,14 @@ pub enum Error {
         /// The most an exhaustive check evaluates.
         limit: u64,
     },
+    /// A vector directory's manifest that cannot be read.
+    #[error("{problem}")]
+    Manifest {
+        /// What is wrong, on one line.
+        problem: String,
+    },
     /// A sweep shard that is not `I/N` with `0 <= I < N`.
-    #[error("expected a shard I/N with 0 <= I < N, got '{got}'")]
+    #[error("expected a shard I/N with 0 <= I < N, got '{}'", OneLine(.got))]
     Shard {
         /// What was given.
         got: String,
@@ -136,7 +166,7 @@ pub enum Error {
 #[non_exhaustive]
 pub enum FixedError {
     /// The text is not in the `u<int>.<frac>` / `s<int>.<frac>` notation.
-    #[error("format must look like u1.15 or s2.16, got '{got}'")]
+    #[error("format must look like u1.15 or s2.16, got '{}'", OneLine(.got))]
     BadNotation {
         /// The text that was given.
         got: String,
@@ -166,15 +196,38 @@ pub enum FixedError {
         got: i64,
     },
     /// The text is not the name of a quantization (rounding) mode.
-    #[error("rounding mode must be one of TRN, TRN_ZERO, RND, RND_ZERO, RND_INF, RND_MIN_INF, RND_CONV, RND_CONV_ODD (upper or lower case), got '{got}'")]
+    #[error("rounding mode must be one of TRN, TRN_ZERO, RND, RND_ZERO, RND_INF, RND_MIN_INF, RND_CONV, RND_CONV_ODD (upper or lower case), got '{}'", OneLine(.got))]
     BadRounding {
         /// The text that was given.
         got: String,
     },
     /// The text is not the name of an overflow mode.
-    #[error("overflow mode must be one of WRAP, SAT, SAT_ZERO, SAT_SYM (upper or lower case), got '{got}'")]
+    #[error("overflow mode must be one of WRAP, SAT, SAT_ZERO, SAT_SYM (upper or lower case), got '{}'", OneLine(.got))]
     BadOverflow {
         /// The text that was given.
         got: String,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::analysis::optimize::Budget;
+    use crate::fixed::{Format, Rounding};
+    use crate::reference::lobe::Cutoff;
+
+    #[test]
+    fn user_text_in_messages_is_escaped_onto_one_line() {
+        let e = "s10#8\r-2".parse::<Format>().unwrap_err().to_string();
+        assert_eq!(e, r"format must look like u1.15 or s2.16, got 's10#8\r-2'");
+        let e = "RND\n".parse::<Rounding>().unwrap_err().to_string();
+        assert!(e.ends_with(r"got 'RND\n'"), "{e}");
+        let e = "clamp\u{2028}x".parse::<Cutoff>().unwrap_err().to_string();
+        assert!(e.starts_with(r"unknown cutoff 'clamp\u{2028}x'"), "{e}");
+        // Tabs and escapes too; quotes and non-ASCII letters are shown as they are.
+        let e = "out <=\t1 ulp\u{1b}[2J 'é'".parse::<Budget>().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            r"budget: unit 'ulp\u{1b}[2J 'é'' does not fit this metric in 'out <=\t1 ulp\u{1b}[2J 'é''; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'"
+        );
+    }
 }

@@ -102,11 +102,30 @@ impl Mesh {
             return Err(fail("the mesh has no triangles".into()));
         }
         let place = |v: [f64; 3]| [0, 1, 2].map(|k| v[k] * scale + translate[k]);
+        // Placed, a vertex or the mesh's extent may leave f64's range (scale 1e300).
+        if let Some((i, v)) = vertices
+            .iter()
+            .map(|&v| place(v))
+            .enumerate()
+            .find(|(_, v)| v.iter().any(|x| !x.is_finite()))
+        {
+            return Err(fail(format!(
+                "vertex {} scaled by {scale:?} and moved by {translate:?} is not finite: {v:?}",
+                i + 1
+            )));
+        }
         let triangles = faces
             .iter()
             .map(|f| f.map(|k| place(vertices[k])))
             .collect();
-        Ok(Mesh::new(triangles))
+        let mesh = Mesh::new(triangles);
+        let (centre, radius) = mesh.bound();
+        if !(radius.is_finite() && centre.iter().all(|x| x.is_finite())) {
+            return Err(fail(format!(
+                "scaled by {scale:?} and moved by {translate:?}, the mesh spans more than f64 holds"
+            )));
+        }
+        Ok(mesh)
     }
 
     /// A mesh of the given triangles, with its hierarchy built.
@@ -167,7 +186,21 @@ fn read_obj(bytes: &[u8], fail: impl Fn(String) -> Error) -> Result<Indexed, Err
         single_index: false,
         ..Default::default()
     };
-    let mut reader = std::io::BufReader::new(bytes);
+    // Only positions and faces are used: texture coordinates and normals (`vt`, `vn` lines,
+    // first words as tobj splits them) are dropped before tobj reads the file, because tobj
+    // 4.0.5 computes their relative indices unchecked (`f 1/-3` overflows: a panic where
+    // overflow checks are on, a wrong element where they are off).
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        fail(format!(
+            "not a readable OBJ file: not UTF-8 text (an invalid byte at offset {})",
+            e.valid_up_to()
+        ))
+    })?;
+    let positions_and_faces: String = text
+        .split_inclusive('\n')
+        .filter(|line| !matches!(line.split_whitespace().next(), Some("vt" | "vn")))
+        .collect();
+    let mut reader = std::io::BufReader::new(positions_and_faces.as_bytes());
     let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
@@ -280,4 +313,39 @@ fn triangle_hit(t: &[[f64; 3]; 3], o: [f64; 3], d: [f64; 3]) -> Option<f64> {
     }
     let dist = dot(e2, q) * inv;
     (dist > 1e-9).then_some(dist)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texture_and_normal_indices_are_ignored() {
+        // `3/-3` names the texture coordinate three before the one there is: tobj's unchecked
+        // index arithmetic overflowed on it. Only the positions matter here.
+        let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\nf 3/-3/-7 1/1/1 2//1\n";
+        let m = Mesh::parse(obj, MeshFormat::Obj, 1.0, [0.0; 3], "t.obj").unwrap();
+        assert_eq!(
+            m.triangles,
+            vec![[[1.0, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]]
+        );
+    }
+
+    #[test]
+    fn placed_vertices_and_extent_stay_finite() {
+        let obj = b"v 0 0 0\nv 10 0 0\nv 0 1 0\nf 1 2 3\n";
+        let e = Mesh::parse(obj, MeshFormat::Obj, 1e308, [0.0; 3], "t.obj").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.obj: vertex 2 scaled by 1e308 and moved by [0.0, 0.0, 0.0] is not finite: [inf, 0.0, 0.0]"
+        );
+        // Every vertex finite (about -1.5e308 and 1.5e308), but not the box's width.
+        let wide = b"v -1e38 0 0\nv 1e38 0 0\nv 0 1 0\nf 1 2 3\n";
+        let e = Mesh::parse(wide, MeshFormat::Obj, 1.5e270, [0.0; 3], "t.obj")
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("the mesh spans more than f64 holds"), "{e}");
+        let m = Mesh::parse(obj, MeshFormat::Obj, 2.0, [1.0, 0.0, 0.0], "t.obj").unwrap();
+        assert_eq!(m.bound(), ([11.0, 1.0, 0.0], 0.5 * 404f64.sqrt()));
+    }
 }

@@ -1,0 +1,6 @@
+//! Fuzz target `nset`: [`specfx_fuzz::nset`] on every input (no panic, one-line errors, round trips).
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    specfx_fuzz::nset(data);
+});
