@@ -307,3 +307,12 @@ fn remove_stale(parent: &Path, name: &str) {
         }
     }
 }
+
+/// Writes what determined a result into its directory: `inputs.toml` (the canonical inputs)
+/// and `provenance.json` (the specfx version, the command and the inputs' sha256). Every
+/// command that writes a result directory calls it (`specfx::provenance`).
+pub fn write_provenance(dir: &Path, p: &specfx::provenance::Provenance) -> Result<()> {
+    use specfx::provenance::{INPUTS_FILE, PROVENANCE_FILE};
+    write_atomic(&dir.join(INPUTS_FILE), p.canonical.as_bytes())?;
+    write_atomic(&dir.join(PROVENANCE_FILE), p.json().as_bytes())
+}

@@ -10,6 +10,7 @@ use super::output::write_atomic;
 use super::Outcome;
 use specfx::analysis::methods::{max_errors, report_methods};
 use specfx::analysis::paper::reproduce;
+use specfx::provenance::{INPUTS_FILE, PROVENANCE_FILE};
 use specfx::report::csv::{write_coefficients, write_method_errors};
 use specfx::report::paper::write_paper_table;
 
@@ -50,6 +51,7 @@ struct Results<'a> {
     furnace: &'a specfx::analysis::furnace::FurnaceReport,
     costs: &'a [super::cost::CostReport],
     sims: &'a [specfx::cycle::sim::SimStats],
+    provenance: &'a specfx::provenance::Provenance,
 }
 
 /// A self-contained index page linking (and showing) everything the report wrote.
@@ -70,6 +72,7 @@ fn write_index(
         furnace,
         costs,
         sims,
+        provenance,
     } = *results;
     let rel = |p: &PathBuf| {
         p.strip_prefix(dir)
@@ -219,7 +222,13 @@ fn write_index(
         let r = rel(f);
         writeln!(w, "<li><a href=\"{r}\">{r}</a></li>")?;
     }
-    writeln!(w, "</ul></body></html>")
+    writeln!(w, "</ul>")?;
+    writeln!(
+        w,
+        "<p>specfx {} · <code>specfx {}</code> · inputs sha256 <code>{}</code> (<a href=\"{INPUTS_FILE}\">{INPUTS_FILE}</a>, <a href=\"{PROVENANCE_FILE}\">{PROVENANCE_FILE}</a>; each part's directory holds its own)</p>",
+        provenance.specfx_version, provenance.command, provenance.inputs_sha256
+    )?;
+    writeln!(w, "</body></html>")
 }
 
 fn step(msg: &str) {
@@ -434,6 +443,13 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         written.push(furnace_dir.join(format!("{stem}.svg")));
     }
 
+    // Everything the report computes is built in: its inputs are the command alone (and the
+    // version, which fixes the built-in configurations, scene and settings).
+    let provenance =
+        specfx::provenance::Provenance::new(&specfx::provenance::Inputs::new("report"));
+    super::output::write_provenance(dir, &provenance)?;
+    written.push(dir.join(INPUTS_FILE));
+    written.push(dir.join(PROVENANCE_FILE));
     written.push(emit(dir, "index.html", |b| {
         let results = Results {
             paper: &paper,
@@ -446,6 +462,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             furnace: &furnace,
             costs: &costs,
             sims: &sims,
+            provenance: &provenance,
         };
         write_index(b, dir, &written, &results)?;
         // Numbers in the page's text never break at their minus sign (U+2212 instead of -).

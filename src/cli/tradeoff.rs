@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 
-use super::output::{print_json, write_atomic, write_chart};
+use super::output::{print_json, write_atomic, write_chart, write_provenance};
 use super::Outcome;
 use specfx::analysis::tradeoff::{
     f64_figures, f64_methods, fixed_config, fixed_figures, fixed_minimax_config, powi_figures,
@@ -16,6 +16,7 @@ use specfx::analysis::tradeoff::{
 use specfx::hdl::cost::Target;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
+use specfx::provenance::{canonical_nset, Inputs, Provenance};
 use specfx::report::tradeoff::{cost_chart, per_n_chart, speed_chart, CostAxis};
 
 /// Arguments of `specfx tradeoff`.
@@ -24,6 +25,9 @@ pub struct TradeoffArgs {
     /// Output directory.
     #[arg(long, default_value = "specfx-tradeoff")]
     out: PathBuf,
+    /// Replace an existing output directory that is not an earlier result of this command.
+    #[arg(long)]
+    force: bool,
     /// Exponents.
     #[arg(long, default_value = "16..=1024")]
     n: NSet,
@@ -151,12 +155,19 @@ pub fn tradeoff(
             ],
         ),
     )?;
+    let mut inputs = Inputs::new("tradeoff").option("n", canonical_nset(ns));
+    if let Some(target) = yosys {
+        inputs = inputs.option("yosys", target.name());
+    }
+    write_provenance(dir, &Provenance::new(&inputs))?;
     Ok(figures)
 }
 
 /// Runs `specfx tradeoff`.
 pub fn run(args: &TradeoffArgs) -> Result<Outcome> {
-    let figures = tradeoff(&args.out, &args.n, args.yosys)?;
+    let out_dir = super::output::OutDir::begin(&args.out, "tradeoff", args.force)?;
+    let figures = tradeoff(out_dir.path(), &args.n, args.yosys)?;
+    out_dir.commit()?;
     if args.json {
         print_json(&figures)?;
     } else {
