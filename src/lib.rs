@@ -26,6 +26,7 @@ pub mod hdl;
 mod names;
 pub mod nset;
 pub mod pipeline;
+pub mod provenance;
 pub mod reference;
 pub mod report;
 pub mod scene;

@@ -212,5 +212,36 @@ fn report_writes_its_files_and_a_summary() {
         .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
         .collect();
     assert!(leftovers.is_empty());
+    // Every part records the version and the sha256 of its canonical inputs (checked here
+    // with sha2); the index page ends with the report's own.
+    use sha2::{Digest, Sha256};
+    for (sub, command) in [
+        (".", "report"),
+        ("budget_baseline", "budget"),
+        ("tradeoff", "tradeoff"),
+        ("stability", "stability"),
+        ("render", "render"),
+        ("fit", "fit"),
+        ("furnace", "furnace"),
+        ("vectors_baseline", "vectors"),
+    ] {
+        let d = dir.join(sub);
+        let p: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.join("provenance.json")).unwrap()).unwrap();
+        let inputs = std::fs::read(d.join("inputs.toml")).unwrap();
+        let hash: String = Sha256::digest(&inputs)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        assert_eq!(p["specfx_version"], env!("CARGO_PKG_VERSION"), "{sub}");
+        assert_eq!(p["command"], command, "{sub}");
+        assert_eq!(p["inputs_sha256"], hash.as_str(), "{sub}");
+        if sub == "." {
+            assert!(
+                index.contains(&hash),
+                "the index page names the report's inputs"
+            );
+        }
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

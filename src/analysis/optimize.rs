@@ -281,6 +281,31 @@ fn cost_value(dp: &Datapath, arch: Arch, metric: Metric) -> f64 {
 }
 
 impl Budget {
+    /// The bounds in one notation, sorted (`shape_total <= 0.00390625`, `luts on ice40 <=
+    /// 800`): the same budget written differently gives the same list.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::analysis::optimize::Budget;
+    /// let a: Budget = "shape_total <= 1 lsb8, correct >= 99%".parse().unwrap();
+    /// let b: Budget = "correct >= 0.99 and shape_total<=0.00390625".parse().unwrap();
+    /// assert_eq!(a.canonical(), ["correct >= 0.99", "shape_total <= 0.00390625"]);
+    /// assert_eq!(a.canonical(), b.canonical());
+    /// ```
+    pub fn canonical(&self) -> Vec<String> {
+        let mut v: Vec<String> = self
+            .bounds
+            .iter()
+            .map(|b| {
+                let op = if b.metric.is_floor() { ">=" } else { "<=" };
+                format!("{} {op} {}", b.metric, b.limit)
+            })
+            .collect();
+        v.sort();
+        v.dedup();
+        v
+    }
+
     /// Whether a bound holds for a value.
     fn holds(b: &Bound, v: f64) -> bool {
         if b.metric.is_floor() {

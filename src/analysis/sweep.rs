@@ -237,6 +237,23 @@ impl Space {
         out
     }
 
+    /// The axis values of point `index` as one label, `key=value` joined by `;` (the
+    /// `values` of its [`PointResult`]).
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::analysis::sweep::Space;
+    /// let s = Space::from_toml("[vary]\nk = [3, 4]\n\"square.rounding\" = [\"TRN\", \"RND\"]\n").unwrap();
+    /// assert_eq!(s.point_label(3), "k=4;square.rounding=RND");
+    /// ```
+    pub fn point_label(&self, index: u64) -> String {
+        self.point_values(index)
+            .iter()
+            .map(|(k, v)| format!("{k}={}", v.to_string().trim_matches('"')))
+            .collect::<Vec<_>>()
+            .join(";")
+    }
+
     /// The configuration and architecture of point `index`.
     pub fn point(&self, index: u64) -> Result<(Config, Arch), Error> {
         let mut cfg = self.base.clone();
@@ -385,12 +402,7 @@ pub struct PointResult {
 
 /// Evaluates point `index` of a space: exhaustive check and analytic cost.
 pub fn evaluate(space: &Space, index: u64) -> PointResult {
-    let values = space
-        .point_values(index)
-        .iter()
-        .map(|(k, v)| format!("{k}={}", v.to_string().trim_matches('"')))
-        .collect::<Vec<_>>()
-        .join(";");
+    let values = space.point_label(index);
     let empty = |invalid: String| PointResult {
         index,
         values: values.clone(),

@@ -10,15 +10,16 @@ use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
 
-use super::output::{print_json, write_atomic, write_chart};
+use super::output::{print_json, write_atomic, write_chart, write_provenance};
 use super::Outcome;
 use specfx::analysis::budget::{analyse, BudgetReport, FormalBound};
 use specfx::analysis::gappa;
 use specfx::analysis::optimize::Budget;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
+use specfx::provenance::{Inputs, Provenance};
 use specfx::report::budget::{charts, document};
-use specfx::report::doc::{write_html, write_markdown};
+use specfx::report::doc::{write_html, write_markdown, Block};
 use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx budget`.
@@ -199,7 +200,9 @@ pub fn budget(
         let svg = write_chart(dir, &stem, &chart)?;
         svgs.push((stem, svg));
     }
-    let doc = document(&report);
+    let provenance = Provenance::new(&inputs(dp, budget, gappa_n));
+    let mut doc = document(&report);
+    doc.push(Block::Paragraph(provenance.line()));
     let mut md = Vec::new();
     write_markdown(&mut md, &doc)?;
     let mut html = Vec::new();
@@ -218,7 +221,20 @@ pub fn budget(
     write_atomic(&dir.join("budget.md"), &md)?;
     write_atomic(&dir.join("budget.html"), &html)?;
     write_atomic(&dir.join("budget.json"), &json)?;
+    write_provenance(dir, &provenance)?;
     Ok(report)
+}
+
+/// What determines a budget report: the configuration, the budget and gappa's exponents.
+fn inputs(dp: &Datapath, budget: Option<&Budget>, gappa_n: Option<&[u32]>) -> Inputs {
+    let mut inputs = Inputs::new("budget").config(dp.config());
+    if let Some(b) = budget {
+        inputs = inputs.option("budget", b.canonical());
+    }
+    match gappa_n {
+        Some(ns) => inputs.option("gappa_n", ns.to_vec()),
+        None => inputs.option("no_gappa", true),
+    }
 }
 
 /// Runs `specfx budget`. Exit code 1 when the budget is not met.

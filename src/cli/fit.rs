@@ -8,7 +8,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
 
-use super::output::{print_json, write_atomic};
+use super::output::{print_json, write_atomic, write_provenance};
 use super::Outcome;
 use specfx::analysis::optimize::Candidate;
 use specfx::cycle::Arch;
@@ -16,6 +16,7 @@ use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::hdl::rom::{constant_rom, rom_verilog};
 use specfx::nset::NSet;
 use specfx::pipeline::{Config, Datapath};
+use specfx::provenance::{Inputs, Provenance};
 use specfx::report::scene::{heatmap_png, path_png};
 use specfx::report::table::{Align, TextTable};
 use specfx::scene::fit::{
@@ -363,7 +364,24 @@ pub fn fit_scene(scene: &Scene, label: &str, args: &FitArgs) -> Result<Option<Fi
         fitted_cost: side_cost(&fitted, args.target, yosys)?,
         fitted_config: fitted_cfg.to_toml(),
     };
-    write_fit(&args.out, &report, &fitted, &fitted_r, &generic_r)?;
+    let mut inputs = Inputs::new("fit")
+        .table("scene", scene.canonical())
+        .config(generic.config())
+        .option("target", args.target.name())
+        .option("analytic_only", args.analytic_only)
+        .option("start_frac", args.start_frac);
+    if let Some(b) = &args.budget {
+        inputs = inputs.option("budget", b.canonical());
+    }
+    let provenance = Provenance::new(&inputs);
+    write_fit(
+        &args.out,
+        &report,
+        &fitted,
+        &fitted_r,
+        &generic_r,
+        &provenance,
+    )?;
     Ok(Some(report))
 }
 
@@ -374,6 +392,7 @@ fn write_fit(
     fitted: &Datapath,
     fitted_r: &Rendered,
     generic_r: &Rendered,
+    provenance: &Provenance,
 ) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let header = format!(
@@ -385,7 +404,8 @@ fn write_fit(
         format!("{header}{}", r.fitted_config).as_bytes(),
     )?;
     write_atomic(&out.join("fitted_rom.v"), rom_verilog(fitted).as_bytes())?;
-    write_atomic(&out.join("fit.md"), fit_markdown(r).as_bytes())?;
+    let md = format!("{}\n{}\n", fit_markdown(r), provenance.line());
+    write_atomic(&out.join("fit.md"), md.as_bytes())?;
     write_atomic(&out.join("fit.json"), &serde_json::to_vec_pretty(r)?)?;
     write_atomic(
         &out.join("inputs.csv"),
@@ -420,7 +440,7 @@ fn write_fit(
             &heatmap_png(fitted_r, &difference_of(a, b), title)?,
         )?;
     }
-    Ok(())
+    write_provenance(out, provenance)
 }
 
 /// The terminal summary.

@@ -7,13 +7,14 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 
-use super::output::{print_json, write_atomic, write_figure};
+use super::output::{print_json, write_atomic, write_figure, write_provenance};
 use super::Outcome;
 use specfx::analysis::furnace::{
     furnace_with_progress, parse_angles, FurnaceReport, FurnaceSettings, DEFAULT_ANGLES,
 };
 use specfx::nset::NSet;
-use specfx::report::doc::write_markdown;
+use specfx::provenance::{Inputs, Provenance};
+use specfx::report::doc::{write_markdown, Block};
 use specfx::report::furnace::{
     chart_png, chart_stem, chart_svg, document, write_csv, write_summary,
 };
@@ -93,8 +94,16 @@ pub fn write_furnace(
         let png = chart_png(&report, i).map_err(anyhow::Error::msg)?;
         write_figure(out, &chart_stem(f.form), &svg, &png)?;
     }
+    let provenance = Provenance::new(
+        &Inputs::new("furnace")
+            .config(dp.config())
+            .option("n", settings.ns().to_vec())
+            .option("angles", settings.angles_deg().to_vec()),
+    );
+    let mut doc = document(&report);
+    doc.push(Block::Paragraph(provenance.line()));
     let mut md = Vec::new();
-    write_markdown(&mut md, &document(&report))?;
+    write_markdown(&mut md, &doc)?;
     write_atomic(&out.join("furnace.md"), &md)?;
     let mut csv = Vec::new();
     write_csv(&mut csv, &report)?;
@@ -102,5 +111,6 @@ pub fn write_furnace(
     let mut json = serde_json::to_vec_pretty(&report)?;
     json.push(b'\n');
     write_atomic(&out.join("furnace.json"), &json)?;
+    write_provenance(out, &provenance)?;
     Ok(report)
 }

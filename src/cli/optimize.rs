@@ -20,6 +20,7 @@ use specfx::report::table::{Align, TextTable};
 /// The first bytes of the configuration `specfx optimize` writes: a file that begins with
 /// them is an earlier result, replaced without `--force`.
 const OUT_HEADER: &str = "# specfx optimize:";
+use specfx::provenance::{canonical_nset, Inputs, Provenance};
 
 /// Arguments of `specfx optimize`.
 #[derive(Debug, Args)]
@@ -302,9 +303,28 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         proof.out_max_ulp,
         100.0 * proof.stages[dp.stage_out()].correctly_rounded
     );
+    let mut variant_names: Vec<&str> = variants.iter().map(|v| v.name()).collect();
+    variant_names.sort_unstable();
+    variant_names.dedup();
+    let provenance = Provenance::new(
+        &Inputs::new("optimize")
+            .config(&base)
+            .option("budget", args.budget.canonical())
+            .option("objective", args.objective.as_str())
+            .option("target", target.name())
+            .option("k", canonical_nset(&args.k))
+            .option("variants", variant_names)
+            .option("start_frac", args.start_frac)
+            .option("arch", arch.to_string()),
+    );
     write_atomic(
         &args.out,
-        format!("{header}{}", config.to_toml()).as_bytes(),
+        format!(
+            "{header}{}{}",
+            provenance_comment(&provenance),
+            config.to_toml()
+        )
+        .as_bytes(),
     )?;
     super::output::outln!(
         "best: k = {}, {}, t {} b {} squares {} out {}: {:.0} {unit} ({})",
@@ -382,4 +402,20 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     }
     super::output::outln!("written to {}", args.out.display())?;
     Ok(Outcome::Ok)
+}
+
+/// The provenance of a configuration file as TOML comments: the line documents end with, then
+/// the canonical inputs, each line behind `#| ` (the hash is of those lines without the
+/// prefix, each ending in a newline: `grep '^#|' FILE | cut -c4- | sha256sum`).
+fn provenance_comment(p: &Provenance) -> String {
+    let mut s = format!(
+        "# specfx {} · specfx {} · inputs sha256 {}: the canonical inputs, on the lines starting with '#|'\n",
+        p.specfx_version, p.command, p.inputs_sha256
+    );
+    for line in p.canonical.lines() {
+        s.push_str(if line.is_empty() { "#|" } else { "#| " });
+        s.push_str(line);
+        s.push('\n');
+    }
+    s
 }

@@ -421,3 +421,12 @@ pub fn inputs(config: &str, scene: Option<&Path>) -> Vec<(&'static str, PathBuf)
 pub fn config_inputs_as(flag: &'static str, arg: &str) -> Vec<(&'static str, PathBuf)> {
     config_input(arg).into_iter().map(|p| (flag, p)).collect()
 }
+
+/// Writes what determined a result into its directory: `inputs.toml` (the canonical inputs)
+/// and `provenance.json` (the specfx version, the command and the inputs' sha256). Every
+/// command that writes a result directory calls it (`specfx::provenance`).
+pub fn write_provenance(dir: &Path, p: &specfx::provenance::Provenance) -> Result<()> {
+    use specfx::provenance::{INPUTS_FILE, PROVENANCE_FILE};
+    write_atomic(&dir.join(INPUTS_FILE), p.canonical.as_bytes())?;
+    write_atomic(&dir.join(PROVENANCE_FILE), p.json().as_bytes())
+}

@@ -6,10 +6,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 
-use super::output::{print_json, write_atomic};
+use super::output::{print_json, write_atomic, write_provenance};
 use super::Outcome;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
+use specfx::provenance::{Inputs, Provenance};
 use specfx::report::scene::{
     flip_png, heatmap_png, path_png, table_markdown, write_inputs_csv, write_table, MaterialRow,
 };
@@ -144,17 +145,24 @@ pub fn render_scene(
         &flip_png(&r, &flip_quant, "vs f64 model")?,
     )?;
     let table = table_markdown(&rows, r.bits);
-    let md = format!(
+    let provenance = Provenance::new(
+        &Inputs::new("render")
+            .table("scene", scene.canonical())
+            .config(dp.config()),
+    );
+    let mut md = format!(
         "# Render of {} through {}\n\nImages: `f64_cos_n.png` (f64 cos^n, classic coefficient), `f64_model.png` (the f64 model of the datapath's algorithm and coefficient), `datapath.png` (bit-accurate, the fragment's cosine quantized to {}); differences in display LSBs `diff_vs_cos_n.png`, `diff_vs_f64_model.png`, and FLIP maps `flip_vs_cos_n.png`, `flip_vs_f64_model.png`.\n\n\"vs cos^n\" is the total error the viewer sees: the approximation of cos^n by the datapath's algorithm (large near highlights of high n) plus its quantization; \"vs f64 model\" is the quantization alone.\n\n{table}",
         specfx::report::doc::md_escape(label),
         dp.config().name,
         dp.config().c.format,
     );
+    md.push_str(&format!("\n{}\n", provenance.line()));
     write_atomic(&out.join("render.md"), md.as_bytes())?;
     let json = serde_json::to_vec_pretty(&rows)?;
     write_atomic(&out.join("render.json"), &json)?;
     let csv = inputs_csv(&r.inputs, dp.config().c.format.lsb());
     write_atomic(&out.join("inputs.csv"), csv.as_bytes())?;
+    write_provenance(out, &provenance)?;
     Ok((rows, table))
 }
 

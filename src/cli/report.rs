@@ -10,6 +10,7 @@ use super::output::write_atomic;
 use super::Outcome;
 use specfx::analysis::methods::{max_errors, report_methods};
 use specfx::analysis::paper::reproduce;
+use specfx::provenance::{INPUTS_FILE, PROVENANCE_FILE};
 use specfx::report::csv::{write_coefficients, write_method_errors};
 use specfx::report::paper::write_paper_table;
 use specfx::report::table::{Align, TextTable};
@@ -51,6 +52,7 @@ struct Results<'a> {
     furnace: &'a specfx::analysis::furnace::FurnaceReport,
     costs: &'a [super::cost::CostReport],
     sims: &'a [specfx::cycle::sim::SimStats],
+    provenance: &'a specfx::provenance::Provenance,
 }
 
 /// A self-contained index page linking (and showing) everything the report wrote.
@@ -71,6 +73,7 @@ fn write_index(
         furnace,
         costs,
         sims,
+        provenance,
     } = *results;
     let rel = |p: &PathBuf| {
         p.strip_prefix(dir)
@@ -220,7 +223,13 @@ fn write_index(
         let r = rel(f);
         writeln!(w, "<li><a href=\"{r}\">{r}</a></li>")?;
     }
-    writeln!(w, "</ul></body></html>")
+    writeln!(w, "</ul>")?;
+    writeln!(
+        w,
+        "<p>specfx {} · <code>specfx {}</code> · inputs sha256 <code>{}</code> (<a href=\"{INPUTS_FILE}\">{INPUTS_FILE}</a>, <a href=\"{PROVENANCE_FILE}\">{PROVENANCE_FILE}</a>; each part's directory holds its own)</p>",
+        provenance.specfx_version, provenance.command, provenance.inputs_sha256
+    )?;
+    writeln!(w, "</body></html>")
 }
 
 /// The report's steps: a line each on stderr, a bar over them on a terminal (a line every
@@ -489,6 +498,13 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     }
 
     steps.finish();
+    // Everything the report computes is built in: its inputs are the command alone (and the
+    // version, which fixes the built-in configurations, scene and settings).
+    let provenance =
+        specfx::provenance::Provenance::new(&specfx::provenance::Inputs::new("report"));
+    super::output::write_provenance(dir, &provenance)?;
+    written.push(dir.join(INPUTS_FILE));
+    written.push(dir.join(PROVENANCE_FILE));
     written.push(emit(dir, "index.html", |b| {
         let results = Results {
             paper: &paper,
@@ -501,6 +517,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             furnace: &furnace,
             costs: &costs,
             sims: &sims,
+            provenance: &provenance,
         };
         write_index(b, dir, &written, &results)?;
         // Numbers in the page's text never break at their minus sign (U+2212 instead of -).

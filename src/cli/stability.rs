@@ -7,13 +7,14 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 
-use super::output::{print_json, write_atomic, write_chart, write_figure};
+use super::output::{print_json, write_atomic, write_chart, write_figure, write_provenance};
 use super::Outcome;
 use specfx::analysis::stability::{
     analyse, default_paths, FloatPath, Grid, Path as MapPath, StabilityReport, Tolerance,
 };
 use specfx::nset::NSet;
-use specfx::report::doc::{write_html, write_markdown};
+use specfx::provenance::{canonical_nset, Inputs, Provenance};
+use specfx::report::doc::{write_html, write_markdown, Block};
 use specfx::report::stability::{
     document, heatmap_png, heatmap_stem, heatmap_svg, overshoot_chart, overview_png, overview_svg,
     write_overshoot_csv, write_regions_csv, write_special_csv,
@@ -163,7 +164,9 @@ pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<Stability
     buf.clear();
     write_overshoot_csv(&mut buf, &report)?;
     write_atomic(&dir.join("overshoot.csv"), &buf)?;
-    let doc = document(&report);
+    let provenance = Provenance::new(&inputs(paths, grid));
+    let mut doc = document(&report);
+    doc.push(Block::Paragraph(provenance.line()));
     buf.clear();
     write_markdown(&mut buf, &doc)?;
     write_atomic(&dir.join("stability.md"), &buf)?;
@@ -177,7 +180,31 @@ pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<Stability
     let mut json = serde_json::to_vec_pretty(&report)?;
     json.push(b'\n');
     write_atomic(&dir.join("stability.json"), &json)?;
+    write_provenance(dir, &provenance)?;
     Ok(report)
+}
+
+/// What determines a stability map: its paths (float paths by name, datapaths by their
+/// configuration), the exponents, the sampling of c and the tolerance.
+fn inputs(paths: &[MapPath], grid: &Grid) -> Inputs {
+    let floats: Vec<String> = paths
+        .iter()
+        .filter_map(|p| match p {
+            MapPath::Float(f) => Some(f.name().to_string()),
+            MapPath::Fixed(_) => None,
+        })
+        .collect();
+    let mut inputs = Inputs::new("stability")
+        .option("float", floats)
+        .option("n", canonical_nset(&grid.n))
+        .option("c_bits", grid.c_bits)
+        .option("tol", grid.tol.value);
+    for p in paths {
+        if let MapPath::Fixed(config) = p {
+            inputs = inputs.config(config);
+        }
+    }
+    inputs
 }
 
 /// Runs `specfx stability`.

@@ -3,15 +3,16 @@
 use std::collections::BTreeMap;
 use std::fs::{self, OpenOptions};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use serde::{Deserialize, Serialize};
 
-use super::output::write_atomic;
+use super::output::OutDir;
 use super::Outcome;
 use specfx::analysis::sweep::{evaluate, mark_pareto, parse_shard, PointResult, Space};
+use specfx::provenance::{sha256_hex, Inputs, Provenance, INPUTS_FILE, PROVENANCE_FILE};
 
 /// Arguments of `specfx sweep`.
 #[derive(Debug, Args)]
@@ -23,7 +24,7 @@ pub struct SweepArgs {
     /// built-in space: baseline with k = 3..5, squarings of 10..=18 fraction bits, TRN or RND.
     #[arg(long)]
     space: Option<PathBuf>,
-    /// Output directory; an unfinished sweep there is resumed.
+    /// Output directory; an unfinished sweep of the same space and shard there is resumed.
     #[arg(long, default_value = "specfx-sweep")]
     out: PathBuf,
     /// Evaluate only the points whose index is I modulo N (written I/N).
@@ -39,10 +40,13 @@ pub struct SweepArgs {
 enum SweepCommand {
     /// Joins the shards of one sweep into a complete one.
     Merge {
-        /// Output directory of the merged sweep.
+        /// Output directory of the merged sweep (never one of the shards, nor inside one).
         #[arg(long)]
         out: PathBuf,
-        /// The shard directories.
+        /// Replace an existing directory that is not an earlier merge of the same sweep.
+        #[arg(long)]
+        force: bool,
+        /// The shard directories: every shard of one sweep, each once.
         #[arg(required = true)]
         shards: Vec<PathBuf>,
     },
@@ -52,16 +56,223 @@ enum SweepCommand {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct SweepInfo {
     specfx_version: String,
+    /// The sweep's identity, shared by all its shards: the sha256 of the canonical space and
+    /// the number of shards ([`sweep_sha256`]).
+    sweep_sha256: String,
     space: Space,
     shard_index: u64,
     shard_count: u64,
     n_points: u64,
 }
 
+/// The identity of a sweep: the sha256 of the canonical text of its space and shard count, so
+/// the same space written differently is the same sweep, and a shard of another space or of
+/// another sharding is not.
+fn sweep_sha256(space: &Space, shard_count: u64) -> String {
+    let inputs = Inputs::new("sweep")
+        .space(space)
+        .option("shard_count", shard_count.to_string());
+    sha256_hex(inputs.canonical().as_bytes())
+}
+
+/// Whether two spaces are the same, however they were written.
+fn same_space(a: &Space, b: &Space) -> bool {
+    sweep_sha256(a, 1) == sweep_sha256(b, 1)
+}
+
+impl SweepInfo {
+    fn new(space: Space, shard_index: u64, shard_count: u64) -> SweepInfo {
+        SweepInfo {
+            specfx_version: specfx::provenance::VERSION.to_string(),
+            sweep_sha256: sweep_sha256(&space, shard_count),
+            n_points: space.n_points(),
+            space,
+            shard_index,
+            shard_count,
+        }
+    }
+
+    /// `I/N`.
+    fn shard(&self) -> String {
+        format!("{}/{}", self.shard_index, self.shard_count)
+    }
+
+    /// Whether point `index` belongs to this shard.
+    fn holds(&self, index: u64) -> bool {
+        index < self.n_points && index % self.shard_count == self.shard_index
+    }
+
+    /// The number of points of this shard.
+    fn shard_points(&self) -> u64 {
+        let (n, i, c) = (self.n_points, self.shard_index, self.shard_count);
+        if i >= n {
+            0
+        } else {
+            (n - 1 - i) / c + 1
+        }
+    }
+
+    fn json(&self) -> Result<Vec<u8>> {
+        let mut json = serde_json::to_vec_pretty(self)?;
+        json.push(b'\n');
+        Ok(json)
+    }
+}
+
+/// Reads and checks a sweep directory's `space.json`: written by this specfx version, its
+/// identity matching its space, its shard within its count.
+fn read_info(dir: &Path) -> Result<SweepInfo> {
+    let path = dir.join("space.json");
+    if !path.exists() && !path.is_symlink() {
+        bail!("{}: not a sweep directory (no space.json)", dir.display());
+    }
+    let text = super::input::read_text(&path, &path.display().to_string())?;
+    let info: SweepInfo = serde_json::from_str(&text).with_context(|| {
+        format!(
+            "{}: not a sweep directory of specfx {} (space.json)",
+            dir.display(),
+            specfx::provenance::VERSION
+        )
+    })?;
+    if info.specfx_version != specfx::provenance::VERSION {
+        bail!(
+            "{}: written by specfx {}, this is {}: finish and merge it with specfx {}, or sweep again",
+            dir.display(),
+            info.specfx_version,
+            specfx::provenance::VERSION,
+            info.specfx_version
+        );
+    }
+    if info.shard_count == 0
+        || info.shard_index >= info.shard_count
+        || info.n_points != info.space.n_points()
+        || info.sweep_sha256 != sweep_sha256(&info.space, info.shard_count)
+    {
+        bail!(
+            "{}: space.json does not match itself (its sweep_sha256, shard or number of points was changed)",
+            path.display()
+        );
+    }
+    Ok(info)
+}
+
+/// How a points log is read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LogUse {
+    /// By the sweep that writes it: unreadable lines (a torn last line, an interrupted
+    /// write) are dropped and computed again, and the log rewritten without them.
+    Resume,
+    /// By `sweep merge`, which never writes to its inputs: an unreadable line is an error,
+    /// except a torn last line, which only makes the shard incomplete.
+    Merge,
+}
+
+/// The largest points log read (about 600 bytes a point, at most 2^20 points).
+const MAX_LOG_BYTES: u64 = 1 << 30;
+
+/// The points of a sweep directory's `points.jsonl`, each checked to belong to the sweep and
+/// shard of `info` (its index in the shard, its axis values those of the space).
+fn read_log(dir: &Path, info: &SweepInfo, how: LogUse) -> Result<BTreeMap<u64, PointResult>> {
+    let path = dir.join("points.jsonl");
+    let mut map = BTreeMap::new();
+    if !path.exists() && !path.is_symlink() {
+        return Ok(map);
+    }
+    let bytes = super::input::read_bytes(&path, &path.display().to_string(), MAX_LOG_BYTES)?;
+    let text = String::from_utf8_lossy(&bytes);
+    let mut good = String::new();
+    let lines: Vec<&str> = text.split_inclusive('\n').collect();
+    for (i, raw) in lines.iter().enumerate() {
+        let line = raw.trim_end_matches('\n');
+        let at = || format!("{} line {}", path.display(), i + 1);
+        let Ok(p) = serde_json::from_str::<PointResult>(line) else {
+            let torn = i + 1 == lines.len() && !raw.ends_with('\n');
+            if how == LogUse::Merge && !torn {
+                bail!(
+                    "{}: not a point record (expected one JSON object a line)",
+                    at()
+                );
+            }
+            continue;
+        };
+        if p.index >= info.n_points {
+            bail!(
+                "{}: point {} is outside the space ({} points): not a point of this sweep",
+                at(),
+                p.index,
+                info.n_points
+            );
+        }
+        if !info.holds(p.index) {
+            bail!(
+                "{}: point {} belongs to shard {}/{}, not to this directory's shard {}",
+                at(),
+                p.index,
+                p.index % info.shard_count,
+                info.shard_count,
+                info.shard()
+            );
+        }
+        let label = info.space.point_label(p.index);
+        if p.values != label {
+            bail!(
+                "{}: point {} is '{}' there but '{label}' in the space: not a point of this sweep",
+                at(),
+                p.index,
+                p.values
+            );
+        }
+        match map.get(&p.index) {
+            Some(q) if *q != p => bail!(
+                "{}: point {} is recorded twice with different figures",
+                at(),
+                p.index
+            ),
+            Some(_) => continue,
+            None => {}
+        }
+        good.push_str(line);
+        good.push('\n');
+        map.insert(p.index, p);
+    }
+    if how == LogUse::Resume && good.len() != text.len() {
+        write_files(dir, dir, &[("points.jsonl".to_string(), good.into_bytes())])?;
+    }
+    Ok(map)
+}
+
+/// Writes files into `dir` all or nothing: each under a temporary name first, then all
+/// renamed; on an error the temporary files are removed and the earlier files stay as they
+/// were. Errors name the files as in `shown` (the final directory of a staged one).
+fn write_files(dir: &Path, shown: &Path, files: &[(String, Vec<u8>)]) -> Result<()> {
+    let tmp = |name: &str| dir.join(format!(".{name}.partial-{}", std::process::id()));
+    let mut made = Vec::new();
+    let result = (|| -> Result<()> {
+        for (name, bytes) in files {
+            let t = tmp(name);
+            let _ = fs::remove_file(&t);
+            made.push(t.clone());
+            fs::write(&t, bytes)
+                .with_context(|| format!("cannot write {}", shown.join(name).display()))?;
+        }
+        for (name, _) in files {
+            fs::rename(tmp(name), dir.join(name))
+                .with_context(|| format!("cannot write {}", shown.join(name).display()))?;
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        for t in made {
+            let _ = fs::remove_file(t);
+        }
+    }
+    result
+}
+
 /// Runs `specfx sweep ...`.
 pub fn run(args: &SweepArgs) -> Result<Outcome> {
-    if let Some(SweepCommand::Merge { out, shards }) = &args.command {
-        return merge(out, shards);
+    if let Some(SweepCommand::Merge { out, force, shards }) = &args.command {
+        return merge(out, shards, *force);
     }
     let space = match &args.space {
         None => Space::builtin(),
@@ -72,39 +283,58 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
         }
     };
     let (shard_index, shard_count) = args.shard.unwrap_or((0, 1));
-    let info = SweepInfo {
-        specfx_version: env!("CARGO_PKG_VERSION").to_string(),
-        n_points: space.n_points(),
-        space,
-        shard_index,
-        shard_count,
-    };
-    let dir = &args.out;
-    let info_path = dir.join("space.json");
-    if info_path.exists() {
-        let old: SweepInfo = serde_json::from_str(&fs::read_to_string(&info_path)?)
-            .with_context(|| format!("{}: not a sweep directory", dir.display()))?;
-        if old.space != info.space
-            || (old.shard_index, old.shard_count) != (shard_index, shard_count)
-        {
+    let target = space.target;
+    if let Some(named) = &args.yosys {
+        if named != "space" && named.parse::<specfx::hdl::cost::Target>()? != target {
             bail!(
-                "{} holds another sweep (a different space or shard): choose another --out",
+                "--yosys {named}: the space is priced on {target}; set target = \"{named}\" in the space file to synthesise on {named}"
+            );
+        }
+    }
+    let info = SweepInfo::new(space, shard_index, shard_count);
+    let dir = &args.out;
+    if dir.join("space.json").exists() || dir.join("space.json").is_symlink() {
+        let old = read_info(dir)?;
+        if old.sweep_sha256 != info.sweep_sha256 || old.shard_index != shard_index {
+            let what = if !same_space(&old.space, &info.space) {
+                "another design space".to_string()
+            } else {
+                format!("shard {}, not {}", old.shard(), info.shard())
+            };
+            bail!(
+                "{} holds another sweep ({what}): choose another --out",
                 dir.display()
             );
         }
     } else {
-        fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        let mut json = serde_json::to_vec_pretty(&info)?;
-        json.push(b'\n');
-        write_atomic(&info_path, &json)?;
+        // A new sweep directory is staged and renamed: it appears with its space.json, or not.
+        let non_empty = fs::read_dir(dir).is_ok_and(|mut d| d.next().is_some());
+        if non_empty {
+            bail!(
+                "{} exists and is not a sweep directory (no space.json): choose another --out",
+                dir.display()
+            );
+        }
+        if dir.exists() && !dir.is_dir() {
+            bail!(
+                "{}: exists and is not a directory (pass another --out)",
+                dir.display()
+            );
+        }
+        let staged = OutDir::begin(dir, "sweep", false, &[])?;
+        write_files(
+            staged.path(),
+            dir,
+            &[("space.json".to_string(), info.json()?)],
+        )?;
+        staged.commit()?;
     }
-    let mut done = read_points(&dir.join("points.jsonl"))?;
+    let log_path = dir.join("points.jsonl");
+    let mut done = read_log(dir, &info, LogUse::Resume)?;
     let todo: Vec<u64> = (0..info.n_points)
-        .filter(|i| i % shard_count == shard_index && !done.contains_key(i))
+        .filter(|&i| info.holds(i) && !done.contains_key(&i))
         .collect();
-    let total = (0..info.n_points)
-        .filter(|i| i % shard_count == shard_index)
-        .count();
+    let total = info.shard_points() as usize;
     log::info!(
         "sweep: {} points in the space, {total} in this shard, {} already done",
         info.n_points,
@@ -112,34 +342,35 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
     );
     let bar = super::progress::Progress::new("sweep", "points", total as u64)
         .resumed_at((total - todo.len()) as u64);
+    let cannot_write = || format!("cannot write {}", log_path.display());
     let mut log = OpenOptions::new()
         .create(true)
         .append(true)
-        .open(dir.join("points.jsonl"))
-        .with_context(|| format!("cannot open {}", dir.join("points.jsonl").display()))?;
+        .open(&log_path)
+        .with_context(cannot_write)?;
     for &index in &todo {
         let p = evaluate(&info.space, index);
         let mut line = serde_json::to_string(&p)?;
         line.push('\n');
-        log.write_all(line.as_bytes())?;
-        log.flush()?;
+        log.write_all(line.as_bytes())
+            .and_then(|()| log.flush())
+            .with_context(cannot_write)?;
         log::debug!("sweep: point {index} done: {}", p.values);
         bar.inc(1);
         done.insert(index, p);
     }
     bar.finish();
+    log.sync_all().with_context(cannot_write)?;
     let mut points: Vec<PointResult> = done.into_values().collect();
     specfx::analysis::sweep::mark_pareto(&mut points);
-    if let Some(named) = &args.yosys {
-        let target = info.space.target;
-        if named != "space" && named.parse::<specfx::hdl::cost::Target>()? != target {
-            bail!(
-                "--yosys {named}: the space is priced on {target}; set target = \"{named}\" in the space file to synthesise on {named}"
-            );
-        }
+    let mut inputs = Inputs::new("sweep")
+        .space(&info.space)
+        .option("shard", info.shard());
+    if args.yosys.is_some() {
         synthesise_front(&info.space, &mut points, target, dir)?;
+        inputs = inputs.option("yosys", target.name());
     }
-    write_results(dir, &mut points, info.space.target)?;
+    write_results(dir, dir, &mut points, target, &Provenance::new(&inputs))?;
     super::output::outln!(
         "sweep: {} points in {} ({} on the Pareto front)",
         points.len(),
@@ -165,8 +396,12 @@ fn synthesise_front(
         dsps: u64,
     }
     let path = dir.join(format!("yosys-{target}.jsonl"));
-    let mut known: BTreeMap<u64, Synth> = fs::read_to_string(&path)
-        .unwrap_or_default()
+    let text = if path.exists() || path.is_symlink() {
+        super::input::read_text(&path, &path.display().to_string())?
+    } else {
+        String::new()
+    };
+    let mut known: BTreeMap<u64, Synth> = text
         .lines()
         .filter_map(|l| serde_json::from_str::<Synth>(l).ok())
         .map(|s| (s.index, s))
@@ -192,8 +427,9 @@ fn synthesise_front(
             OpenOptions::new()
                 .create(true)
                 .append(true)
-                .open(&path)?
-                .write_all(line.as_bytes())?;
+                .open(&path)
+                .and_then(|mut f| f.write_all(line.as_bytes()))
+                .with_context(|| format!("cannot write {}", path.display()))?;
             slot.insert(s);
         }
         let s = &known[&p.index];
@@ -204,98 +440,214 @@ fn synthesise_front(
     Ok(())
 }
 
-/// The points recorded so far; a torn last line (an interrupted write) is dropped and will be
-/// computed again.
-fn read_points(path: &Path) -> Result<BTreeMap<u64, PointResult>> {
-    let mut map = BTreeMap::new();
-    let Ok(text) = fs::read_to_string(path) else {
-        return Ok(map);
-    };
-    let mut good = String::new();
-    for line in text.lines() {
-        if let Ok(p) = serde_json::from_str::<PointResult>(line) {
-            good.push_str(line);
-            good.push('\n');
-            map.insert(p.index, p);
-        }
-    }
-    if good.len() != text.len() {
-        write_atomic(path, good.as_bytes())?;
-    }
-    Ok(map)
-}
-
+/// Writes the sweep's results into `dir` (named `shown` in errors) all or nothing: CSV,
+/// JSON, the chart, and what determined them (`inputs.toml`, `provenance.json`).
 fn write_results(
     dir: &Path,
+    shown: &Path,
     points: &mut [PointResult],
     target: specfx::hdl::cost::Target,
+    provenance: &Provenance,
 ) -> Result<()> {
     mark_pareto(points);
     let mut csv = Vec::new();
     specfx::report::sweep::write_csv(&mut csv, points, target)?;
-    write_atomic(&dir.join("sweep.csv"), &csv)?;
     let mut json = serde_json::to_vec_pretty(&points)?;
     json.push(b'\n');
-    write_atomic(&dir.join("sweep.json"), &json)?;
     let chart = specfx::report::sweep::chart(points, target);
     let svg = specfx::report::chart::render_svg(&chart).map_err(anyhow::Error::msg)?;
-    write_atomic(&dir.join("sweep.svg"), svg.as_bytes())?;
     let png = specfx::report::chart::render_png(&chart).map_err(anyhow::Error::msg)?;
-    write_atomic(&dir.join("sweep.png"), &png)?;
-    Ok(())
+    write_files(
+        dir,
+        shown,
+        &[
+            ("sweep.csv".to_string(), csv),
+            ("sweep.json".to_string(), json),
+            ("sweep.svg".to_string(), svg.into_bytes()),
+            ("sweep.png".to_string(), png),
+            (
+                INPUTS_FILE.to_string(),
+                provenance.canonical.clone().into_bytes(),
+            ),
+            (PROVENANCE_FILE.to_string(), provenance.json().into_bytes()),
+        ],
+    )
 }
 
-fn merge(out: &Path, shards: &[PathBuf]) -> Result<Outcome> {
-    let mut info: Option<SweepInfo> = None;
-    let mut points = BTreeMap::new();
+/// A path made absolute with every symbolic link resolved, also when its last components do
+/// not exist yet (they are appended to the canonical form of the longest existing prefix).
+fn resolved(path: &Path) -> Result<PathBuf> {
+    let abs = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .context("cannot read the current directory")?
+            .join(path)
+    };
+    let mut existing = abs.as_path();
+    let mut rest: Vec<Component<'_>> = Vec::new();
+    loop {
+        if let Ok(c) = existing.canonicalize() {
+            let mut out = c;
+            for comp in rest.iter().rev() {
+                match comp {
+                    Component::ParentDir => {
+                        out.pop();
+                    }
+                    Component::CurDir => {}
+                    other => out.push(other.as_os_str()),
+                }
+            }
+            return Ok(out);
+        }
+        match (existing.parent(), existing.components().next_back()) {
+            (Some(parent), Some(last)) => {
+                rest.push(last);
+                existing = parent;
+            }
+            _ => return Ok(abs),
+        }
+    }
+}
+
+/// Whether `out` is an earlier merge of the sweep `sweep` (which a merge may replace).
+fn earlier_merge_of(out: &Path, sweep: &str) -> bool {
+    let marker = fs::read_to_string(out.join(super::output::MARKER)).unwrap_or_default();
+    marker.split_whitespace().next() == Some(MERGE_MARKER)
+        && read_info(out).is_ok_and(|i| i.sweep_sha256 == sweep)
+}
+
+/// The marker of a merged sweep directory.
+const MERGE_MARKER: &str = "sweep-merge";
+
+fn merge(out: &Path, shards: &[PathBuf], force: bool) -> Result<Outcome> {
+    // Every shard's identity first, then every point, then the output: nothing is written
+    // until the inputs are known to form one complete sweep.
+    let mut seen: Vec<(PathBuf, &PathBuf, SweepInfo)> = Vec::new();
     for dir in shards {
-        let path = dir.join("space.json");
-        let this: SweepInfo = serde_json::from_str(
-            &fs::read_to_string(&path)
-                .with_context(|| format!("cannot read {}", path.display()))?,
-        )
-        .with_context(|| format!("{}: not a sweep directory", dir.display()))?;
-        if let Some(first) = &info {
-            if first.space != this.space {
+        let info = read_info(dir)?;
+        let real = resolved(dir)?;
+        for (other_real, other, other_info) in &seen {
+            if *other_real == real {
                 bail!(
-                    "{}: a shard of another sweep (its space differs)",
+                    "{} and {} are the same directory: pass each shard once",
+                    other.display(),
                     dir.display()
                 );
             }
-        } else {
-            info = Some(this.clone());
+            if !same_space(&other_info.space, &info.space) {
+                bail!(
+                    "{}: a shard of another sweep (its design space differs from {}'s)",
+                    dir.display(),
+                    other.display()
+                );
+            }
+            if other_info.sweep_sha256 != info.sweep_sha256 {
+                bail!(
+                    "{}: shard {} of a sweep in {} shards, but {} is shard {}: shards of one sweep share their count",
+                    dir.display(),
+                    info.shard(),
+                    info.shard_count,
+                    other.display(),
+                    other_info.shard()
+                );
+            }
+            if other_info.shard_index == info.shard_index {
+                bail!(
+                    "{} and {} are both shard {}: pass each shard once",
+                    other.display(),
+                    dir.display(),
+                    info.shard()
+                );
+            }
         }
-        points.extend(read_points(&dir.join("points.jsonl"))?);
+        seen.push((real, dir, info));
     }
-    let info = info.expect("at least one shard");
-    let missing = (0..info.n_points)
-        .filter(|i| !points.contains_key(i))
-        .count();
-    if missing > 0 {
+    let first = seen[0].2.clone();
+    let missing: Vec<String> = (0..first.shard_count)
+        .filter(|i| !seen.iter().any(|(_, _, s)| s.shard_index == *i))
+        .take(8)
+        .map(|i| format!("{i}/{}", first.shard_count))
+        .collect();
+    if !missing.is_empty() {
         bail!(
-            "the shards hold {} of {} points: {missing} are missing (run or resume the other shards)",
-            points.len(),
-            info.n_points
+            "the shards given are {} of {}: shard{} {} missing (pass every shard's directory)",
+            seen.len(),
+            first.shard_count,
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", ")
         );
     }
-    fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let target = info.space.target;
-    let merged = SweepInfo {
-        shard_index: 0,
-        shard_count: 1,
-        ..info
-    };
-    let mut json = serde_json::to_vec_pretty(&merged)?;
-    json.push(b'\n');
-    write_atomic(&out.join("space.json"), &json)?;
+    // The output is none of the inputs, inside none, and holds none.
+    let out_real = resolved(out)?;
+    for (real, dir, _) in &seen {
+        if out_real == *real || out_real.starts_with(real) || real.starts_with(&out_real) {
+            let how = if out_real == *real {
+                "is"
+            } else if out_real.starts_with(real) {
+                "is inside"
+            } else {
+                "contains"
+            };
+            bail!(
+                "--out {} {how} the shard {}: merge never writes over its inputs (choose another --out)",
+                out.display(),
+                dir.display()
+            );
+        }
+    }
+    let mut points = BTreeMap::new();
+    for (_, dir, info) in &seen {
+        let mine = read_log(dir, info, LogUse::Merge)?;
+        let expected = info.shard_points();
+        if (mine.len() as u64) < expected {
+            bail!(
+                "{} (shard {}) holds {} of its {expected} points, {} missing: resume it (specfx sweep --shard {} --out {}, with its space)",
+                dir.display(),
+                info.shard(),
+                mine.len(),
+                expected - mine.len() as u64,
+                info.shard(),
+                dir.display()
+            );
+        }
+        points.extend(mine);
+    }
+    let merged = SweepInfo::new(first.space.clone(), 0, 1);
+    let occupied = fs::read_dir(out).is_ok_and(|mut d| d.next().is_some());
+    if occupied && !force && !earlier_merge_of(out, &merged.sweep_sha256) {
+        bail!(
+            "{} already exists and is not an earlier merge of this sweep: pass --force to replace it",
+            out.display()
+        );
+    }
+    let staged = OutDir::begin(out, MERGE_MARKER, true, &[])?;
+    let target = merged.space.target;
     let mut lines = String::new();
     for p in points.values() {
         lines.push_str(&serde_json::to_string(p)?);
         lines.push('\n');
     }
-    write_atomic(&out.join("points.jsonl"), lines.as_bytes())?;
+    write_files(
+        staged.path(),
+        out,
+        &[
+            ("space.json".to_string(), merged.json()?),
+            ("points.jsonl".to_string(), lines.into_bytes()),
+        ],
+    )?;
     let mut points: Vec<PointResult> = points.into_values().collect();
-    write_results(out, &mut points, target)?;
+    let inputs = Inputs::new("sweep")
+        .space(&merged.space)
+        .option("shard", merged.shard());
+    write_results(
+        staged.path(),
+        out,
+        &mut points,
+        target,
+        &Provenance::new(&inputs),
+    )?;
+    staged.commit()?;
     super::output::outln!(
         "sweep merge: {} points from {} shards into {}",
         points.len(),

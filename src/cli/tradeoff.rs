@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 
-use super::output::{print_json, write_atomic, write_chart};
+use super::output::{print_json, write_atomic, write_chart, write_provenance};
 use super::Outcome;
 use specfx::analysis::tradeoff::{
     f64_figures, f64_methods, fixed_config, fixed_figures, fixed_minimax_config, powi_figures,
@@ -15,6 +15,7 @@ use specfx::analysis::tradeoff::{
 };
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
+use specfx::provenance::{canonical_nset, Inputs, Provenance};
 use specfx::report::tradeoff::{
     cost_chart, per_n_chart, speed_chart, write_csv, write_speed_csv, write_table, CostAxis,
 };
@@ -118,6 +119,11 @@ pub fn tradeoff(
             ],
         ),
     )?;
+    let mut inputs = Inputs::new("tradeoff").option("n", canonical_nset(ns));
+    if let Some(target) = yosys {
+        inputs = inputs.option("yosys", target.name());
+    }
+    write_provenance(dir, &Provenance::new(&inputs))?;
     Ok(figures)
 }
 

@@ -121,6 +121,15 @@ pub fn open(path: &Path) -> Result<VectorDir> {
     let mut files: BTreeSet<String> = ports.iter().map(|p| p.file_name()).collect();
     files.insert("vectors.csv".to_string());
     let listed: BTreeSet<String> = m.sha256.keys().cloned().collect();
+    // The record of what produced the vectors, verified like the rest when listed.
+    for record in [
+        specfx::provenance::INPUTS_FILE,
+        specfx::provenance::PROVENANCE_FILE,
+    ] {
+        if listed.contains(record) {
+            files.insert(record.to_string());
+        }
+    }
     if let Some(missing) = files.difference(&listed).next() {
         bail!("{name}: key 'sha256': no hash for {missing}");
     }

@@ -15,6 +15,7 @@ use specfx::golden::{
 };
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
+use specfx::provenance::{sha256_hex, Inputs, Provenance, INPUTS_FILE, PROVENANCE_FILE};
 
 /// Arguments of `specfx vectors`.
 #[derive(Debug, Args)]
@@ -127,6 +128,25 @@ pub fn write_dir(
         let (digest, mut w) = writer.finish();
         w.flush()?;
         sha256.insert(port.file_name(), digest);
+    }
+    // What determined the vectors (corner cases are always included, named or not).
+    let canonical_cases = CaseSelection {
+        corner: true,
+        ..*selection
+    };
+    let provenance = Provenance::new(
+        &Inputs::new("vectors")
+            .config(dp.config())
+            .option("cases", canonical_cases.to_string())
+            .option("order", order.to_string())
+            .option("seed", seed.to_string()),
+    );
+    super::output::write_provenance(&partial, &provenance)?;
+    for (name, text) in [
+        (INPUTS_FILE, provenance.canonical.clone()),
+        (PROVENANCE_FILE, provenance.json()),
+    ] {
+        sha256.insert(name.to_string(), sha256_hex(text.as_bytes()));
     }
     let manifest = Manifest {
         specfx_version: env!("CARGO_PKG_VERSION").to_string(),

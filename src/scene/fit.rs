@@ -148,6 +148,31 @@ impl fmt::Display for ImageBudget {
 }
 
 impl ImageBudget {
+    /// The bounds in one notation, sorted (`differing <= 0.05`, `max_lsb[vessel] <= 4`): the
+    /// same budget written differently gives the same list.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::scene::fit::ImageBudget;
+    /// let a: ImageBudget = "max_lsb <= 8 and differing <= 5%".parse().unwrap();
+    /// let b: ImageBudget = "differing<=0.05, max_lsb <= 8".parse().unwrap();
+    /// assert_eq!(a.canonical(), ["differing <= 0.05", "max_lsb <= 8"]);
+    /// assert_eq!(a.canonical(), b.canonical());
+    /// ```
+    pub fn canonical(&self) -> Vec<String> {
+        let mut v: Vec<String> = self
+            .bounds
+            .iter()
+            .map(|b| match &b.material {
+                Some(m) => format!("{}[{m}] <= {}", b.metric.name(), b.limit),
+                None => format!("{} <= {}", b.metric.name(), b.limit),
+            })
+            .collect();
+        v.sort();
+        v.dedup();
+        v
+    }
+
     /// "No worse than `figures`" for every material: each material's max LSBs, differing share
     /// and FLIP mean as its limits (the default budget of `fit`, with the generic datapath's
     /// figures; limits rounded up to readable figures, which the generic datapath still meets).

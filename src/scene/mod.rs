@@ -9,7 +9,7 @@ pub mod fit;
 pub mod mesh;
 pub mod render;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
 
@@ -176,7 +176,7 @@ impl ObjectFile {
 }
 
 /// Image size and display depth.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Image {
     /// Width in pixels (1..=8192).
@@ -193,7 +193,7 @@ fn default_bits() -> u32 {
 }
 
 /// A pinhole camera.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Camera {
     /// The eye.
@@ -212,7 +212,7 @@ fn default_up() -> [f64; 3] {
 }
 
 /// The cosine of the specular lobe.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Model {
     /// Blinn-Phong: N.H, H the half vector of L and V.
@@ -223,7 +223,7 @@ pub enum Model {
 }
 
 /// How surfaces are shaded.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Shading {
     /// `blinn_phong` (default) or `phong`.
@@ -239,7 +239,7 @@ fn default_ambient() -> f64 {
 }
 
 /// The kind of a light.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LightKind {
     /// Parallel light from `direction`.
@@ -249,7 +249,7 @@ pub enum LightKind {
 }
 
 /// A light.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Light {
     /// `directional` or `point`.
@@ -275,7 +275,7 @@ fn one() -> f64 {
 }
 
 /// A material: Lambert diffuse plus a normalised specular lobe of exponent `n`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
     /// The name objects use.
@@ -337,6 +337,11 @@ pub struct Object {
     pub shape: Shape,
 }
 
+/// A scene's part as a TOML value (for [`Scene::canonical`]).
+fn toml_value(what: &str, v: &impl Serialize) -> toml::Value {
+    toml::Value::try_from(v).unwrap_or_else(|e| panic!("{what} serialises to TOML: {e}"))
+}
+
 /// Reads a mesh file named in a scene: its bytes.
 pub type Loader<'a> = &'a dyn Fn(&str) -> std::io::Result<Vec<u8>>;
 
@@ -390,6 +395,88 @@ impl Scene {
     /// The built-in default scene.
     pub fn default_scene() -> Scene {
         Scene::from_toml(DEFAULT_SCENE).expect("the built-in scene is valid")
+    }
+
+    /// The scene in one canonical form, for a result's recorded inputs: every key of the
+    /// validated scene (defaults filled in) in a fixed order; a mesh object as the number and
+    /// the sha256 of its triangles (little-endian f64, after its scale and translation), so
+    /// that no file name or path is recorded.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::scene::Scene;
+    /// let a = Scene::default_scene();
+    /// // The same scene with a comment, and without the up vector it spells out (the default).
+    /// let text = format!("# commented\n{}", specfx::scene::DEFAULT_SCENE)
+    ///     .replacen("up = [0.0, 1.0, 0.0]\n", "", 1);
+    /// assert_ne!(text.len(), specfx::scene::DEFAULT_SCENE.len() + 12);
+    /// let b = Scene::from_toml(&text).unwrap();
+    /// assert_eq!(a.canonical(), b.canonical());
+    /// assert!(a.canonical().contains_key("material"));
+    /// ```
+    pub fn canonical(&self) -> toml::Table {
+        let mut t = toml::Table::new();
+        t.insert("image".into(), toml_value("image", &self.image));
+        t.insert("camera".into(), toml_value("camera", &self.camera));
+        t.insert("shading".into(), toml_value("shading", &self.shading));
+        t.insert("light".into(), toml_value("lights", &self.lights));
+        t.insert("material".into(), toml_value("materials", &self.materials));
+        let objects = self
+            .objects
+            .iter()
+            .map(|o| {
+                let mut ot = toml::Table::new();
+                let v3 = |x: [f64; 3]| toml_value("a vector", &x);
+                let put = |ot: &mut toml::Table, k: &str, v: toml::Value| {
+                    ot.insert(k.into(), v);
+                };
+                ot.insert("material".into(), o.material.clone().into());
+                match o.shape {
+                    Shape::Sphere { center, radius } => {
+                        put(&mut ot, "kind", "sphere".into());
+                        put(&mut ot, "center", v3(center));
+                        put(&mut ot, "radius", radius.into());
+                    }
+                    Shape::Capsule { a, b, radius } => {
+                        put(&mut ot, "kind", "capsule".into());
+                        put(&mut ot, "a", v3(a));
+                        put(&mut ot, "b", v3(b));
+                        put(&mut ot, "radius", radius.into());
+                    }
+                    Shape::Torus {
+                        center,
+                        axis,
+                        major,
+                        minor,
+                    } => {
+                        put(&mut ot, "kind", "torus".into());
+                        put(&mut ot, "center", v3(center));
+                        put(&mut ot, "axis", v3(axis));
+                        put(&mut ot, "major", major.into());
+                        put(&mut ot, "minor", minor.into());
+                    }
+                    Shape::Mesh { mesh } => {
+                        let tris = &self.meshes[mesh].triangles;
+                        let bytes: Vec<u8> = tris
+                            .iter()
+                            .flatten()
+                            .flatten()
+                            .flat_map(|x| x.to_le_bytes())
+                            .collect();
+                        put(&mut ot, "kind", "mesh".into());
+                        put(&mut ot, "triangles", (tris.len() as i64).into());
+                        put(
+                            &mut ot,
+                            "triangles_sha256",
+                            crate::provenance::sha256_hex(&bytes).into(),
+                        );
+                    }
+                }
+                toml::Value::Table(ot)
+            })
+            .collect();
+        t.insert("object".into(), toml::Value::Array(objects));
+        t
     }
 
     /// The index of a material by name.
