@@ -3,7 +3,8 @@
 //!
 //! Levels: `--quiet` keeps errors and warnings; the default adds informational lines (what a
 //! command is doing); `-v` adds details (files read and written, timings of steps), each
-//! prefixed by the seconds since the start; `-vv` adds trace records, also of other crates.
+//! prefixed by the seconds since the start (`-vv` is the same: no dependency logs through `log`
+//! today, and records of other crates are left out).
 //! Lines are printed above any progress bar ([`super::progress::suspend`]).
 
 use std::ffi::OsStr;
@@ -20,8 +21,6 @@ pub enum Verbosity {
     Normal,
     /// Also details: files read and written, timings.
     Verbose,
-    /// Also trace records, of every crate.
-    Trace,
 }
 
 impl Verbosity {
@@ -30,8 +29,7 @@ impl Verbosity {
         match (quiet, verbose) {
             (true, _) => Verbosity::Quiet,
             (false, 0) => Verbosity::Normal,
-            (false, 1) => Verbosity::Verbose,
-            (false, _) => Verbosity::Trace,
+            (false, _) => Verbosity::Verbose,
         }
     }
 
@@ -39,8 +37,7 @@ impl Verbosity {
         match self {
             Verbosity::Quiet => log::LevelFilter::Warn,
             Verbosity::Normal => log::LevelFilter::Info,
-            Verbosity::Verbose => log::LevelFilter::Debug,
-            Verbosity::Trace => log::LevelFilter::Trace,
+            Verbosity::Verbose => log::LevelFilter::Trace,
         }
     }
 }
@@ -152,9 +149,7 @@ static LOGGER: StderrLogger = StderrLogger;
 
 impl log::Log for StderrLogger {
     fn enabled(&self, metadata: &log::Metadata<'_>) -> bool {
-        let verbosity = settings().verbosity;
-        metadata.level() <= verbosity.level()
-            && (verbosity == Verbosity::Trace || metadata.target().starts_with("specfx"))
+        metadata.level() <= settings().verbosity.level() && metadata.target().starts_with("specfx")
     }
 
     fn log(&self, record: &log::Record<'_>) {
@@ -206,7 +201,7 @@ mod tests {
         assert_eq!(Verbosity::from_flags(true, 0), Verbosity::Quiet);
         assert_eq!(Verbosity::from_flags(false, 0), Verbosity::Normal);
         assert_eq!(Verbosity::from_flags(false, 1), Verbosity::Verbose);
-        assert_eq!(Verbosity::from_flags(false, 3), Verbosity::Trace);
+        assert_eq!(Verbosity::from_flags(false, 3), Verbosity::Verbose);
         assert_eq!(Verbosity::Quiet.level(), log::LevelFilter::Warn);
     }
 

@@ -46,8 +46,7 @@ struct Cli {
     /// Print only results, warnings and errors: no progress, no informational lines.
     #[arg(short, long, global = true, conflicts_with = "verbose")]
     quiet: bool,
-    /// Print details on stderr: files read and written, how long each step took (twice:
-    /// everything, also from the libraries used).
+    /// Print details on stderr: files read and written, how long each step took.
     #[arg(short, long, global = true, action = clap::ArgAction::Count)]
     verbose: u8,
     /// Colour in help and messages: auto (on a terminal, unless NO_COLOR is set), always or

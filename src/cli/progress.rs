@@ -6,10 +6,10 @@
 //! step it runs (`report` running `stability`) stack, and log lines print above them.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
-use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 
 use super::logging::{settings, Verbosity};
 
@@ -46,7 +46,7 @@ pub struct Progress {
     pos: AtomicU64,
     len: AtomicU64,
     /// Where this run started (a resumed sweep starts at what is done), for the rate.
-    first: AtomicU64,
+    first: Arc<AtomicU64>,
     start: Instant,
 }
 
@@ -55,15 +55,28 @@ impl Progress {
     /// [`Progress::set_len`]); `label` starts every line ("sweep"), `unit` names the steps.
     pub fn new(label: &str, unit: &str, len: u64) -> Progress {
         let s = settings();
+        let first = Arc::new(AtomicU64::new(0));
         let show = if s.verbosity == Verbosity::Quiet {
             Show::Off
         } else if s.stderr_terminal {
             let bar = bars().add(ProgressBar::new(len));
+            // The ETA at the mean rate of this run, as off a terminal (indicatif's own
+            // estimate swings widely when steps are uneven, as the report's are).
+            let since = Arc::clone(&first);
+            let eta = move |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+                let done = state.pos().saturating_sub(since.load(Ordering::Relaxed));
+                let left = state.len().unwrap_or(0).saturating_sub(state.pos());
+                let _ = match mean_rate_eta(state.elapsed(), done, left) {
+                    Some(d) => write!(w, "{}", human(d, false)),
+                    None => write!(w, "-"),
+                };
+            };
             bar.set_style(
                 ProgressStyle::with_template(&format!(
-                    "{label} [{{bar:30}}] {{pos}}/{{len}} {unit}, {{elapsed}}, eta {{eta}} {{wide_msg}}"
+                    "{label} [{{bar:30}}] {{pos}}/{{len}} {unit}, {{elapsed}}, eta {{mean_eta}} {{wide_msg}}"
                 ))
                 .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .with_key("mean_eta", eta)
                 .progress_chars("=> "),
             );
             bar.enable_steady_tick(Duration::from_millis(500));
@@ -77,7 +90,7 @@ impl Progress {
             show,
             pos: AtomicU64::new(0),
             len: AtomicU64::new(len),
-            first: AtomicU64::new(0),
+            first,
             start: Instant::now(),
         }
     }
@@ -90,7 +103,7 @@ impl Progress {
             show: Show::Off,
             pos: AtomicU64::new(0),
             len: AtomicU64::new(len),
-            first: AtomicU64::new(0),
+            first: Arc::new(AtomicU64::new(0)),
             start: Instant::now(),
         }
     }
@@ -168,11 +181,7 @@ impl Progress {
     fn eta(&self, pos: u64) -> Option<Duration> {
         let done = pos.saturating_sub(self.first.load(Ordering::Relaxed));
         let len = self.len.load(Ordering::Relaxed);
-        (done > 0).then(|| {
-            self.start
-                .elapsed()
-                .mul_f64(len.saturating_sub(pos) as f64 / done as f64)
-        })
+        mean_rate_eta(self.start.elapsed(), done, len.saturating_sub(pos))
     }
 
     /// Clears the bar and logs (with `-v`) how long the work took.
@@ -259,6 +268,12 @@ fn tenth_line(
     format!("{label}: {}% ({count}/{len} {unit}){time}", tenth * 10)
 }
 
+/// The time `left` steps take at the mean rate of `done` steps in `elapsed`; none before the
+/// first step.
+fn mean_rate_eta(elapsed: Duration, done: u64, left: u64) -> Option<Duration> {
+    (done > 0).then(|| elapsed.mul_f64(left as f64 / done as f64))
+}
+
 /// A duration for people: `850ms` (only when `fine`), `12s`, `3m05s`, `1h02m`.
 fn human(d: Duration, fine: bool) -> String {
     let s = d.as_secs();
@@ -335,6 +350,15 @@ mod tests {
             tenth_line("trace", "rows", 10, 7, Some(s(0)), s(185)),
             "trace: 100% (7/7 rows), took 3m05s"
         );
+    }
+
+    #[test]
+    fn the_eta_is_the_mean_rate_of_this_run() {
+        let s = Duration::from_secs;
+        // 4 steps in 10 s: 6 more take 15 s.
+        assert_eq!(mean_rate_eta(s(10), 4, 6), Some(s(15)));
+        assert_eq!(mean_rate_eta(s(10), 0, 6), None);
+        assert_eq!(mean_rate_eta(s(10), 3, 0), Some(s(0)));
     }
 
     #[test]

@@ -57,20 +57,33 @@ pub fn tradeoff(
         start.elapsed().as_secs_f64()
     };
     let mut figures = Vec::new();
-    for (name, method) in f64_methods() {
-        log::info!("tradeoff: {name}");
-        figures.push(f64_figures(&name, method, ns_v, &mut time_it));
-    }
-    log::info!("tradeoff: powi");
-    figures.insert(1, powi_figures(ns_v, &mut time_it));
-    let configs = [8, 12, 16]
+    let methods = f64_methods();
+    let configs: Vec<_> = [8, 12, 16]
         .into_iter()
         .map(fixed_config)
-        .chain((3..=6).map(fixed_minimax_config));
+        .chain((3..=6).map(fixed_minimax_config))
+        .collect();
+    let bar = super::progress::Progress::new(
+        "tradeoff",
+        "methods",
+        (methods.len() + 1 + configs.len()) as u64,
+    );
+    let method_start = |name: &str| {
+        log::debug!("tradeoff: {name}");
+        bar.set_message(name.to_string());
+    };
+    for (name, method) in methods {
+        method_start(&name);
+        figures.push(f64_figures(&name, method, ns_v, &mut time_it));
+        bar.inc(1);
+    }
+    method_start("powi");
+    figures.insert(1, powi_figures(ns_v, &mut time_it));
+    bar.inc(1);
     for mut cfg in configs {
         cfg.n = ns.clone();
         let dp = Datapath::new(cfg)?;
-        log::info!("tradeoff: {}", dp.config().name);
+        method_start(&dp.config().name);
         let mut f = fixed_figures(&dp, &mut time_it);
         if let Some(target) = yosys {
             log::info!(
@@ -88,7 +101,9 @@ pub fn tradeoff(
             });
         }
         figures.push(f);
+        bar.inc(1);
     }
+    bar.finish();
     let mut csv = Vec::new();
     write_csv(&mut csv, &figures)?;
     write_atomic(&dir.join("tradeoff.csv"), &csv)?;
