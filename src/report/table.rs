@@ -136,8 +136,8 @@ impl TextTable {
     /// Writes the table: with `width` `None` every column at its widest cell's width; with
     /// `Some(w)` cells wrapped (at spaces where they can be, anywhere where they cannot) so
     /// that every line has at most `w` characters, notes word-wrapped too, as long as `w`
-    /// leaves each column a few characters (below that, lines are as narrow as comfy-table
-    /// can make them).
+    /// leaves every column one character and its separator (below that, lines are as narrow
+    /// as comfy-table can make them). A table narrower than `w` is written as with `None`.
     pub fn write(&self, w: &mut impl Write, width: Option<u16>) -> io::Result<()> {
         let mut table = Table::new();
         table
