@@ -569,6 +569,24 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
+/// A full stderr does not turn an error (or progress and log lines) into a panic: the exit code
+/// still says what happened (2 for bad input, 0 for a success).
+#[test]
+fn a_full_stderr_keeps_the_exit_code() {
+    for (args, code) in [
+        (&["check", "--config", "no-such.toml"][..], 2),
+        (&["check", "--bogus"][..], 2),
+        (&["-v", "check", "--n", "16..=20"][..], 0),
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+            .args(args)
+            .stderr(std::fs::File::create("/dev/full").unwrap())
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(code), "{args:?}");
+    }
+}
+
 /// A full disk behind stdout is an error that names stdout, not a panic.
 #[test]
 fn a_full_stdout_is_named() {

@@ -319,7 +319,15 @@ pub fn main() -> ExitCode {
             e.exit()
         }
         Err(e) => {
-            eprintln!("specfx: {}", one_line(&e.render().to_string()));
+            // A closed or full stderr is no reason to panic: the exit code still tells.
+            {
+                use std::io::Write as _;
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "specfx: {}",
+                    one_line(&e.render().to_string())
+                );
+            }
             return ExitCode::from(2);
         }
     };
@@ -364,7 +372,10 @@ pub fn main() -> ExitCode {
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
         Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("specfx: error: {err:#}");
+            {
+                use std::io::Write as _;
+                let _ = writeln!(std::io::stderr(), "specfx: error: {err:#}");
+            }
             ExitCode::from(2)
         }
     }

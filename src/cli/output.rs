@@ -139,7 +139,10 @@ pub fn install_interrupt_handler() {
                 let _ = std::fs::remove_dir_all(d);
             }
         }
-        eprintln!("specfx: interrupted; earlier results are unchanged");
+        let _ = writeln!(
+            io::stderr(),
+            "specfx: interrupted; earlier results are unchanged"
+        );
         std::process::exit(130);
     });
 }

@@ -170,7 +170,10 @@ impl Progress {
                 let taken = self.start.elapsed();
                 for tenth in reached {
                     let line = tenth_line(&self.label, &self.unit, tenth, len, eta, taken);
-                    eprintln!("{line}");
+                    {
+                        use std::io::Write as _;
+                        let _ = writeln!(std::io::stderr(), "{line}");
+                    }
                 }
             }
             Show::Off => {}
