@@ -252,6 +252,11 @@ fn write_files(dir: &Path, shown: &Path, files: &[(String, Vec<u8>)]) -> Result<
             let t = tmp(name);
             let _ = fs::remove_file(&t);
             made.push(t.clone());
+            log::debug!(
+                "writing {} ({} bytes)",
+                shown.join(name).display(),
+                bytes.len()
+            );
             fs::write(&t, bytes)
                 .with_context(|| format!("cannot write {}", shown.join(name).display()))?;
         }
