@@ -97,6 +97,43 @@ fn every_target_has_a_seed_corpus_and_every_directory_a_target() {
     assert_eq!(bins_sorted, names, "fuzz/Cargo.toml's [[bin]] targets");
 }
 
+/// The (name, version) pairs of a `Cargo.lock`.
+fn locked_packages(path: &str) -> Vec<(String, String)> {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(path))
+        .unwrap_or_else(|e| panic!("{path}: {e}"));
+    let lock: toml::Table = text.parse().unwrap_or_else(|e| panic!("{path}: {e}"));
+    lock["package"]
+        .as_array()
+        .expect("[[package]] tables")
+        .iter()
+        .map(|p| {
+            (
+                p["name"].as_str().expect("a name").to_string(),
+                p["version"].as_str().expect("a version").to_string(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn the_fuzz_targets_build_the_binarys_dependency_versions() {
+    // The fuzz crate has its own lock file; every package the binary also uses must be at the
+    // binary's version, or the fuzzer tests other parsers than the ones users run.
+    let main = locked_packages("Cargo.lock");
+    let stale: Vec<String> = locked_packages("fuzz/Cargo.lock")
+        .into_iter()
+        .filter(|(name, version)| {
+            main.iter().any(|(n, _)| n == name) && !main.contains(&(name.clone(), version.clone()))
+        })
+        .map(|(name, version)| format!("{name} {version}"))
+        .collect();
+    assert!(
+        stale.is_empty(),
+        "fuzz/Cargo.lock has other versions than Cargo.lock: {stale:?}; refresh it with \
+         `cp Cargo.lock fuzz/Cargo.lock && cargo metadata --manifest-path fuzz/Cargo.toml >/dev/null`"
+    );
+}
+
 #[test]
 fn config_corpus() {
     assert!(replay("config") > 0);
