@@ -268,7 +268,15 @@ fn one_line(text: &str) -> String {
             break;
         }
         if !line.is_empty() {
-            parts.push(line.to_string());
+            // A value clap echoes may hold control characters (a lone `\r` moves the cursor).
+            let shown = line.chars().map(|c| {
+                if c.is_control() {
+                    c.escape_debug().to_string()
+                } else {
+                    c.to_string()
+                }
+            });
+            parts.push(shown.collect());
         }
     }
     let mut out = String::new();
@@ -413,7 +421,12 @@ mod tests {
             value.contains("[possible values: icarus, verilator]"),
             "{value}"
         );
-        for e in [missing, typo, sub, value] {
+        let control = err(&["check", "--n", "16..x\r"]);
+        assert!(
+            control.starts_with(r"error: invalid value '16..x\r' for '--n <N>'"),
+            "{control}"
+        );
+        for e in [missing, typo, sub, value, control] {
             assert!(!e.contains('\n') && !e.contains("Usage"), "{e}");
         }
     }
