@@ -2,34 +2,11 @@
 //! threads, and every file it writes is compared (measured speed lives in `measured_*` files,
 //! the only ones allowed to differ).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+use common::snapshot;
 
-/// Every file under `dir` (relative path, bytes), sorted; `measured_*` files left out.
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    fn walk(root: &Path, dir: &Path, out: &mut Vec<(PathBuf, Vec<u8>)>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else if !p
-                .file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with("measured_")
-            {
-                out.push((
-                    p.strip_prefix(root).unwrap().to_path_buf(),
-                    std::fs::read(&p).unwrap(),
-                ));
-            }
-        }
-    }
-    let mut v = Vec::new();
-    walk(dir, dir, &mut v);
-    v.sort();
-    v
-}
+use std::path::PathBuf;
+use std::process::Command;
 
 /// Runs `specfx <args> <out-flag> <dir>` with `threads` threads in a fresh directory and
 /// returns what it wrote (and its stdout as a file named `stdout`).

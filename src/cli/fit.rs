@@ -79,7 +79,7 @@ impl FitArgs {
 }
 
 /// The cost of one datapath with its constant ROM.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct SideCost {
     /// The exponents it serves.
     pub n: String,

@@ -23,6 +23,7 @@ mod progress;
 mod reference;
 pub mod render;
 mod report;
+mod resume;
 mod sim;
 pub mod stability;
 mod sweep;

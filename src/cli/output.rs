@@ -129,6 +129,9 @@ pub const MARKER: &str = ".specfx-result";
 /// Staging directories of this process not yet committed, removed on Ctrl-C or SIGTERM.
 static STAGING: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
+/// What the interrupt message adds when the run can be resumed (set by a resumable command).
+pub static RESUME_HINT: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
 /// Installs the Ctrl-C / SIGTERM handler: removes this process's staging directories (the
 /// previous results stay as they were) and exits with code 130.
 pub fn install_interrupt_handler() {
@@ -139,9 +142,14 @@ pub fn install_interrupt_handler() {
                 let _ = std::fs::remove_dir_all(d);
             }
         }
+        let hint = RESUME_HINT
+            .lock()
+            .ok()
+            .and_then(|h| h.clone())
+            .map_or(String::new(), |h| format!("; {h}"));
         let _ = writeln!(
             io::stderr(),
-            "specfx: interrupted; earlier results are unchanged"
+            "specfx: interrupted; earlier results are unchanged{hint}"
         );
         std::process::exit(130);
     });
@@ -158,6 +166,8 @@ pub struct OutDir {
     target: PathBuf,
     staging: PathBuf,
     done: bool,
+    /// Kept when the run does not finish (a resumable result), instead of removed.
+    keep: bool,
 }
 
 impl OutDir {
@@ -169,6 +179,32 @@ impl OutDir {
         force: bool,
         inputs: &[(&str, PathBuf)],
     ) -> Result<OutDir> {
+        Ok(OutDir::start(target, command, force, inputs, None)?.0)
+    }
+
+    /// Like [`OutDir::begin`], for a result that can be resumed: unless `restart`, the staging
+    /// directory an interrupted or killed run of `command` left for `target` is taken over
+    /// (renamed to this process's; the newest when there are several), and this run's staging
+    /// directory is kept, not removed, when the run ends without a commit (an error, Ctrl-C,
+    /// SIGTERM). Returns whether a directory was taken over.
+    pub fn begin_resumable(
+        target: &Path,
+        command: &str,
+        force: bool,
+        inputs: &[(&str, PathBuf)],
+        restart: bool,
+    ) -> Result<(OutDir, bool)> {
+        OutDir::start(target, command, force, inputs, Some(restart))
+    }
+
+    /// [`OutDir::begin`] (`resume` None) and [`OutDir::begin_resumable`] (`Some(restart)`).
+    fn start(
+        target: &Path,
+        command: &str,
+        force: bool,
+        inputs: &[(&str, PathBuf)],
+        resume: Option<bool>,
+    ) -> Result<(OutDir, bool)> {
         refuse_over_inputs(target, "--out", inputs)?;
         let name = target
             .file_name()
@@ -179,6 +215,13 @@ impl OutDir {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
+        // A run killed between moving the previous result aside and renaming its own into
+        // place left the previous result as `.<name>.old-<pid>`: it is put back first.
+        if !target.exists() && !target.is_symlink() {
+            if let Some((old, _)) = stale(&parent, &name).into_iter().find(|(_, p)| !p) {
+                let _ = std::fs::rename(old, target);
+            }
+        }
         if target.exists() || target.is_symlink() {
             if !target.is_dir() {
                 anyhow::bail!(
@@ -197,23 +240,46 @@ impl OutDir {
         }
         std::fs::create_dir_all(&parent)
             .with_context(|| format!("cannot create {}", parent.display()))?;
-        remove_stale(&parent, &name);
         let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
         if staging.exists() {
             std::fs::remove_dir_all(&staging)
                 .with_context(|| format!("cannot remove {}", staging.display()))?;
         }
-        std::fs::create_dir(&staging)
-            .with_context(|| format!("cannot create {}", staging.display()))?;
-        STAGING.lock().expect("staging list").push(staging.clone());
+        // The newest unfinished run of the same command, taken over by a rename (of two runs
+        // racing for it, one gets it and the other starts afresh).
+        let resumed = resume == Some(false)
+            && stale(&parent, &name)
+                .into_iter()
+                .filter(|(p, partial)| {
+                    *partial
+                        && p.is_dir()
+                        && std::fs::read_to_string(p.join(MARKER))
+                            .is_ok_and(|m| m.split_whitespace().next() == Some(command))
+                })
+                .max_by_key(|(p, _)| {
+                    std::fs::metadata(p)
+                        .and_then(|m| m.modified())
+                        .unwrap_or(std::time::SystemTime::UNIX_EPOCH)
+                })
+                .is_some_and(|(p, _)| std::fs::rename(&p, &staging).is_ok());
+        remove_stale(&parent, &name);
+        if !resumed {
+            std::fs::create_dir(&staging)
+                .with_context(|| format!("cannot create {}", staging.display()))?;
+        }
+        let keep = resume.is_some();
+        if !keep {
+            STAGING.lock().expect("staging list").push(staging.clone());
+        }
         let out = OutDir {
             target: target.to_path_buf(),
             staging,
             done: false,
+            keep,
         };
         std::fs::write(out.staging.join(MARKER), format!("{command}\n"))
             .with_context(|| format!("cannot write into {}", out.staging.display()))?;
-        Ok(out)
+        Ok((out, resumed))
     }
 
     /// Where to write the result's files.
@@ -265,30 +331,41 @@ impl OutDir {
 
 impl Drop for OutDir {
     fn drop(&mut self) {
-        if !self.done {
+        if !self.done && !self.keep {
             let _ = std::fs::remove_dir_all(&self.staging);
             self.unregister();
         }
     }
 }
 
-/// Removes `.<name>.partial-<pid>` and `.<name>.old-<pid>` directories left by processes that
-/// no longer run (killed mid-write).
-fn remove_stale(parent: &Path, name: &str) {
+/// The `.<name>.partial-<pid>` (true) and `.<name>.old-<pid>` (false) directories left by
+/// processes that no longer run (killed mid-write, or resumable results).
+fn stale(parent: &Path, name: &str) -> Vec<(PathBuf, bool)> {
     let Ok(entries) = std::fs::read_dir(parent) else {
-        return;
+        return Vec::new();
     };
+    let mut found = Vec::new();
     for e in entries.flatten() {
         let file = e.file_name().to_string_lossy().into_owned();
-        let pid = [".partial-", ".old-"].iter().find_map(|tag| {
+        let tagged = [".partial-", ".old-"].iter().find_map(|tag| {
             file.strip_prefix(&format!(".{name}{tag}"))
                 .and_then(|p| p.parse::<u32>().ok())
+                .map(|pid| (pid, *tag == ".partial-"))
         });
-        if let Some(pid) = pid {
+        if let Some((pid, partial)) = tagged {
             if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
-                let _ = std::fs::remove_dir_all(e.path());
+                found.push((e.path(), partial));
             }
         }
+    }
+    found.sort();
+    found
+}
+
+/// Removes the directories [`stale`] finds.
+fn remove_stale(parent: &Path, name: &str) {
+    for (path, _) in stale(parent, name) {
+        let _ = std::fs::remove_dir_all(path);
     }
 }
 
@@ -432,4 +509,76 @@ pub fn write_provenance(dir: &Path, p: &specfx::provenance::Provenance) -> Resul
     use specfx::provenance::{INPUTS_FILE, PROVENANCE_FILE};
     write_atomic(&dir.join(INPUTS_FILE), p.canonical.as_bytes())?;
     write_atomic(&dir.join(PROVENANCE_FILE), p.json().as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A staging directory a dead process left for `target`, with `command`'s marker.
+    fn left(target: &Path, tag: &str, command: &str) -> PathBuf {
+        let name = target.file_name().unwrap().to_string_lossy();
+        let dir = target.with_file_name(format!(".{name}{tag}999999999"));
+        std::fs::create_dir(&dir).unwrap();
+        std::fs::write(dir.join(MARKER), format!("{command}\n")).unwrap();
+        std::fs::write(dir.join("done.txt"), "kept").unwrap();
+        dir
+    }
+
+    #[test]
+    fn a_resumable_result_takes_over_what_an_interrupted_run_left() {
+        let tmp = tempfile::tempdir().unwrap();
+        let target = tmp.path().join("r");
+        let stale = left(&target, ".partial-", "report");
+        let (out, resumed) = OutDir::begin_resumable(&target, "report", false, &[], false).unwrap();
+        assert!(resumed);
+        assert!(!stale.exists());
+        assert_eq!(
+            std::fs::read_to_string(out.path().join("done.txt")).unwrap(),
+            "kept"
+        );
+        // Not committed: kept for the next run, not removed.
+        let kept = out.path().to_path_buf();
+        drop(out);
+        assert!(kept.exists());
+        std::fs::rename(&kept, &stale).unwrap();
+
+        // --restart: the interrupted run's files are removed, not used.
+        let (out, resumed) = OutDir::begin_resumable(&target, "report", false, &[], true).unwrap();
+        assert!(!resumed && !stale.exists());
+        assert!(!out.path().join("done.txt").exists());
+        out.commit().unwrap();
+        assert!(target.join(MARKER).exists());
+
+        // Another command's staging directory is never taken over.
+        let other = left(&target, ".partial-", "stability");
+        let (out, resumed) = OutDir::begin_resumable(&target, "report", false, &[], false).unwrap();
+        assert!(!resumed && !other.exists());
+        assert!(!out.path().join("done.txt").exists());
+        drop(out);
+
+        // A plain result is removed when it does not finish.
+        let out = OutDir::begin(&target, "report", false, &[]).unwrap();
+        let staging = out.path().to_path_buf();
+        drop(out);
+        assert!(!staging.exists());
+    }
+
+    #[test]
+    fn a_previous_result_moved_aside_by_a_killed_commit_is_put_back() {
+        let tmp = tempfile::tempdir().unwrap();
+        let target = tmp.path().join("r");
+        let old = left(&target, ".old-", "report");
+        let out = OutDir::begin(&target, "report", false, &[]).unwrap();
+        assert!(!old.exists());
+        assert_eq!(
+            std::fs::read_to_string(target.join("done.txt")).unwrap(),
+            "kept"
+        );
+        drop(out);
+        assert!(
+            target.join("done.txt").exists(),
+            "untouched without a commit"
+        );
+    }
 }

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Args;
+use serde::{Deserialize, Serialize};
 
 use super::output::write_atomic;
 use super::Outcome;
@@ -25,6 +26,23 @@ pub struct ReportArgs {
     /// Replace an existing output directory that is not an earlier report.
     #[arg(long)]
     force: bool,
+    /// Start afresh instead of resuming: by default a run interrupted (Ctrl-C, SIGTERM, an
+    /// error, even SIGKILL) leaves its finished steps in the staging directory, and the next
+    /// run with the same --out reuses those still true for this build and these tools.
+    #[arg(long)]
+    restart: bool,
+}
+
+/// The first line of `tool flag`'s output when the tool runs, else None.
+fn tool_version(tool: &str, flag: &str) -> Option<String> {
+    super::child::output(std::process::Command::new(tool).arg(flag))
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| {
+            let text = String::from_utf8_lossy(&o.stdout).into_owned()
+                + &String::from_utf8_lossy(&o.stderr);
+            text.lines().next().unwrap_or("").trim().to_string()
+        })
 }
 
 /// Renders into a buffer and writes it atomically to `dir/name`; returns the path.
@@ -40,17 +58,99 @@ fn emit(
     Ok(path)
 }
 
+/// What the index page and the summary need of one architecture's synthesis (kept when a
+/// report is interrupted, see [`super::resume`]).
+#[derive(Serialize, Deserialize)]
+struct CostRow {
+    arch: specfx::cycle::Arch,
+    /// yosys LUTs, DSPs, flip-flops and carry cells.
+    luts: u64,
+    dsps: u64,
+    ffs: u64,
+    carries: u64,
+    /// The analytic model's LUTs, latency and initiation interval.
+    analytic_luts: u64,
+    latency: u64,
+    initiation_interval: u64,
+    /// yosys LUTs of the constant ROM.
+    rom_luts: u64,
+    /// Place and route (nextpnr), when it ran.
+    timing: Option<TimingRow>,
+    /// Resources beyond the UP5K.
+    over_limit: Vec<String>,
+}
+
+/// What the index page needs of a place and route.
+#[derive(Serialize, Deserialize)]
+struct TimingRow {
+    fmax_mhz: Option<f64>,
+    fmax_is_upper_bound: bool,
+    latency_ns: Option<f64>,
+    throughput_samples_per_s: Option<f64>,
+}
+
+impl CostRow {
+    fn new(c: &super::cost::CostReport) -> CostRow {
+        CostRow {
+            arch: c.arch,
+            luts: c.luts.unwrap_or(0),
+            dsps: c.dsps.unwrap_or(0),
+            ffs: c.ffs.unwrap_or(0),
+            carries: c.yosys.as_ref().map_or(0, |y| y.carries),
+            analytic_luts: c.analytic.luts,
+            latency: c.analytic.latency,
+            initiation_interval: c.analytic.initiation_interval,
+            rom_luts: c.rom_yosys.as_ref().map_or(0, |r| r.luts),
+            timing: c.timing.as_ref().map(|t| TimingRow {
+                fmax_mhz: t.fmax_mhz,
+                fmax_is_upper_bound: t.fmax_is_upper_bound,
+                latency_ns: t.latency_ns,
+                throughput_samples_per_s: t.throughput_samples_per_s,
+            }),
+            over_limit: c.over_limit.clone(),
+        }
+    }
+}
+
+/// What the index page needs of one method of the trade-off.
+#[derive(Serialize, Deserialize)]
+struct FigureRow {
+    method: String,
+    max_abs_err: f64,
+    mean_abs_err: f64,
+}
+
+/// What the index page and the summary need of the stability maps.
+#[derive(Serialize, Deserialize)]
+struct StabilitySummary {
+    /// Every path, and whether it stays within the tolerance everywhere.
+    paths: Vec<(String, bool)>,
+    /// The exponents of the grid, as printed.
+    n: String,
+    /// The tolerance, as printed.
+    tol: String,
+}
+
+/// What the index page and the summary need of the fit to the built-in scene.
+#[derive(Serialize, Deserialize)]
+struct FitSummary {
+    target: specfx::hdl::cost::Target,
+    inputs: u64,
+    generic_cost: super::fit::SideCost,
+    fitted_cost: super::fit::SideCost,
+}
+
 /// What the index page summarises.
 struct Results<'a> {
     paper: &'a specfx::analysis::paper::PaperReproduction,
     checked: &'a specfx::analysis::check::CheckReport,
     budget: &'a specfx::analysis::budget::BudgetReport,
-    figures: &'a [specfx::analysis::tradeoff::MethodFigures],
-    stability: &'a specfx::analysis::stability::StabilityReport,
+    figures: &'a [FigureRow],
+    stability: &'a StabilitySummary,
     render: &'a [specfx::report::scene::MaterialRow],
-    fit: &'a super::fit::FitReport,
+    fit: &'a FitSummary,
     furnace: &'a specfx::analysis::furnace::FurnaceReport,
-    costs: &'a [super::cost::CostReport],
+    costs: &'a [CostRow],
     sims: &'a [specfx::cycle::sim::SimStats],
     provenance: &'a specfx::provenance::Provenance,
 }
@@ -100,7 +200,7 @@ fn write_index(
         if checked.monotonic { "yes" } else { "NO" },
         pipelined.map_or(String::new(), |c| format!(
             "Synthesis (yosys, iCE40, pipelined): {} LUTs, {} DSPs, {} flip-flops, latency {} cycles, one result per cycle. ",
-            c.luts.unwrap_or(0), c.dsps.unwrap_or(0), c.ffs.unwrap_or(0), c.analytic.latency
+            c.luts, c.dsps, c.ffs, c.latency
         )),
         fit.fitted_cost.analytic_total_luts,
         fit.target,
@@ -132,12 +232,7 @@ fn write_index(
             writeln!(
                 w,
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                c.arch,
-                c.luts.unwrap_or(0),
-                c.analytic.luts,
-                c.dsps.unwrap_or(0),
-                c.ffs.unwrap_or(0),
-                c.rom_yosys.as_ref().map_or(0, |r| r.luts),
+                c.arch, c.luts, c.analytic_luts, c.dsps, c.ffs, c.rom_luts,
             )?;
         }
         writeln!(w, "</table></div><div class=\"table\"><table><tr><th>architecture</th><th>latency (cycles)</th><th>initiation interval</th><th>Fmax on UP5K (nextpnr)</th><th>latency (ns)</th><th>throughput (Msamples/s)</th></tr>")?;
@@ -147,8 +242,8 @@ fn write_index(
                 w,
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 c.arch,
-                c.analytic.latency,
-                c.analytic.initiation_interval,
+                c.latency,
+                c.initiation_interval,
                 t.and_then(|t| t.fmax_mhz.map(|f| format!(
                     "{}{f:.1} MHz",
                     if t.fmax_is_upper_bound { "&le; " } else { "" }
@@ -198,13 +293,13 @@ fn write_index(
     }
     writeln!(w, "</table></div>")?;
     let passing: Vec<&str> = stability
-        .maps
+        .paths
         .iter()
-        .filter(|m| m.passes())
-        .map(|m| m.path.as_str())
+        .filter(|(_, passes)| *passes)
+        .map(|(path, _)| path.as_str())
         .collect();
     writeln!(w, "<h2>Where the methods fail</h2><p>{} paths mapped over n = {} and theta in [0, 90] degrees against a tolerance of {}; {} stay within it everywhere ({}). Failure regions, special inputs (NaN, infinities, cosines just outside [0, 1]) and one heat map per path: <a href=\"stability/stability.html\">stability/stability.html</a> (also .md, .json, regions.csv).</p><img src=\"stability/overview.png\" alt=\"where each path passes or fails\">",
-        stability.maps.len(), stability.grid.n, stability.grid.tol, passing.len(), passing.join(", "))?;
+        stability.paths.len(), stability.n, stability.tol, passing.len(), passing.join(", "))?;
     if let Some(all) = render.iter().find(|r| r.material == "all") {
         writeln!(w, "<h2>The datapath in an image</h2><p>The built-in scene (cells, a vessel, a bone-like ring; n = 16 to 1024) rendered with the baseline datapath's specular lobe: at most {} display LSBs from f64 cos^n ({:.2}% of covered pixels differ, FLIP mean {:.4}), at most {} from the f64 model of its own algorithm (the quantization alone). Per material: <a href=\"render/render.md\">render/render.md</a>.</p><img src=\"render/datapath.png\" alt=\"the scene through the datapath\"><img src=\"render/diff_vs_cos_n.png\" alt=\"difference from cos^n in display LSBs\">",
             all.total.max_lsb, 100.0 * all.total.differing, all.total.flip_mean, all.quant.max_lsb)?;
@@ -287,8 +382,28 @@ impl Steps {
 
 /// Runs `specfx report`.
 pub fn run(args: &ReportArgs) -> Result<Outcome> {
-    let out_dir = super::output::OutDir::begin(&args.out, "report", args.force, &[])?;
+    let (out_dir, resumed) =
+        super::output::OutDir::begin_resumable(&args.out, "report", args.force, &[], args.restart)?;
     let dir = out_dir.path();
+    let yosys_version = tool_version("yosys", "-V");
+    let nextpnr_version = tool_version("nextpnr-ice40", "--version");
+    let hdl = super::cost::hdl_ref_dir(None);
+    let key = super::resume::run_key(&format!(
+        "yosys {yosys_version:?}\nnextpnr-ice40 {nextpnr_version:?}\nhdl_ref {}",
+        hdl.display()
+    ));
+    let mut resume = super::resume::Resume::open(dir, key, resumed)?;
+    if resumed {
+        log::info!(
+            "specfx report: resuming the interrupted run in {} ({} finished steps kept; --restart starts afresh)",
+            args.out.display(),
+            resume.n_reusable()
+        );
+    }
+    *super::output::RESUME_HINT.lock().expect("hint") = Some(format!(
+        "run `specfx report --out {}` again to resume from the finished steps",
+        args.out.display()
+    ));
     let mut written = Vec::new();
     let mut steps = Steps::new();
 
@@ -367,44 +482,49 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         b.push(b'\n');
         Ok(())
     })?);
-    let yosys_present = super::child::output(std::process::Command::new("yosys").arg("-V"))
-        .is_ok_and(|o| o.status.success());
+    let yosys_present = yosys_version.is_some();
     let mut costs = Vec::new();
     if yosys_present {
         steps.start("synthesising baseline with yosys (ice40, both architectures)");
-        let hdl = super::cost::hdl_ref_dir(None);
-        let nextpnr_present =
-            super::child::output(std::process::Command::new("nextpnr-ice40").arg("--version"))
-                .is_ok_and(|o| o.status.success());
-        for arch in specfx::cycle::Arch::ALL {
-            let mut c =
-                super::cost::cost_report(&dp, arch, specfx::hdl::cost::Target::Ice40, &hdl, false)?;
-            c.device = Some(specfx::hdl::pnr::Device::Up5k);
-            c.over_limit = specfx::hdl::pnr::device_check(
-                c.dsps.unwrap_or(0),
-                c.luts.unwrap_or(0),
-                c.ffs.unwrap_or(0),
-                specfx::hdl::pnr::Device::Up5k,
-            );
-            if nextpnr_present {
-                steps.part(&format!(
-                    "placing and routing baseline ({arch}) on an iCE40 UP5K with nextpnr"
-                ));
-                c.timing = Some(super::pnr::run_timing(
+        costs = resume.step("costs", &["cost_baseline.txt"], || {
+            let mut reports = Vec::new();
+            for arch in specfx::cycle::Arch::ALL {
+                let mut c = super::cost::cost_report(
                     &dp,
                     arch,
-                    specfx::hdl::pnr::Device::Up5k,
+                    specfx::hdl::cost::Target::Ice40,
                     &hdl,
-                )?);
+                    false,
+                )?;
+                c.device = Some(specfx::hdl::pnr::Device::Up5k);
+                c.over_limit = specfx::hdl::pnr::device_check(
+                    c.dsps.unwrap_or(0),
+                    c.luts.unwrap_or(0),
+                    c.ffs.unwrap_or(0),
+                    specfx::hdl::pnr::Device::Up5k,
+                );
+                if nextpnr_version.is_some() {
+                    steps.part(&format!(
+                        "placing and routing baseline ({arch}) on an iCE40 UP5K with nextpnr"
+                    ));
+                    c.timing = Some(super::pnr::run_timing(
+                        &dp,
+                        arch,
+                        specfx::hdl::pnr::Device::Up5k,
+                        &hdl,
+                    )?);
+                }
+                reports.push(c);
             }
-            costs.push(c);
-        }
-        written.push(emit(dir, "cost_baseline.txt", |b| {
-            for c in &costs {
-                super::cost::write_cost(b, c, None)?;
-            }
-            Ok(())
-        })?);
+            emit(dir, "cost_baseline.txt", |b| {
+                for c in &reports {
+                    super::cost::write_cost(b, c, None)?;
+                }
+                Ok(())
+            })?;
+            Ok(reports.iter().map(CostRow::new).collect())
+        })?;
+        written.push(dir.join("cost_baseline.txt"));
     } else {
         steps.start_at(
             log::Level::Warn,
@@ -422,11 +542,21 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
 
     steps.start("speed against accuracy of every method (the trade-off charts)");
     let tradeoff_dir = dir.join("tradeoff");
-    let figures = super::tradeoff::tradeoff(
-        &tradeoff_dir,
-        &specfx::nset::NSet::range(16, 1024)?,
-        yosys_present.then_some(specfx::hdl::cost::Target::Ice40),
-    )?;
+    let figures: Vec<FigureRow> = resume.step("tradeoff", &["tradeoff"], || {
+        let figures = super::tradeoff::tradeoff(
+            &tradeoff_dir,
+            &specfx::nset::NSet::range(16, 1024)?,
+            yosys_present.then_some(specfx::hdl::cost::Target::Ice40),
+        )?;
+        Ok(figures
+            .into_iter()
+            .map(|f| FigureRow {
+                method: f.method,
+                max_abs_err: f.max_abs_err,
+                mean_abs_err: f.mean_abs_err,
+            })
+            .collect())
+    })?;
     written.push(tradeoff_dir.join("tradeoff.csv"));
     written.push(tradeoff_dir.join("measured_speed_accuracy.png"));
     written.push(tradeoff_dir.join("error_vs_n.png"));
@@ -437,11 +567,22 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     steps
         .start("mapping where every method and datapath fails (n = 1..=4096, theta 0..90 degrees)");
     let stability_dir = dir.join("stability");
-    let stability = super::stability::stability(
-        &stability_dir,
-        &specfx::analysis::stability::default_paths(),
-        &specfx::analysis::stability::Grid::default(),
-    )?;
+    let stability = resume.step("stability", &["stability"], || {
+        let report = super::stability::stability(
+            &stability_dir,
+            &specfx::analysis::stability::default_paths(),
+            &specfx::analysis::stability::Grid::default(),
+        )?;
+        Ok(StabilitySummary {
+            paths: report
+                .maps
+                .iter()
+                .map(|m| (m.path.clone(), m.passes()))
+                .collect(),
+            n: report.grid.n.to_string(),
+            tol: report.grid.tol.to_string(),
+        })
+    })?;
     for f in [
         "stability.html",
         "stability.md",
@@ -469,12 +610,20 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
 
     steps.start("fitting a datapath to the built-in scene (default budget: no worse than baseline per material)");
     let fit_dir = dir.join("fit");
-    let fit = super::fit::fit_scene(
-        &scene,
-        "the built-in scene",
-        &super::fit::FitArgs::defaults(fit_dir.clone(), !yosys_present),
-    )?
-    .context("the default fit budget is met by the generic datapath itself: this is a bug")?;
+    let fit = resume.step("fit", &["fit"], || {
+        let fit = super::fit::fit_scene(
+            &scene,
+            "the built-in scene",
+            &super::fit::FitArgs::defaults(fit_dir.clone(), !yosys_present),
+        )?
+        .context("the default fit budget is met by the generic datapath itself: this is a bug")?;
+        Ok(FitSummary {
+            target: fit.target,
+            inputs: fit.inputs,
+            generic_cost: fit.generic_cost,
+            fitted_cost: fit.fitted_cost,
+        })
+    })?;
     for f in super::fit::FIT_FILES {
         written.push(fit_dir.join(f));
     }
@@ -498,6 +647,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     }
 
     steps.finish();
+    resume.finish()?;
     // Everything the report computes is built in: its inputs are the command alone (and the
     // version, which fixes the built-in configurations, scene and settings).
     let provenance =
@@ -578,7 +728,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     writeln!(
         out,
         "  golden vectors: {n_vectors} in {}",
-        vectors_dir.display()
+        args.out.join("vectors_baseline").display()
     )?;
     writeln!(
         out,
@@ -598,26 +748,16 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         writeln!(
             out,
             "  yosys ice40 {}: {} LUT4, {} carry, {} DSP, {} FF",
-            c.arch,
-            c.luts.unwrap_or(0),
-            c.yosys.as_ref().map_or(0, |y| y.carries),
-            c.dsps.unwrap_or(0),
-            c.ffs.unwrap_or(0)
+            c.arch, c.luts, c.carries, c.dsps, c.ffs
         )?;
     }
-    let failing: Vec<&str> = stability
-        .maps
-        .iter()
-        .filter(|m| !m.passes())
-        .map(|m| m.path.as_str())
-        .collect();
+    let passing = stability.paths.iter().filter(|(_, passes)| *passes).count();
     writeln!(
         out,
-        "  stability: {} of {} paths stay within {} of cos^n over n = {} (details: stability/stability.html)",
-        stability.maps.len() - failing.len(),
-        stability.maps.len(),
-        stability.grid.tol,
-        stability.grid.n
+        "  stability: {passing} of {} paths stay within {} of cos^n over n = {} (details: stability/stability.html)",
+        stability.paths.len(),
+        stability.tol,
+        stability.n
     )?;
     writeln!(
         out,
