@@ -10,7 +10,7 @@ use std::fmt::Display;
 use specfx::analysis::optimize::Budget;
 use specfx::analysis::sweep::{Space, MAX_POINTS};
 use specfx::fixed::{Format, Overflow, Rounding};
-use specfx::golden::manifest_config;
+use specfx::golden::verify::{VerifiedManifest, CSV_FILE};
 use specfx::nset::{NSet, N_MAX};
 use specfx::pipeline::{Config, Datapath};
 use specfx::scene::fit::ImageBudget;
@@ -86,23 +86,63 @@ fn datapath(input: &str, config: Config) -> bool {
     }
 }
 
-/// A vector directory's `manifest.json` (`--config DIR`, `--vectors DIR`):
-/// `golden::manifest_config`, then `Datapath::new`. The configuration written back as JSON
-/// (as `specfx vectors` writes it) reads back the same.
+/// A vector directory (`--config DIR`, `--vectors DIR`) in one input: the text of its
+/// `manifest.json`, then `vectors.csv` and the hex files in the order of the manifest's ports,
+/// separated by NUL bytes; checked as the command line checks a directory
+/// (`golden::verify::VerifiedManifest`), except that a sha256 mismatch (which the command
+/// refuses first) does not stop the other checks. Every error is one line; an accepted
+/// manifest's configuration is valid and reads back from the JSON `specfx vectors` writes;
+/// an accepted CSV has `n_vectors` rows of one value per port, each n in the set; an accepted
+/// hex file has a line per vector.
 pub fn manifest(data: &[u8]) -> bool {
-    let Some(text) = text(data) else {
+    let mut parts = data.split(|&b| b == 0);
+    let Some(text) = parts.next().and_then(text) else {
         return false;
     };
-    let config = match manifest_config(text) {
-        Ok(c) => c,
+    let m = match VerifiedManifest::parse(text, "manifest.json") {
+        Ok(m) => m,
         Err(e) => return refused(text, &e),
     };
-    let printed = serde_json::json!({ "config": config }).to_string();
-    match manifest_config(&printed) {
+    let config = m.config().clone();
+    let printed = serde_json::to_string(&config).expect("a configuration serialises");
+    match serde_json::from_str::<Config>(&printed) {
         Ok(again) => assert_eq!(again, config, "{text:?} printed as {printed:?}"),
         Err(e) => panic!("{text:?} printed as {printed:?} does not parse: {e}"),
     }
-    datapath(text, config)
+    if let Err(e) = Datapath::new(config) {
+        panic!("{text:?}: a verified manifest holds an invalid configuration: {e}");
+    }
+    let csv = parts.next().unwrap_or(b"");
+    if let Err(e) = m.check_sha256(CSV_FILE, csv, CSV_FILE) {
+        assert_one_line(text, &e);
+    }
+    let rows = match m.read_csv(csv, CSV_FILE) {
+        Ok(rows) => rows,
+        Err(e) => return refused(text, &e),
+    };
+    let n_ports = m.ports().len() as u64;
+    assert_eq!(rows.len() as u64, m.n_vectors() * n_ports, "{text:?}");
+    let inputs = match m.inputs(&rows, CSV_FILE) {
+        Ok(inputs) => inputs,
+        Err(e) => return refused(text, &e),
+    };
+    assert_eq!(inputs.len() as u64, m.n_vectors(), "{text:?}");
+    assert!(inputs
+        .iter()
+        .all(|(n, _)| m.config().n.values().binary_search(n).is_ok()));
+    for (j, port) in m.ports().iter().enumerate() {
+        let hex = parts.next().unwrap_or(b"");
+        match m.check_hex(j, hex, &port.file_name(), &rows) {
+            Ok(()) => {
+                let lines = std::str::from_utf8(hex)
+                    .expect("accepted hex is text")
+                    .lines();
+                assert_eq!(lines.count() as u64, m.n_vectors(), "{text:?}");
+            }
+            Err(e) => return refused(text, &e),
+        }
+    }
+    true
 }
 
 /// A design space (`specfx sweep --space FILE`): `Space::from_toml`. A space has 1 to

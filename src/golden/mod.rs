@@ -5,14 +5,14 @@
 //! byte-for-byte deterministic for the same configuration, cases, order and seed.
 
 pub mod cases;
+pub mod verify;
 
 use std::collections::BTreeMap;
 use std::io::{self, Write};
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use sha2::{Digest, Sha256};
 
-use crate::error::Error;
 use crate::fixed::Format;
 use crate::pipeline::fast::EventCounts;
 use crate::pipeline::{Config, Datapath, ProbeColumns, Variant};
@@ -663,30 +663,6 @@ pub struct Manifest {
     pub sha256: BTreeMap<String, String>,
 }
 
-/// The configuration a vector directory's `manifest.json` records (its key `config`, every
-/// key of [`Config`]), read from the file's text; [`Datapath::new`] validates it.
-///
-/// # Examples
-/// ```
-/// use specfx::golden::manifest_config;
-/// use specfx::pipeline::Config;
-/// let text = format!("{{\"config\": {}}}", serde_json::to_string(&Config::baseline()).unwrap());
-/// assert_eq!(manifest_config(&text).unwrap(), Config::baseline());
-/// assert_eq!(manifest_config("{}").unwrap_err().to_string(), "no key 'config'");
-/// ```
-pub fn manifest_config(text: &str) -> Result<Config, Error> {
-    let fail = |problem: String| Error::Manifest {
-        problem: crate::error::one_line(&problem),
-    };
-    let value: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| fail(format!("not JSON: {e}")))?;
-    let config = value
-        .get("config")
-        .ok_or_else(|| fail("no key 'config'".to_string()))?;
-    Config::deserialize(config)
-        .map_err(|e| fail(format!("key 'config' is not a specfx configuration: {e}")))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -720,22 +696,6 @@ mod tests {
                 assert_eq!(hex_word(v, width), want, "{v} in {width} bits");
             }
         }
-    }
-
-    #[test]
-    fn manifest_errors_are_one_line() {
-        let e = manifest_config("{\"config\": {\"name\": \"x\", \"variant\": \"a\\nb\"}}")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.starts_with("key 'config' is not a specfx configuration: unknown variant `a b`, expected `plain` or `minimax`"),
-            "{e}"
-        );
-        let e = manifest_config("{\n").unwrap_err().to_string();
-        assert!(
-            e.starts_with("not JSON: EOF while parsing an object"),
-            "{e}"
-        );
     }
 
     #[test]
