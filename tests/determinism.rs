@@ -1,6 +1,7 @@
 //! The same command gives the same bytes: each main command is run twice, with one and with two
 //! threads, and every file it writes is compared (measured speed lives in `measured_*` files,
-//! the only ones allowed to differ).
+//! the only ones allowed to differ). The whole `report` (which also covers `fit`, `tradeoff`
+//! and `cost`) is compared the same way in `tests/report.rs`, where its runs are shared.
 
 mod common;
 use common::snapshot;
@@ -117,4 +118,47 @@ fn optimize_is_the_same_bytes() {
         ],
         Some("--out"),
     );
+}
+
+#[test]
+fn the_cycle_models_trace_is_the_same_bytes() {
+    same_bytes(
+        "sim",
+        &[
+            "sim",
+            "--arch",
+            "folded",
+            "--cycles",
+            "2000",
+            "--vcd-cycles",
+            "300",
+        ],
+        Some("--vcd"),
+    );
+}
+
+#[test]
+fn the_verilog_rom_and_parameters_are_the_same_bytes() {
+    same_bytes(
+        "rom",
+        &[
+            "hdl",
+            "rom",
+            "--config",
+            &common::config_path("minimax_folded.toml"),
+        ],
+        Some("--out"),
+    );
+    same_bytes(
+        "params",
+        &[
+            "hdl", "params", "--config", "baseline", "--format", "define",
+        ],
+        Some("--out"),
+    );
+}
+
+#[test]
+fn the_papers_claims_are_the_same_bytes() {
+    same_bytes("paper", &["paper", "--json"], None);
 }
