@@ -280,3 +280,77 @@ fn existing_single_line_errors_are_unchanged_by_the_flags() {
     assert_eq!(text(&plain.stderr).lines().count(), 1);
     assert_eq!(text(&plain.stderr).lines().last(), Some(last));
 }
+
+#[test]
+fn completions_and_manual_pages_cover_every_command() {
+    // The commands, from the binary's own help (its "Commands:" block).
+    let help = text(&run(&["--help"], &[]).stdout);
+    let commands: Vec<String> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .filter(|c| c != "help")
+        .collect();
+    assert!(commands.len() > 20, "{commands:?}");
+    let bash = run(&["completions", "bash"], &[]);
+    assert!(bash.status.success());
+    let script = text(&bash.stdout);
+    assert!(script.contains("_specfx()"), "a bash completion function");
+    for c in &commands {
+        assert!(script.contains(c.as_str()), "completion of {c}");
+    }
+    let page = text(&run(&["man"], &[]).stdout);
+    assert!(page.contains(".TH specfx 1"), "{page}");
+
+    // --out: one page per command; a foreign file of the same name is kept, unless --force;
+    // the command's own pages are replaced.
+    let dir = temp("man");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("specfx-report.1"), "my notes\n").unwrap();
+    let o = run(&["man", "--out", dir.to_str().unwrap()], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("specfx-report.1: already exists") && err.lines().count() == 1,
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        1,
+        "nothing written"
+    );
+    let forced = run(&["man", "--out", dir.to_str().unwrap(), "--force"], &[]);
+    assert!(forced.status.success(), "{}", text(&forced.stderr));
+    for c in &commands {
+        let page = std::fs::read_to_string(dir.join(format!("specfx-{c}.1"))).unwrap();
+        assert!(page.contains(&format!(".TH specfx-{c} 1")), "{c}");
+    }
+    let again = run(&["man", "--out", dir.to_str().unwrap()], &[]);
+    assert!(again.status.success(), "{}", text(&again.stderr));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_minimax_table_replaces_only_a_minimax_table() {
+    let file = temp("minimax.csv");
+    std::fs::write(&file, "precious\n").unwrap();
+    let args = ["minimax", "--write", file.to_str().unwrap(), "--n-max", "2"];
+    let o = run(&args, &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("already exists and is not an earlier result"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "precious\n");
+    let forced = run(&[&args[..], &["--force"]].concat(), &[]);
+    assert!(forced.status.success(), "{}", text(&forced.stderr));
+    // k = 1..=7 for n = 1, 2 under the header.
+    let table = std::fs::read_to_string(&file).unwrap();
+    assert_eq!(table.lines().count(), 1 + 14, "{table}");
+    let again = run(&args, &[]);
+    assert!(again.status.success(), "{}", text(&again.stderr));
+    std::fs::remove_file(&file).unwrap();
+}

@@ -213,7 +213,13 @@ pub struct ManArgs {
     /// printing specfx.1.
     #[arg(long)]
     out: Option<std::path::PathBuf>,
+    /// Replace files of the same names that are not specfx manual pages.
+    #[arg(long)]
+    force: bool,
 }
+
+/// The first bytes of every manual page of specfx (clap_mangen's preamble, then the title).
+const MAN_HEADER: &str = ".ie \\n(.g .ds Aq \\(aq\n.el .ds Aq '\n.TH specfx";
 
 fn completions(args: &CompletionsArgs) -> anyhow::Result<Outcome> {
     let mut cmd = command();
@@ -243,13 +249,22 @@ fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
             })?;
         }
         Some(dir) => {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create {}", dir.display()))?;
-            output::write_atomic(&dir.join("specfx.1"), &render(cmd.clone())?)?;
+            // Every page is rendered and every file checked before the first is written: a
+            // file of the same name that is not a specfx manual page is kept (unless --force).
+            let mut pages = vec![(dir.join("specfx.1"), render(cmd.clone())?)];
             for sub in cmd.get_subcommands() {
                 let name = format!("specfx-{}", sub.get_name());
                 let page = render(sub.clone().name(name.clone()))?;
-                output::write_atomic(&dir.join(format!("{name}.1")), &page)?;
+                pages.push((dir.join(format!("{name}.1")), page));
+            }
+            for (path, page) in &pages {
+                debug_assert!(page.starts_with(MAN_HEADER.as_bytes()));
+                output::check_file_output(path, "--out", &[], Some(MAN_HEADER), args.force)?;
+            }
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", dir.display()))?;
+            for (path, page) in &pages {
+                output::write_atomic(path, page)?;
             }
         }
     }

@@ -109,6 +109,9 @@ pub struct MinimaxArgs {
     /// (the library embeds data/minimax.csv).
     #[arg(long, value_name = "FILE")]
     write: Option<PathBuf>,
+    /// Replace an existing --write file that is not a minimax table.
+    #[arg(long)]
+    force: bool,
     /// Largest n of a recomputed table.
     #[arg(long, default_value_t = TABLE_N_MAX)]
     n_max: u32,
@@ -120,7 +123,7 @@ pub struct MinimaxArgs {
 /// Runs `specfx minimax`.
 pub fn run_minimax(args: &MinimaxArgs) -> Result<Outcome> {
     if let Some(path) = &args.write {
-        return write_table(path, args.n_max);
+        return write_table(path, args.n_max, args.force);
     }
     if let Some(&k) = args.k.values().iter().find(|&&k| !K_RANGE.contains(&k)) {
         bail!("--k: expected numbers of squarings in 1..=7, got {k}");
@@ -139,10 +142,14 @@ pub fn run_minimax(args: &MinimaxArgs) -> Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
-fn write_table(path: &std::path::Path, n_max: u32) -> Result<Outcome> {
+/// The first line of a minimax table (`write_minimax_table`).
+const TABLE_HEADER: &str = "k,n,a,b,max_abs_err,plain_max_abs_err\n";
+
+fn write_table(path: &std::path::Path, n_max: u32, force: bool) -> Result<Outcome> {
     if n_max == 0 {
         bail!("--n-max: expected at least 1, got 0");
     }
+    super::output::check_file_output(path, "--write", &[], Some(TABLE_HEADER), force)?;
     let jobs: Vec<(u32, u32)> = K_RANGE
         .flat_map(|k| (1..=n_max).map(move |n| (k, n)))
         .collect();
