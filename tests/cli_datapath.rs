@@ -239,10 +239,24 @@ fn vectors_are_complete_correct_deterministic_and_not_overwritten() {
         assert_eq!(v, r[7]);
     }
 
-    // The same command again is refused, and changes nothing.
+    // The same command again replaces its own earlier result with the same bytes; a
+    // directory that is not a vector directory is refused without --force, and kept.
+    let before = std::fs::read(dir.join("vectors.csv")).unwrap();
     let o = specfx(&a);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(dir.join("vectors.csv")).unwrap(), before);
+    let mine = temp_path("vec-mine");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    let mut m: Vec<&str> = args.to_vec();
+    m.push(mine.to_str().unwrap());
+    let o = specfx(&m);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("--force"));
+    assert!(stderr(&o).contains("--force"), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read_to_string(mine.join("notes.txt")).unwrap(),
+        "mine"
+    );
     // With --force into another directory, the files are byte-identical.
     let dir2 = temp_path("vec2");
     let mut b: Vec<&str> = args.to_vec();

@@ -533,3 +533,50 @@ fn tradeoff_replaces_only_its_own_earlier_result() {
     }
     assert!(dir.join("t/tradeoff.csv").is_file());
 }
+
+#[test]
+fn vectors_never_write_over_a_directory_that_is_not_theirs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::create_dir(dir.join("vz")).unwrap();
+    std::fs::write(dir.join("precious.txt"), "mine").unwrap();
+    std::fs::create_dir(dir.join("mydata.partial")).unwrap();
+    std::fs::write(dir.join("mydata.partial/thesis.tex"), "mine").unwrap();
+    let vectors = ["vectors", "--n", "16", "--cases", "corner", "--out"];
+    fn with<'a>(vectors: &[&'a str], out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+        [vectors, &[out], extra].concat()
+    }
+    let with = |out: &'static str, extra: &[&'static str]| with(&vectors, out, extra);
+    // Paths without a directory name of their own: refused before anything is touched.
+    for out in [".", "..", "vz/.."] {
+        let o = run_in(dir, &with(out, &["--force"]));
+        assert_refused(&o, "expected a directory name", out);
+    }
+    // A vector directory given as the configuration is not replaced, even with --force.
+    assert!(run_in(dir, &with("v", &[])).status.success());
+    std::fs::write(dir.join("v/notes.txt"), "mine").unwrap();
+    for config in ["v", "v/manifest.json"] {
+        let mut args = with("v", &["--force"]);
+        args.extend(["--config", config]);
+        let o = run_in(dir, &args);
+        assert_refused(&o, "the input --config", config);
+    }
+    // A trailing slash names the same directory; the earlier result is replaced without
+    // --force, and nobody's `<name>.partial` is touched.
+    assert!(run_in(dir, &with("mydata/", &[])).status.success());
+    assert!(run_in(dir, &with("mydata", &[])).status.success());
+    for kept in ["precious.txt", "mydata.partial/thesis.tex", "v/notes.txt"] {
+        assert_eq!(
+            std::fs::read_to_string(dir.join(kept)).unwrap(),
+            "mine",
+            "{kept}"
+        );
+    }
+    assert!(dir.join("mydata/manifest.json").is_file());
+    let hidden: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "staging left behind: {hidden:?}");
+}

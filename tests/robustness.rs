@@ -544,6 +544,28 @@ const CASES: &[Case] = &[
         inputs: &[Input::File("sc.toml", "not toml at all")],
         expect: "line",
     },
+    // Found from outside (issue 14, third pass): limits stated before the work, and device
+    // nodes never replaced by a file.
+    Case {
+        args: &["minimax", "--write", "{dir}/m.csv", "--n-max", "4294967295"],
+        inputs: &[],
+        expect: "--n-max: expected 1..=65535, got 4294967295",
+    },
+    Case {
+        args: &["sim", "--cycles", "18446744073709551615"],
+        inputs: &[],
+        expect: "--cycles: expected 1..=1000000000",
+    },
+    Case {
+        args: &["hdl", "rom", "--out", "/dev/null", "--force"],
+        inputs: &[],
+        expect: "--out /dev/null: is not a regular file",
+    },
+    Case {
+        args: &["vectors", "--n", "16", "--cases", "corner", "--out", "{dir}/vz/..", "--force"],
+        inputs: &[],
+        expect: "expected a directory name",
+    },
 ];
 
 /// How long a case may run before it counts as hung.

@@ -165,7 +165,15 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         None => {
             let dp = super::datapath::load(&args.config, args.n.as_ref())?;
             let dir = wd.join("vectors");
-            super::vectors::write_dir(&dp, &dir, &args.cases, args.order, args.run.seed, false)?;
+            super::vectors::write_dir(
+                &dp,
+                &dir,
+                &args.cases,
+                args.order,
+                args.run.seed,
+                false,
+                &[],
+            )?;
             dir
         }
     };

@@ -205,6 +205,9 @@ impl OutDir {
         inputs: &[(&str, PathBuf)],
         resume: Option<bool>,
     ) -> Result<(OutDir, bool)> {
+        // `dir/` and `dir/.` name `dir` (components() drops a trailing `.`); `.`, `..` and
+        // `dir/..` have no name of their own and are refused below.
+        let target = &target.components().collect::<PathBuf>();
         refuse_over_inputs(target, "--out", inputs)?;
         let name = target
             .file_name()
@@ -433,6 +436,13 @@ pub fn check_file_output(
     if out.is_dir() {
         anyhow::bail!(
             "{flag} {}: is a directory, expected a file path",
+            out.display()
+        );
+    }
+    // A device, FIFO or socket is never replaced by a file, even with --force.
+    if out.exists() && !out.is_file() {
+        anyhow::bail!(
+            "{flag} {}: is not a regular file, expected a file path",
             out.display()
         );
     }

@@ -146,8 +146,8 @@ pub fn run_minimax(args: &MinimaxArgs) -> Result<Outcome> {
 const TABLE_HEADER: &str = "k,n,a,b,max_abs_err,plain_max_abs_err\n";
 
 fn write_table(path: &std::path::Path, n_max: u32, force: bool) -> Result<Outcome> {
-    if n_max == 0 {
-        bail!("--n-max: expected at least 1, got 0");
+    if !(1..=specfx::nset::N_MAX).contains(&n_max) {
+        bail!("--n-max: expected 1..={}, got {n_max}", specfx::nset::N_MAX);
     }
     super::output::check_file_output(path, "--write", &[], Some(TABLE_HEADER), force)?;
     let jobs: Vec<(u32, u32)> = K_RANGE

@@ -451,6 +451,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         specfx::golden::Order::Interleaved,
         1,
         true,
+        &[],
     )?;
     written.push(vectors_dir.clone());
 

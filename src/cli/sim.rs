@@ -64,10 +64,13 @@ pub struct SimArgs {
     json: bool,
 }
 
+/// The most cycles `specfx sim` simulates (about a minute and a half on one core).
+const MAX_CYCLES: u64 = 1_000_000_000;
+
 /// Runs `specfx sim`. Exit code 1 when any output differs from the functional model.
 pub fn run(args: &SimArgs) -> Result<Outcome> {
-    if args.cycles == 0 {
-        bail!("--cycles: expected at least 1, got 0");
+    if !(1..=MAX_CYCLES).contains(&args.cycles) {
+        bail!("--cycles: expected 1..={MAX_CYCLES}, got {}", args.cycles);
     }
     let dp = super::datapath::load(&args.config, args.n.as_ref())?;
     if let Some(path) = &args.vcd {

@@ -5,7 +5,7 @@ use std::fs::{self, File};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 
 use super::Outcome;
@@ -23,7 +23,8 @@ pub struct VectorsArgs {
     /// A TOML configuration file, or a built-in name: baseline.
     #[arg(long, default_value = "baseline")]
     config: String,
-    /// The directory to write (refused if it exists, unless --force).
+    /// The directory to write. It is written completely or not at all, and replaces only an
+    /// earlier vector directory (or an empty one) unless --force; never the configuration.
     #[arg(long)]
     out: PathBuf,
     /// Exponents, replacing the configuration's set.
@@ -39,7 +40,7 @@ pub struct VectorsArgs {
     /// sorted (by n, then c).
     #[arg(long, default_value = "interleaved")]
     order: Order,
-    /// Replace an existing directory.
+    /// Replace an existing directory that is not an earlier vector directory.
     #[arg(long)]
     force: bool,
 }
@@ -54,6 +55,7 @@ pub fn run(args: &VectorsArgs) -> Result<Outcome> {
         args.order,
         args.seed,
         args.force,
+        &super::output::config_inputs_as("--config", &args.config),
     )?;
     super::output::outln!(
         "wrote {n} vectors ({}, {} order, seed {}) to {}",
@@ -66,9 +68,9 @@ pub fn run(args: &VectorsArgs) -> Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
-/// Writes a vector directory: everything goes to `<out>.partial` first, which is renamed to
-/// `out` only once complete, so an interrupted run never leaves a half-written vector file
-/// under `out`. Returns the number of vectors and their coverage.
+/// Writes a vector directory, staged ([`super::output::OutDir`]): complete or absent, an
+/// existing directory replaced only when it is an earlier vector directory (or empty, or with
+/// `force`), never one of `inputs`. Returns the number of vectors and their coverage.
 pub fn write_dir(
     dp: &Datapath,
     out: &Path,
@@ -76,24 +78,13 @@ pub fn write_dir(
     order: Order,
     seed: u64,
     force: bool,
+    inputs: &[(&str, PathBuf)],
 ) -> Result<(u64, Coverage)> {
     let mut cases = cases::select(dp, selection, seed)
         .with_context(|| format!("config {}", dp.config().name))?;
     cases::order(&mut cases, order, seed);
-    if out.exists() && !force {
-        bail!(
-            "{} already exists: pass --force to replace it",
-            out.display()
-        );
-    }
-    let mut partial = out.as_os_str().to_owned();
-    partial.push(".partial");
-    let partial = PathBuf::from(partial);
-    if partial.exists() {
-        fs::remove_dir_all(&partial)
-            .with_context(|| format!("cannot remove {}", partial.display()))?;
-    }
-    fs::create_dir_all(&partial).with_context(|| format!("cannot create {}", partial.display()))?;
+    let staged = super::output::OutDir::begin(out, "vectors", force, inputs)?;
+    let partial = staged.path().to_path_buf();
 
     let ports = ports(dp);
     let open = |name: &str| -> Result<HashingWriter<BufWriter<File>>> {
@@ -167,11 +158,7 @@ pub fn write_dir(
     json.push(b'\n');
     fs::write(partial.join("manifest.json"), json)
         .with_context(|| format!("cannot write {}", partial.join("manifest.json").display()))?;
-    if out.exists() {
-        fs::remove_dir_all(out).with_context(|| format!("cannot replace {}", out.display()))?;
-    }
-    fs::rename(&partial, out)
-        .with_context(|| format!("cannot rename {} to {}", partial.display(), out.display()))?;
+    staged.commit()?;
     log::debug!(
         "vectors: wrote {} (vectors.csv, {} $readmemh files, manifest.json)",
         out.display(),
