@@ -221,7 +221,10 @@ impl OutDir {
         // A run killed between moving the previous result aside and renaming its own into
         // place left the previous result as `.<name>.old-<pid>`: it is put back first.
         if !target.exists() && !target.is_symlink() {
-            if let Some((old, _)) = stale(&parent, &name).into_iter().find(|(_, p)| !p) {
+            let moved_aside = stale(&parent, &name)
+                .into_iter()
+                .find(|(p, partial)| !partial && p.join(MARKER).is_file());
+            if let Some((old, _)) = moved_aside {
                 let _ = std::fs::rename(old, target);
             }
         }
@@ -356,8 +359,13 @@ fn stale(parent: &Path, name: &str) -> Vec<(PathBuf, bool)> {
                 .map(|pid| (pid, *tag == ".partial-"))
         });
         if let Some((pid, partial)) = tagged {
-            if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
-                found.push((e.path(), partial));
+            // Only what specfx wrote: a directory with its marker (or still empty, killed
+            // before the marker); a user's directory of the same shape is left alone.
+            let path = e.path();
+            let ours = path.join(MARKER).is_file()
+                || std::fs::read_dir(&path).is_ok_and(|mut d| d.next().is_none());
+            if ours && pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+                found.push((path, partial));
             }
         }
     }
@@ -590,5 +598,15 @@ mod tests {
             target.join("done.txt").exists(),
             "untouched without a commit"
         );
+
+        // A user's directory of that shape, without the marker, is not a result: left alone.
+        let other = tmp.path().join("s");
+        let theirs = other.with_file_name(".s.old-999999999");
+        std::fs::create_dir(&theirs).unwrap();
+        std::fs::write(theirs.join("notes.txt"), "mine").unwrap();
+        let out = OutDir::begin(&other, "report", false, &[]).unwrap();
+        assert!(!other.exists());
+        drop(out);
+        assert!(theirs.exists());
     }
 }
