@@ -226,6 +226,13 @@ fn bad_scenes_name_what_is_wrong() {
         ),
         ("intensity = 1", "intensity = inf", "light[0].intensity"),
         ("[shading]", "[shading]\nglow = 1", "line"),
+        // Material names end up in budgets and file headers: the configuration-name rule.
+        (
+            "name = \"m\"",
+            "name = \"m\\nmax_lsb = 1\"",
+            "material[0].name: expected 1..=64 ASCII letters",
+        ),
+        ("name = \"m\"", "name = \"a]b\"", "material[0].name"),
     ] {
         assert!(good.contains(from), "{from}");
         let bad = good.replacen(from, to, 1);
@@ -233,6 +240,48 @@ fn bad_scenes_name_what_is_wrong() {
         assert!(err.contains(expect), "{to}: {err}");
         assert_eq!(err.lines().count(), 1, "{err}");
     }
+}
+
+/// The limits on lights and on pixels x lights hold at their edges: 256 lights pass and 257
+/// do not; 8192 x 8192 pixels pass with one light and not with two.
+#[test]
+fn lights_are_limited_before_any_work() {
+    let good = sphere_scene(0.1, 64, 1.0, 0.03);
+    let light = "[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, 1.0]\n";
+    let with = |lights: usize, size: u32| {
+        let size = format!("width = {size}\nheight = {size}");
+        format!(
+            "{}{}",
+            good.replacen("width = 3\nheight = 3", &size, 1),
+            light.repeat(lights - 1)
+        )
+    };
+    assert!(Scene::from_toml(&with(256, 3)).is_ok());
+    let err = Scene::from_toml(&with(257, 3)).unwrap_err().to_string();
+    assert!(
+        err.contains("light: expected 1 to 256 [[light]] tables, got 257"),
+        "{err}"
+    );
+    assert!(Scene::from_toml(&with(1, 8192)).is_ok());
+    let err = Scene::from_toml(&with(2, 8192)).unwrap_err().to_string();
+    assert!(
+        err.contains("is 134217728, above the limit of 67108864"),
+        "{err}"
+    );
+}
+
+/// A scene without `[shading]` gets what an empty `[shading]` gets, as documented: ambient
+/// 0.03 and Blinn-Phong.
+#[test]
+fn a_scene_without_shading_gets_the_documented_defaults() {
+    let good = sphere_scene(0.1, 64, 1.0, 0.5);
+    let table = "[shading]\nmodel = \"phong\"\nambient = 0.5\n";
+    assert!(good.contains(table));
+    let without = Scene::from_toml(&good.replacen(table, "", 1)).unwrap();
+    let empty = Scene::from_toml(&good.replacen(table, "[shading]\n", 1)).unwrap();
+    assert_eq!(without.shading.ambient, 0.03);
+    assert_eq!(without.shading, empty.shading);
+    assert_eq!(without.shading.model, specfx::scene::Model::BlinnPhong);
 }
 
 #[test]

@@ -1171,6 +1171,34 @@ pub fn float_cosines(c_bits: u32) -> Vec<f64> {
 /// How many exponents are evaluated in parallel between two progress reports.
 const CHUNK: usize = 64;
 
+/// The most samples one map may take (2^34, a few minutes on two cores): see [`samples`].
+pub const MAX_SAMPLES: u64 = 1 << 34;
+
+/// How many samples [`map`] takes on `grid`: each float path at every exponent and each of its
+/// `2^c_bits + 1` cosines, each datapath at every exponent and each of its input codes in
+/// [0, 1] (`2^f + 1` for `f` fraction bits). Saturates at `u64::MAX`.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::stability::{samples, FloatPath, Grid, Path};
+/// let grid = Grid { n: "1..=10".parse().unwrap(), c_bits: 4, ..Grid::default() };
+/// let paths = [Path::Float(FloatPath::PowI), Path::Float(FloatPath::PowF32)];
+/// assert_eq!(samples(&paths, &grid), 2 * 10 * 17);
+/// ```
+pub fn samples(paths: &[Path], grid: &Grid) -> u64 {
+    let ns = grid.n.values().len() as u128;
+    let codes = |bits: i64| (1u128 << bits.clamp(0, 100)) + 1;
+    let total: u128 = paths
+        .iter()
+        .map(|p| match p {
+            Path::Float(_) => codes(i64::from(grid.c_bits)),
+            Path::Fixed(c) => codes(i64::from(c.c.format.frac_bits())),
+        })
+        .map(|per_n| per_n * ns)
+        .sum();
+    u64::try_from(total).unwrap_or(u64::MAX)
+}
+
 /// Maps every path over the grid. `progress(done, total)` is called after each chunk of
 /// exponents (of the float paths together, then of each datapath).
 ///
@@ -1199,6 +1227,14 @@ pub fn map(
             what: "c_bits",
             expected: "in 1..=24".into(),
             got: grid.c_bits.to_string(),
+        });
+    }
+    let work = samples(paths, grid);
+    if work > MAX_SAMPLES {
+        return Err(Error::OutOfRange {
+            what: "samples (exponents x cosines, summed over the paths)",
+            expected: format!("at most 2^34 = {MAX_SAMPLES}"),
+            got: work.to_string(),
         });
     }
     let ns = grid.n.values();

@@ -397,7 +397,9 @@ fn write_fit(
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let header = format!(
         "# specfx fit: the cheapest datapath found that renders {} within '{}' (against f64 cos^n),\n# proved on all {} inputs the scene produces; see fit.md.\n",
-        r.scene, r.budget, r.inputs
+        r.scene.escape_debug(),
+        r.budget,
+        r.inputs
     );
     write_atomic(
         &out.join("fitted.toml"),

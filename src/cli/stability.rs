@@ -218,6 +218,16 @@ pub fn run(args: &StabilityArgs) -> Result<Outcome> {
     if !(1..=24).contains(&grid.c_bits) {
         bail!("--c-bits: expected 1..=24, got {}", grid.c_bits);
     }
+    let work = specfx::analysis::stability::samples(&paths, &grid);
+    if work > specfx::analysis::stability::MAX_SAMPLES {
+        bail!(
+            "--n, --c-bits, --float and --config: {} paths x {} exponents x their cosines is {work} samples, \
+             above the limit of 2^34 = {}; map fewer exponents, a coarser --c-bits or fewer paths",
+            paths.len(),
+            grid.n.values().len(),
+            specfx::analysis::stability::MAX_SAMPLES
+        );
+    }
     let out_dir = super::output::OutDir::begin(
         &args.out,
         "stability",

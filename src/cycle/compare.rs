@@ -12,10 +12,14 @@
 //!    `z` in the **first** file is don't-care (the model writes `x` where a register holds no
 //!    valid data), and every other bit must be equal in the second.
 //!
+//! A file must be well-formed VCD: scopes nested at most [`MAX_SCOPE_DEPTH`] deep, a header of
+//! at most [`MAX_HEADER_BYTES`], every value change for a declared identifier and no wider
+//! than its variable, time never going back. Anything else is an error naming the line.
+//!
 //! Reads from any `io::BufRead`; the files are the caller's business.
 
 use std::collections::HashMap;
-use std::io::BufRead;
+use std::io::{BufRead, Read};
 
 use vcd::{Command, IdCode, ReferenceIndex, ScopeItem, Value, VarType};
 
@@ -27,6 +31,73 @@ pub const CLOCK: &str = "tb_specfx.clk";
 pub const RESET: &str = "tb_specfx.rst";
 /// The cycle counter samples are keyed by.
 pub const CYCLE: &str = "tb_specfx.cycle";
+/// The deepest `$scope` nesting a trace may have (the parser recurses per scope).
+pub const MAX_SCOPE_DEPTH: usize = 256;
+/// The longest header (everything up to `$enddefinitions`) a trace may have: 64 MiB.
+pub const MAX_HEADER_BYTES: u64 = 64 << 20;
+
+/// The trace with its header checked for depth and length (read whole, so that the parser,
+/// which recurses per scope, cannot overflow the stack), followed by the rest of it.
+fn guarded<R: BufRead>(which: usize, mut r: R) -> Result<impl BufRead, Error> {
+    let mut header = Vec::new();
+    let (mut depth, mut line, mut skipping) = (0usize, 0u64, false);
+    loop {
+        let start = header.len();
+        let room = MAX_HEADER_BYTES + 1 - start as u64;
+        let got = (&mut r)
+            .take(room)
+            .read_until(b'\n', &mut header)
+            .map_err(|e| trace_error(which, format!("cannot read it: {e}")))?;
+        if got == 0 {
+            break;
+        }
+        if header.len() as u64 > MAX_HEADER_BYTES {
+            return Err(trace_error(
+                which,
+                format!(
+                    "the header (up to $enddefinitions) is longer than {MAX_HEADER_BYTES} bytes"
+                ),
+            ));
+        }
+        line += 1;
+        let mut done = false;
+        for token in header[start..].split(|b| b.is_ascii_whitespace()) {
+            match token {
+                b"$end" => skipping = false,
+                _ if skipping => {}
+                b"$comment" | b"$date" | b"$version" => skipping = true,
+                b"$scope" => {
+                    depth += 1;
+                    if depth > MAX_SCOPE_DEPTH {
+                        return Err(trace_error(
+                            which,
+                            format!("line {line}: $scope nested deeper than {MAX_SCOPE_DEPTH}"),
+                        ));
+                    }
+                }
+                b"$upscope" => depth = depth.saturating_sub(1),
+                b"$enddefinitions" => done = true,
+                _ => {}
+            }
+        }
+        if done {
+            break;
+        }
+    }
+    Ok(std::io::Cursor::new(header).chain(r))
+}
+
+/// A parser's error as `line N: what` (the parser's own errors carry their line; a read
+/// error takes the parser's current line).
+fn parse_failure(e: &std::io::Error, line: u64) -> String {
+    match e
+        .get_ref()
+        .and_then(|i| i.downcast_ref::<vcd::ParseError>())
+    {
+        Some(p) => format!("line {}: {}", p.line(), p.kind()),
+        None => format!("line {line}: {e}"),
+    }
+}
 
 /// A signal whose widths differ between the files.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -99,6 +170,21 @@ struct Var {
 
 fn trace_error(which: usize, problem: String) -> Error {
     Error::Trace { which, problem }
+}
+
+/// Every identifier code the file declares, with its variable's width (the widest, when one
+/// code is declared twice).
+fn declared(items: &[ScopeItem], out: &mut HashMap<IdCode, u32>) {
+    for item in items {
+        match item {
+            ScopeItem::Scope(s) => declared(&s.items, out),
+            ScopeItem::Var(v) => {
+                let w = out.entry(v.code).or_insert(v.size);
+                *w = (*w).max(v.size);
+            }
+            _ => {}
+        }
+    }
 }
 
 /// The file's variables in declaration order, full names unique (the first kept).
@@ -217,11 +303,16 @@ struct Reader<R> {
     cycle: usize,
     /// Per compared signal, its slot.
     signal_slots: Vec<usize>,
+    /// Every declared identifier code and its width.
+    declared: HashMap<IdCode, u32>,
+    /// The last time step seen.
+    time: Option<u64>,
 }
 
 impl<R: BufRead> Reader<R> {
     /// Prepares to sample `compared` (full names) of a file whose variables are `vars`.
-    fn new(which: usize, parser: vcd::Parser<R>, vars: &[Var], compared: &[&str]) -> Reader<R> {
+    fn new(which: usize, parser: vcd::Parser<R>, header: &Header, compared: &[&str]) -> Reader<R> {
+        let vars = &header.vars;
         let mut slots = HashMap::new();
         let mut current = Vec::new();
         let mut slot_of = |v: &Var| -> usize {
@@ -247,6 +338,8 @@ impl<R: BufRead> Reader<R> {
             rst,
             cycle,
             signal_slots,
+            declared: header.declared.clone(),
+            time: None,
         }
     }
 
@@ -259,9 +352,12 @@ impl<R: BufRead> Reader<R> {
     ) -> Result<(), Error> {
         let mut batch: Vec<(usize, Vec<Value>)> = Vec::new();
         loop {
-            let command = self.parser.next().transpose().map_err(|e| {
-                trace_error(self.which, format!("line {}: {e}", self.parser.line()))
-            })?;
+            let command = self
+                .parser
+                .next()
+                .transpose()
+                .map_err(|e| trace_error(self.which, parse_failure(&e, self.parser.line())))?;
+            self.check(&command)?;
             let end_of_step = matches!(command, None | Some(Command::Timestamp(_)));
             if end_of_step {
                 let clk_before = self.current[self.clk].last().copied();
@@ -288,6 +384,35 @@ impl<R: BufRead> Reader<R> {
                 }
                 Some(_) => {}
             }
+        }
+    }
+
+    /// Refuses a change of an undeclared identifier, a value wider than its variable and a
+    /// time step before the last.
+    fn check(&mut self, command: &Option<Command>) -> Result<(), Error> {
+        let line = self.parser.line();
+        let fail = |what: String| Err(trace_error(self.which, format!("line {line}: {what}")));
+        let (id, bits) = match command {
+            Some(Command::Timestamp(t)) => {
+                if let Some(last) = self.time.filter(|&last| *t < last) {
+                    return fail(format!("time #{t} goes back (the last was #{last})"));
+                }
+                self.time = Some(*t);
+                return Ok(());
+            }
+            Some(Command::ChangeScalar(id, _)) => (id, 1),
+            Some(Command::ChangeVector(id, v)) => (id, v.len()),
+            Some(Command::ChangeReal(id, _)) | Some(Command::ChangeString(id, _)) => (id, 0),
+            _ => return Ok(()),
+        };
+        match self.declared.get(id) {
+            None => fail(format!(
+                "a value for identifier '{id}', which no $var declares"
+            )),
+            Some(&w) if bits > w as usize => fail(format!(
+                "a value of {bits} bits for identifier '{id}', a variable of {w} bits"
+            )),
+            Some(_) => Ok(()),
         }
     }
 
@@ -365,18 +490,34 @@ fn differs(first: &Packed, second: &Packed, offset: usize, width: u32) -> bool {
     })
 }
 
+/// What a file's header declares.
+struct Header {
+    /// The variables, full names unique.
+    vars: Vec<Var>,
+    /// Every identifier code and its width.
+    declared: HashMap<IdCode, u32>,
+}
+
 /// The variables of a file's header, which must hold the clock and the cycle counter.
-fn header<R: BufRead>(which: usize, p: &mut vcd::Parser<R>) -> Result<Vec<Var>, Error> {
-    let h = p
-        .parse_header()
-        .map_err(|e| trace_error(which, format!("not a VCD file: line {}: {e}", p.line())))?;
+fn header<R: BufRead>(which: usize, p: &mut vcd::Parser<R>) -> Result<Header, Error> {
+    let h = p.parse_header().map_err(|e| {
+        trace_error(
+            which,
+            format!("not a VCD file: {}", parse_failure(&e, p.line())),
+        )
+    })?;
     let vars = variables(&h.items);
     for needed in [CLOCK, CYCLE] {
         if !vars.iter().any(|v| v.name == needed) {
             return Err(trace_error(which, format!("no signal {needed}")));
         }
     }
-    Ok(vars)
+    let mut ids = HashMap::new();
+    declared(&h.items, &mut ids);
+    Ok(Header {
+        vars,
+        declared: ids,
+    })
 }
 
 /// Compares two VCD traces of the testbench (see the module documentation); `first`'s `x` and
@@ -401,16 +542,17 @@ fn header<R: BufRead>(which: usize, p: &mut vcd::Parser<R>) -> Result<Vec<Var>, 
 /// assert_eq!(c.cycles_compared, 2); // cycle 0: v is x in the model, don't-care
 /// ```
 pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, Error> {
-    let mut pa = vcd::Parser::new(first);
-    let mut pb = vcd::Parser::new(second);
-    let va = header(0, &mut pa)?;
-    let vb = header(1, &mut pb)?;
+    let mut pa = vcd::Parser::new(guarded(0, first)?);
+    let mut pb = vcd::Parser::new(guarded(1, second)?);
+    let ha = header(0, &mut pa)?;
+    let hb = header(1, &mut pb)?;
+    let (va, vb) = (&ha.vars, &hb.vars);
     let by_name_b: HashMap<&str, &Var> = vb.iter().map(|v| (v.name.as_str(), v)).collect();
     let by_name_a: HashMap<&str, &Var> = va.iter().map(|v| (v.name.as_str(), v)).collect();
     let mut compared: Vec<(&str, u32)> = Vec::new();
     let mut width_mismatches = Vec::new();
     let mut only_first = Vec::new();
-    for a in &va {
+    for a in va {
         match by_name_b.get(a.name.as_str()) {
             None => only_first.push(a.name.clone()),
             Some(b) if b.width != a.width => width_mismatches.push(WidthMismatch {
@@ -432,7 +574,7 @@ pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, 
     // The first file's samples, then the second's compared with them as they come.
     let mut samples_a: Vec<Packed> = Vec::new();
     let mut index_a: HashMap<u64, usize> = HashMap::new();
-    Reader::new(0, pa, &va, &names).run(&layout, |cycle, packed| {
+    Reader::new(0, pa, &ha, &names).run(&layout, |cycle, packed| {
         index_a.entry(cycle).or_insert_with(|| {
             samples_a.push(packed);
             samples_a.len() - 1
@@ -445,7 +587,7 @@ pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, 
     let mut first_cycle_of = vec![None::<u64>; compared.len()];
     let mut known = vec![false; compared.len()];
     let mut first_difference: Option<Difference> = None;
-    Reader::new(1, pb, &vb, &names).run(&layout, |cycle, b| {
+    Reader::new(1, pb, &hb, &names).run(&layout, |cycle, b| {
         if !seen_b.insert(cycle) {
             return Ok(());
         }
@@ -512,6 +654,89 @@ mod tests {
         assert_eq!(extend(&[X, V1], 3), [X, X, V1]);
         assert_eq!(extend(&[Z], 2), [Z, Z]);
         assert_eq!(extend(&[V1, V1, V0], 2), [V1, V0]);
+    }
+
+    const GOOD: &str = "$scope module tb_specfx $end $var reg 1 ! clk $end
+$var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end $enddefinitions $end
+#0 0! b0 \" bx #
+#5 1! #6 b1 \" b101 # #10 0! #15 1!
+";
+
+    /// `second`'s error against the good trace.
+    fn second_error(second: &str) -> String {
+        match compare(GOOD.as_bytes(), second.as_bytes()) {
+            Err(Error::Trace { which: 1, problem }) => problem,
+            other => panic!("{second}: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn malformed_traces_are_refused_with_their_line() {
+        assert!(compare(GOOD.as_bytes(), GOOD.as_bytes()).unwrap().agrees());
+        for (from, to, expect) in [
+            (
+                "b101 #",
+                "b101 %",
+                "line 4: a value for identifier '%', which no $var declares",
+            ),
+            (
+                "b101 #",
+                "b10101 #",
+                "line 4: a value of 5 bits for identifier '#', a variable of 4 bits",
+            ),
+            (
+                "#10 0!",
+                "#4 0!",
+                "line 4: time #4 goes back (the last was #6)",
+            ),
+            ("#15", "#1x", "line 4: "),
+        ] {
+            assert_eq!(
+                second_error(&GOOD.replacen(from, to, 1)).split_once(" at line"),
+                None
+            );
+            let e = second_error(&GOOD.replacen(from, to, 1));
+            assert!(e.starts_with(expect), "{to}: {e}");
+        }
+        // The line is said once: the parser's own errors carry it as "at line N".
+        let e = second_error(&GOOD.replacen("#6", "#6 q", 1));
+        assert_eq!(e, "line 4: unexpected character at start of command");
+    }
+
+    #[test]
+    fn deep_scopes_and_long_headers_are_refused_before_parsing() {
+        let at = |depth: usize| {
+            let scopes = "$scope module a $end\n".repeat(depth - 1);
+            let ups = "$upscope $end ".repeat(depth - 1);
+            GOOD.replacen("$var reg", &format!("{scopes}$var reg"), 1)
+                .replacen("$upscope", &format!("{ups}$upscope"), 1)
+        };
+        // 256 deep is read (and compared: the clock is then not tb_specfx.clk); 257 is not.
+        let e = second_error(&at(MAX_SCOPE_DEPTH));
+        assert_eq!(e, "no signal tb_specfx.clk");
+        let e = second_error(&at(MAX_SCOPE_DEPTH + 1));
+        assert_eq!(e, "line 256: $scope nested deeper than 256");
+        // Far deeper than the stack would allow the parser's recursion.
+        let e = second_error(&at(100_000));
+        assert_eq!(e, "line 256: $scope nested deeper than 256");
+        // `$scope` in a comment is not a scope.
+        let commented = GOOD.replacen(
+            "$scope",
+            &format!("$comment {} $end $scope", "$scope ".repeat(300)),
+            1,
+        );
+        assert!(compare(GOOD.as_bytes(), commented.as_bytes())
+            .unwrap()
+            .agrees());
+        let long = format!(
+            "$comment {} $end\n{GOOD}",
+            "x".repeat(MAX_HEADER_BYTES as usize)
+        );
+        let e = second_error(&long);
+        assert!(
+            e.starts_with("the header (up to $enddefinitions) is longer than"),
+            "{e}"
+        );
     }
 
     #[test]

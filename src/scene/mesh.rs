@@ -196,6 +196,9 @@ fn read_obj(bytes: &[u8], fail: impl Fn(String) -> Error) -> Result<Indexed, Err
             e.valid_up_to()
         ))
     })?;
+    // A byte-order mark is not part of the first line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    check_obj(text).map_err(&fail)?;
     let positions_and_faces: String = text
         .split_inclusive('\n')
         .filter(|line| !matches!(line.split_whitespace().next(), Some("vt" | "vn")))
@@ -225,7 +228,165 @@ fn read_obj(bytes: &[u8], fail: impl Fn(String) -> Error) -> Result<Indexed, Err
     Ok((vertices, faces))
 }
 
+/// Checks the position and face lines of an OBJ file before tobj reads it, so that an error
+/// names its line and what was expected (tobj says only "face parse error").
+fn check_obj(text: &str) -> Result<(), String> {
+    let mut vertices: i64 = 0;
+    for (i, line) in text.lines().enumerate() {
+        let shown = || line.trim().escape_debug().to_string();
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let numbers: Vec<&str> = words.collect();
+                if !(3..=7).contains(&numbers.len())
+                    || numbers.iter().any(|w| w.parse::<f32>().is_err())
+                {
+                    return Err(format!(
+                        "line {}: expected `v x y z` (three numbers, then optionally w or a colour), got '{}'",
+                        i + 1,
+                        shown()
+                    ));
+                }
+                vertices += 1;
+            }
+            Some("f") => {
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Err(format!(
+                        "line {}: expected `f` and at least three vertices (i, i/t, i//n or i/t/n), got '{}'",
+                        i + 1,
+                        shown()
+                    ));
+                }
+                for corner in corners {
+                    let index = corner.split('/').next().unwrap_or_default();
+                    let Ok(k) = index.parse::<i64>() else {
+                        return Err(format!(
+                            "line {}: expected a vertex index (an integer; negative counts back), got '{}'",
+                            i + 1,
+                            corner.escape_debug()
+                        ));
+                    };
+                    if k == 0 || k.unsigned_abs() > vertices.unsigned_abs() {
+                        return Err(format!(
+                            "line {}: vertex index {k} is out of range: {vertices} vertices come before this line",
+                            i + 1
+                        ));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Whether an STL file is binary: it does not start with `solid `, or it does (some exporters
+/// write that into a binary header) but its size is exactly a binary file's and it is not a
+/// valid ASCII one.
+fn stl_is_binary(bytes: &[u8]) -> bool {
+    let exact = bytes.get(80..84).is_some_and(|c| {
+        84 + 50 * u64::from(u32::from_le_bytes(c.try_into().expect("four bytes")))
+            == bytes.len() as u64
+    });
+    !bytes.starts_with(b"solid ") || (exact && check_ascii_stl(bytes).is_err())
+}
+
+/// Checks a binary STL's size against its triangle count.
+fn check_binary_stl(bytes: &[u8]) -> Result<(), String> {
+    let Some(count) = bytes.get(80..84) else {
+        return Err(format!(
+            "expected an ASCII STL (starting with `solid `) or a binary one (an 80-byte header and a 4-byte triangle count), got {} bytes",
+            bytes.len()
+        ));
+    };
+    let count = u32::from_le_bytes(count.try_into().expect("four bytes"));
+    let need = 84 + 50 * u64::from(count);
+    if (bytes.len() as u64) < need {
+        return Err(format!(
+            "binary STL: its header says {count} triangles, which take {need} bytes, but the file has {}",
+            bytes.len()
+        ));
+    }
+    Ok(())
+}
+
+/// Checks an ASCII STL line by line, so that an error names its line and what was expected.
+fn check_ascii_stl(bytes: &[u8]) -> Result<(), String> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        format!(
+            "ASCII STL: not UTF-8 text (an invalid byte at offset {})",
+            e.valid_up_to()
+        )
+    })?;
+    // What each line must be, in turn: a facet (or the end), its loop, three vertices, the
+    // loop's end and the facet's end.
+    const STEPS: [&str; 7] = [
+        "facet normal x y z",
+        "outer loop",
+        "vertex x y z",
+        "vertex x y z",
+        "vertex x y z",
+        "endloop",
+        "endfacet",
+    ];
+    let numbers = |w: &[&str]| w.iter().all(|x| x.parse::<f32>().is_ok_and(f32::is_finite));
+    let mut step = 0;
+    let mut last = 1;
+    for (i, line) in text.lines().enumerate().skip(1) {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        if words.is_empty() {
+            continue;
+        }
+        last = i + 1;
+        let ok = match step {
+            0 if words[0] == "endsolid" => return Ok(()),
+            0 => words.len() == 5 && words[..2] == ["facet", "normal"] && numbers(&words[2..]),
+            1 => words == ["outer", "loop"],
+            2..=4 => words.len() == 4 && words[0] == "vertex" && numbers(&words[1..]),
+            5 => words == ["endloop"],
+            _ => words == ["endfacet"],
+        };
+        if !ok {
+            let expected = if step == 0 {
+                "`facet normal x y z` or `endsolid`".to_string()
+            } else {
+                format!("`{}`", STEPS[step])
+            };
+            return Err(format!(
+                "line {}: expected {expected} (x y z finite numbers), got '{}'",
+                i + 1,
+                line.trim().escape_debug()
+            ));
+        }
+        step = (step + 1) % STEPS.len();
+    }
+    Err(format!(
+        "line {last}: the ASCII STL ends before `endsolid` (expected {})",
+        if step == 0 {
+            "a facet or `endsolid`"
+        } else {
+            STEPS[step]
+        }
+    ))
+}
+
 fn read_stl(bytes: &[u8], fail: impl Fn(String) -> Error) -> Result<Indexed, Error> {
+    let binary = stl_is_binary(bytes);
+    if binary {
+        check_binary_stl(bytes).map_err(&fail)?;
+    } else {
+        check_ascii_stl(bytes).map_err(&fail)?;
+    }
+    // stl_io takes any file starting with `solid ` for ASCII.
+    let mut owned;
+    let bytes = if binary && bytes.starts_with(b"solid ") {
+        owned = bytes.to_vec();
+        owned[..6].fill(0);
+        &owned[..]
+    } else {
+        bytes
+    };
     let mut cursor = std::io::Cursor::new(bytes);
     let mesh =
         stl_io::read_stl(&mut cursor).map_err(|e| fail(format!("not a readable STL file: {e}")))?;
@@ -328,6 +489,101 @@ mod tests {
         assert_eq!(
             m.triangles,
             vec![[[1.0, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]]
+        );
+    }
+
+    fn err(bytes: &[u8], format: MeshFormat) -> String {
+        Mesh::parse(bytes, format, 1.0, [0.0; 3], "m")
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn obj_errors_name_the_line_and_what_was_expected() {
+        let v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        for (tail, expect) in [
+            (
+                "f 1 2\n",
+                "line 4: expected `f` and at least three vertices",
+            ),
+            (
+                "f 1 2 x/1\n",
+                "line 4: expected a vertex index (an integer; negative counts back), got 'x/1'",
+            ),
+            (
+                "f 1 2 4\n",
+                "line 4: vertex index 4 is out of range: 3 vertices come before this line",
+            ),
+            ("f 1 2 -4\n", "line 4: vertex index -4 is out of range"),
+            ("f 0 1 2\n", "line 4: vertex index 0 is out of range"),
+            ("v 1 2\n", "line 4: expected `v x y z` (three numbers"),
+            ("v 1 2 z\n", "line 4: expected `v x y z`"),
+        ] {
+            let e = err(format!("{v}{tail}").as_bytes(), MeshFormat::Obj);
+            assert!(e.starts_with(&format!("m: {expect}")), "{tail}: {e}");
+        }
+        // A byte-order mark, CRLF line ends and negative indices are fine.
+        let bom = format!("\u{feff}{v}f -3 -2 -1\r\n").replace('\n', "\r\n");
+        let m = Mesh::parse(bom.as_bytes(), MeshFormat::Obj, 1.0, [0.0; 3], "m").unwrap();
+        assert_eq!(
+            m.triangles,
+            vec![[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]
+        );
+    }
+
+    #[test]
+    fn stl_errors_name_the_line_or_the_size() {
+        let facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
+        let good = format!("solid t\n{facet}endsolid t\n");
+        let m = Mesh::parse(good.as_bytes(), MeshFormat::Stl, 1.0, [0.0; 3], "m").unwrap();
+        assert_eq!(m.triangles.len(), 1);
+        for (from, to, expect) in [
+            (
+                "vertex 1 0 0",
+                "vertex 1 0",
+                "line 5: expected `vertex x y z`",
+            ),
+            ("endloop", "end loop", "line 7: expected `endloop`"),
+            (
+                "vertex 1 0 0",
+                "vertex 1 nan 0",
+                "line 5: expected `vertex x y z` (x y z finite",
+            ),
+            (
+                "endsolid t\n",
+                "",
+                "line 8: the ASCII STL ends before `endsolid`",
+            ),
+            (
+                "facet normal",
+                "facet",
+                "line 2: expected `facet normal x y z` or `endsolid`",
+            ),
+        ] {
+            let e = err(good.replacen(from, to, 1).as_bytes(), MeshFormat::Stl);
+            assert!(e.starts_with(&format!("m: {expect}")), "{to}: {e}");
+        }
+        // Binary: 84 header bytes, then 50 per triangle.
+        let mut bin = vec![0u8; 80];
+        bin.extend_from_slice(&2u32.to_le_bytes());
+        bin.extend_from_slice(&[0u8; 60]);
+        let e = err(&bin, MeshFormat::Stl);
+        assert_eq!(e, "m: binary STL: its header says 2 triangles, which take 184 bytes, but the file has 144");
+        assert!(err(&bin[..50], MeshFormat::Stl).contains("got 50 bytes"));
+        // A binary header that starts with `solid ` (some exporters write one) is still binary.
+        let mut tri = vec![0u8; 12];
+        for v in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            tri.extend(v.iter().flat_map(|x| x.to_le_bytes()));
+        }
+        tri.extend_from_slice(&[0, 0]);
+        let mut solid = b"solid exported".to_vec();
+        solid.resize(80, b' ');
+        solid.extend_from_slice(&1u32.to_le_bytes());
+        solid.extend_from_slice(&tri);
+        let m = Mesh::parse(&solid, MeshFormat::Stl, 1.0, [0.0; 3], "m").unwrap();
+        assert_eq!(
+            m.triangles,
+            vec![[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]
         );
     }
 

@@ -13,6 +13,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
 
+/// The most lights a scene may have.
+pub const MAX_LIGHTS: usize = 256;
+
+/// The most pixels x lights a scene may have (2^26: an 8192 x 8192 image with one light, or
+/// 1024 x 1024 with 64); each lit pixel keeps a specular term per light until it is shaded.
+pub const MAX_PIXEL_LIGHTS: u64 = 1 << 26;
+
 /// A validated scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -223,7 +230,7 @@ pub enum Model {
 }
 
 /// How surfaces are shaded.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Shading {
     /// `blinn_phong` (default) or `phong`.
@@ -236,6 +243,17 @@ pub struct Shading {
 
 fn default_ambient() -> f64 {
     0.03
+}
+
+impl Default for Shading {
+    /// What a scene without `[shading]` gets, the same as an empty `[shading]`: Blinn-Phong,
+    /// ambient 0.03.
+    fn default() -> Shading {
+        Shading {
+            model: Model::default(),
+            ambient: default_ambient(),
+        }
+    }
 }
 
 /// The kind of a light.
@@ -536,8 +554,27 @@ impl Scene {
                 format!("expected 0..=1, got {amb}"),
             );
         }
-        if self.lights.is_empty() {
-            return bad("light".into(), "expected at least one [[light]]".into());
+        if self.lights.is_empty() || self.lights.len() > MAX_LIGHTS {
+            return bad(
+                "light".into(),
+                format!(
+                    "expected 1 to {MAX_LIGHTS} [[light]] tables, got {}",
+                    self.lights.len()
+                ),
+            );
+        }
+        let work = u64::from(img.width) * u64::from(img.height) * self.lights.len() as u64;
+        if work > MAX_PIXEL_LIGHTS {
+            return bad(
+                "light".into(),
+                format!(
+                    "{} x {} pixels x {} lights is {work}, above the limit of {MAX_PIXEL_LIGHTS} \
+                     (each lit pixel keeps a term per light); use fewer lights or a smaller image",
+                    img.width,
+                    img.height,
+                    self.lights.len()
+                ),
+            );
         }
         for (i, l) in self.lights.iter().enumerate() {
             let key = |k: &str| format!("light[{i}].{k}");
@@ -565,13 +602,15 @@ impl Scene {
         }
         for (i, m) in self.materials.iter().enumerate() {
             let key = |k: &str| format!("material[{i}].{k}");
-            if m.name.is_empty() || self.material_index(&m.name) != Some(i) {
+            // Names end up in budget expressions, tables, CSV and file headers: the rule of
+            // configuration names.
+            if let Err(problem) = crate::pipeline::config::check_name(&m.name) {
+                return bad(key("name"), problem);
+            }
+            if self.material_index(&m.name) != Some(i) {
                 return bad(
                     key("name"),
-                    format!(
-                        "expected a unique, non-empty name, got '{}'",
-                        m.name.escape_debug()
-                    ),
+                    format!("expected a unique name, got '{}' again", m.name),
                 );
             }
             if !(1..=65535).contains(&m.n) {
