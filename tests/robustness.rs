@@ -2,6 +2,8 @@
 //! one clear line on stderr naming the culprit, without a panic, without hanging and without
 //! leaving a file behind in its working directory.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -12,7 +14,49 @@ enum Input {
     File(&'static str, &'static str),
     /// A named pipe (reading it would block forever).
     Fifo(&'static str),
+    /// A symbolic link to a target (which may not exist).
+    Symlink(&'static str, &'static str),
+    /// A text file: a head, then a body repeated a number of times.
+    Repeated(&'static str, &'static str, &'static str, usize),
 }
+
+/// A one-sphere scene: `[image]` keys, then more tables (lights, a mesh object); its
+/// material is `m` or the name given (as written in TOML).
+macro_rules! scene {
+    ($image:literal, $more:literal) => {
+        scene!($image, $more, "m")
+    };
+    ($image:literal, $more:literal, $name:literal) => {
+        concat!(
+            "[image]\n",
+            $image,
+            "\n[camera]\nposition = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 30.0\n",
+            "[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, 1.0]\n",
+            "[[material]]\nname = \"",
+            $name,
+            "\"\nn = 16\nk_s = 0.1\nk_d = 0.5\ncolour = [0.8, 0.6, 0.4]\n",
+            "[[object]]\nkind = \"sphere\"\nmaterial = \"",
+            $name,
+            "\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n",
+            $more
+        )
+    };
+}
+
+/// A trace of the testbench's clock and cycle counter, and a 4-bit signal `v` (id `#`).
+macro_rules! trace {
+    ($changes:literal) => {
+        concat!(
+            "$scope module tb_specfx $end $var reg 1 ! clk $end\n",
+            "$var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end $enddefinitions $end\n",
+            "#0 0! b0 \" bx #\n",
+            $changes
+        )
+    };
+}
+
+/// How long a step may take before it counts as hung.
+const TIMEOUT: Duration = Duration::from_secs(60);
 
 /// One bad invocation: arguments (`{dir}` is the case's working directory), the inputs it
 /// needs, and a piece of the one error line it must print.
@@ -566,10 +610,151 @@ const CASES: &[Case] = &[
         inputs: &[],
         expect: "expected a directory name",
     },
+    // Found from outside (issue 14, fourth pass): work limits stated before any work.
+    Case {
+        args: &["render", "--scene", "{dir}/s.toml", "--out", "{dir}/r"],
+        inputs: &[Input::File(
+            "s.toml",
+            scene!("width = 8192\nheight = 8192", "[[light]]\nkind = \"directional\"\ndirection = [0.0, 1.0, 1.0]\n"),
+        )],
+        expect: "light: 8192 x 8192 pixels x 2 lights is 134217728, above the limit of 67108864",
+    },
+    Case {
+        args: &["stability", "--n", "1..=65535", "--c-bits", "24", "--out", "{dir}/st"],
+        inputs: &[],
+        expect: "samples, above the limit of 2^34 = 17179869184",
+    },
+    // Names that would reach generated files.
+    Case {
+        args: &["fit", "--scene", "{dir}/s.toml", "--out", "{dir}/f"],
+        inputs: &[Input::File(
+            "s.toml",
+            scene!("width = 4\nheight = 4", "", "m\\nx = 1"),
+        )],
+        expect: "material[0].name: expected 1..=64 ASCII letters",
+    },
+    // Meshes: the line and what was expected.
+    Case {
+        args: &["render", "--scene", "{dir}/s.toml", "--out", "{dir}/r"],
+        inputs: &[
+            Input::File(
+                "s.toml",
+                scene!("width = 4\nheight = 4", "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m.obj\"\n"),
+            ),
+            Input::File("m.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n"),
+        ],
+        expect: "(m.obj): line 3: vertex index 3 is out of range: 2 vertices come before this line",
+    },
+    Case {
+        args: &["render", "--scene", "{dir}/s.toml", "--out", "{dir}/r"],
+        inputs: &[
+            Input::File(
+                "s.toml",
+                scene!("width = 4\nheight = 4", "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m.stl\"\n"),
+            ),
+            Input::File("m.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"),
+        ],
+        expect: "(m.stl): line 4: the ASCII STL ends before `endsolid` (expected vertex x y z)",
+    },
+    // Traces: nesting the parser would recurse through, and changes no header declares.
+    Case {
+        args: &["trace", "compare", "{dir}/a.vcd", "{dir}/deep.vcd"],
+        inputs: &[
+            Input::File("a.vcd", trace!("#5 1!\n")),
+            Input::Repeated("deep.vcd", "$scope module tb_specfx $end\n", "$scope module a $end\n", 30_000),
+        ],
+        expect: "deep.vcd: line 257: $scope nested deeper than 256",
+    },
+    Case {
+        args: &["trace", "compare", "{dir}/a.vcd", "{dir}/b.vcd"],
+        inputs: &[
+            Input::File("a.vcd", trace!("#5 1!\n")),
+            Input::File("b.vcd", trace!("#5 1! b1 %\n")),
+        ],
+        expect: "b.vcd: line 4: a value for identifier '%', which no $var declares",
+    },
+    Case {
+        args: &["trace", "compare", "{dir}/a.vcd", "{dir}/b.vcd"],
+        inputs: &[
+            Input::File("a.vcd", trace!("#5 1!\n")),
+            Input::File("b.vcd", trace!("#5 1! b10101 #\n")),
+        ],
+        expect: "b.vcd: line 4: a value of 5 bits for identifier '#', a variable of 4 bits",
+    },
+    Case {
+        args: &["trace", "compare", "{dir}/a.vcd", "{dir}/b.vcd"],
+        inputs: &[
+            Input::File("a.vcd", trace!("#5 1!\n")),
+            Input::File("b.vcd", trace!("#5 1! #3 0!\n")),
+        ],
+        expect: "b.vcd: line 4: time #3 goes back (the last was #5)",
+    },
+    Case {
+        args: &["trace", "compare", "{dir}/a.vcd", "{dir}/b.vcd"],
+        inputs: &[
+            Input::File("a.vcd", trace!("#5 1!\n")),
+            Input::File("b.vcd", trace!("#5 1! q\n")),
+        ],
+        expect: "b.vcd: line 4: unexpected character at start of command",
+    },
+    // Messages that named the wrong thing.
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::Symlink("c.toml", "gone.toml")],
+        expect: "config {dir}/c.toml: a symbolic link to gone.toml, which cannot be read",
+    },
+    Case {
+        args: &["budget", "--budget", "shape_total <= 1 lsb8 and", "--out", "{dir}/b"],
+        inputs: &[],
+        expect: "an empty bound (',' or 'and' with nothing before or after it)",
+    },
+    Case {
+        args: &["calibrate", "--count", "0", "--data", "{dir}/cal"],
+        inputs: &[],
+        expect: "'0' for '--count <COUNT>': 0 is not in 1..=100000",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/sp.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("sp.toml", "[base]\nk = 99\n[vary]\n")],
+        expect: "space {dir}/sp.toml: base.k: expected a number of squarings in 1..=7, got 99",
+    },
+    Case {
+        args: &["fit", "--budget", "differing <= 101%", "--out", "{dir}/f"],
+        inputs: &[],
+        expect: "a share of pixels is at most 100% (or 1) in 'differing <= 101%'",
+    },
+    // Outputs that cannot be written are found before the work (/proc takes no new file).
+    Case {
+        args: &["optimize", "--out", "/proc/o.toml"],
+        inputs: &[],
+        expect: "--out /proc/o.toml: cannot write into /proc",
+    },
+    Case {
+        args: &["optimize", "--out", "{dir}/no/o.toml"],
+        inputs: &[],
+        expect: "--out {dir}/no/o.toml: its directory {dir}/no does not exist",
+    },
+    Case {
+        args: &["hdl", "rom", "--out", "/proc/rom.v"],
+        inputs: &[],
+        expect: "--out /proc/rom.v: cannot write into /proc",
+    },
+    Case {
+        args: &["sim", "--cycles", "10", "--vcd", "/proc/s.vcd"],
+        inputs: &[],
+        expect: "--vcd /proc/s.vcd: cannot write into /proc",
+    },
+    Case {
+        args: &["man", "--out", "/proc/man"],
+        inputs: &[],
+        expect: "--out /proc/man: cannot write into /proc",
+    },
+    Case {
+        args: &["hdl", "stimulus", "--vectors", "{dir}", "--out", "/proc/st"],
+        inputs: &[],
+        expect: "--out /proc/st: cannot write into /proc",
+    },
 ];
-
-/// How long a case may run before it counts as hung.
-const TIMEOUT: Duration = Duration::from_secs(60);
 
 fn files_in(dir: &Path) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = walk(dir);
@@ -647,6 +832,13 @@ fn bad_input_gets_one_line_and_exit_code_2_and_leaves_nothing() {
                         .success();
                     assert!(ok, "mkfifo");
                 }
+                Input::Symlink(name, target) => {
+                    std::os::unix::fs::symlink(target, dir.join(name)).unwrap()
+                }
+                Input::Repeated(name, head, body, count) => {
+                    std::fs::write(dir.join(name), format!("{head}{}", body.repeat(*count)))
+                        .unwrap()
+                }
             }
         }
         let before = files_in(&dir);
@@ -655,42 +847,30 @@ fn bad_input_gets_one_line_and_exit_code_2_and_leaves_nothing() {
             .iter()
             .map(|a| a.replace("{dir}", dir.to_str().unwrap()))
             .collect();
-        let mut child = Command::new(env!("CARGO_BIN_EXE_specfx"))
-            .args(&args)
-            .current_dir(&dir)
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let start = Instant::now();
-        let status = loop {
-            if let Some(s) = child.try_wait().unwrap() {
-                break Some(s);
-            }
-            if start.elapsed() > TIMEOUT {
-                child.kill().unwrap();
-                break None;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        };
-        let out = child.wait_with_output().unwrap();
+        let (out, finished) = common::run_guarded(
+            Command::new(env!("CARGO_BIN_EXE_specfx"))
+                .args(&args)
+                .current_dir(&dir)
+                .stdin(Stdio::null()),
+        );
         let stderr = String::from_utf8_lossy(&out.stderr);
         let label = format!("case {i} `specfx {}`", args.join(" "));
-        match status {
-            None => failures.push(format!("{label}: hung")),
-            Some(s) if s.code() != Some(2) => {
-                failures.push(format!("{label}: exit {:?}, stderr {stderr}", s.code()))
-            }
-            Some(_) => {}
+        if !finished {
+            failures.push(format!("{label}: hung"));
+        } else if out.status.code() != Some(2) {
+            failures.push(format!(
+                "{label}: exit {:?}, stderr {stderr}",
+                out.status.code()
+            ));
         }
         if stderr.contains("panicked") {
             failures.push(format!("{label}: panicked: {stderr}"));
         }
-        if stderr.lines().count() != 1 || !stderr.contains(case.expect) {
+        let expect = case.expect.replace("{dir}", dir.to_str().unwrap());
+        if stderr.lines().count() != 1 || !stderr.contains(&expect) {
             failures.push(format!(
                 "{label}: expected one line containing {:?}, got {stderr:?}",
-                case.expect
+                expect
             ));
         }
         let after = files_in(&dir);
@@ -827,5 +1007,68 @@ fn interrupted_runs_leave_the_earlier_result_intact() {
         }
         assert!(staging(&dir).is_empty(), "SIG{signal}: {:?}", staging(&dir));
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A full disk (a file size limit) met while writing several files leaves none of them, and
+/// no directory made for them: `man --out` and `hdl stimulus` write all or nothing.
+#[test]
+fn a_full_disk_leaves_no_partial_pages_or_stimulus() {
+    let dir = fresh_dir("full");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let man = dir.join("man");
+    let (o, finished) = common::limited(2, &["man", "--out", &s(&man)]);
+    assert!(finished, "man hung on a full disk");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("File too large"), "{err}");
+    assert!(!man.exists(), "man left {:?}", files_in(&man));
+    // Into an existing directory: its own files stay, nothing is added.
+    std::fs::create_dir_all(&man).unwrap();
+    std::fs::write(man.join("mine.txt"), "kept").unwrap();
+    let (o, _) = common::limited(2, &["man", "--out", &s(&man)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(files_in(&man), [man.join("mine.txt")]);
+    // With room, every page.
+    let o = common::specfx(&["man", "--out", &s(&man)]);
+    assert!(o.status.success());
+    assert!(files_in(&man).len() > 20);
+
+    let vectors = dir.join("v");
+    let o = common::specfx(&[
+        "vectors",
+        "--n",
+        "16",
+        "--cases",
+        "random:2000",
+        "--out",
+        &s(&vectors),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stim = dir.join("a/stim");
+    let args = [
+        "hdl",
+        "stimulus",
+        "--vectors",
+        &s(&vectors),
+        "--out",
+        &s(&stim),
+    ];
+    let (o, finished) = common::limited(2, &args);
+    assert!(finished, "hdl stimulus hung on a full disk");
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        !dir.join("a").exists(),
+        "left {:?}",
+        files_in(&dir.join("a"))
+    );
+    let o = common::specfx(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(files_in(&stim).len(), 4);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -6,11 +6,10 @@
 //! interrupted sweep resumes to the same bytes.
 
 mod common;
-use common::specfx;
+use common::{limited, run_guarded, specfx};
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::{Command, Output};
 
 /// A fresh directory for one test.
 fn temp(name: &str) -> PathBuf {
@@ -298,41 +297,6 @@ fn merge_never_writes_over_its_inputs_nor_an_existing_result() {
     );
     let after: Vec<_> = w.shards.iter().map(|d| snapshot(d)).collect();
     assert!(before == after, "a shard changed");
-}
-
-/// Runs `specfx args...` with its file size limited to `blocks` 512-byte blocks (SIGXFSZ
-/// ignored, so a write past the limit fails with EFBIG as on a full disk), killed if it runs
-/// for more than a minute; returns its output and whether it finished by itself.
-fn limited(blocks: u32, args: &[&str]) -> (Output, bool) {
-    let mut line = format!(
-        "trap '' XFSZ; ulimit -f {blocks}; exec '{}'",
-        env!("CARGO_BIN_EXE_specfx")
-    );
-    for a in args {
-        line.push_str(&format!(" '{a}'"));
-    }
-    run_guarded(Command::new("sh").args(["-c", &line]))
-}
-
-/// Runs a command, killing it after a minute: (output, finished by itself).
-fn run_guarded(cmd: &mut Command) -> (Output, bool) {
-    let mut child = cmd
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    let finished = loop {
-        if child.try_wait().unwrap().is_some() {
-            break true;
-        }
-        if start.elapsed() > Duration::from_secs(60) {
-            child.kill().unwrap();
-            break false;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    (child.wait_with_output().unwrap(), finished)
 }
 
 #[test]

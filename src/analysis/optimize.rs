@@ -149,8 +149,9 @@ impl FromStr for Budget {
         }
         };
         let mut bounds = Vec::new();
-        for part in s.split(',').flat_map(|p| p.split(" and ")) {
-            let part = part.trim();
+        let parts = bound_parts(s).map_err(|why| bad(s.trim(), &why))?;
+        for part in &parts {
+            let part = part.as_str();
             let (lhs, op, rhs) = if let Some((l, r)) = part.split_once("<=") {
                 (l, "<=", r)
             } else if let Some((l, r)) = part.split_once(">=") {
@@ -238,11 +239,45 @@ impl FromStr for Budget {
             bounds.push(Bound { metric, limit });
         }
         Ok(Budget {
-            text: s.trim().to_string(),
+            // One canonical spelling: no newline or other separator survives into a report.
+            text: parts.join(" and "),
             bounds,
             arch: Arch::Pipelined,
         })
     }
+}
+
+/// The bounds of a budget expression: the parts between `,` and the word `and`, each with its
+/// words joined by single spaces.
+///
+/// # Errors
+/// An empty part (a separator at either end, or two in a row) is refused.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::optimize::bound_parts;
+/// assert_eq!(bound_parts("a <= 1 lsb8 and  b>=2,c <= 3").unwrap(), ["a <= 1 lsb8", "b>=2", "c <= 3"]);
+/// assert!(bound_parts("a <= 1 lsb8 and").is_err());
+/// assert!(bound_parts("a <= 1, , b <= 2").is_err());
+/// ```
+pub fn bound_parts(s: &str) -> Result<Vec<String>, String> {
+    let mut parts = Vec::new();
+    for piece in s.split(',') {
+        let mut words: Vec<&str> = Vec::new();
+        for word in piece.split_whitespace() {
+            if word == "and" {
+                parts.push(words.join(" "));
+                words.clear();
+            } else {
+                words.push(word);
+            }
+        }
+        parts.push(words.join(" "));
+    }
+    if parts.iter().any(String::is_empty) {
+        return Err("an empty bound (',' or 'and' with nothing before or after it)".into());
+    }
+    Ok(parts)
 }
 
 impl fmt::Display for Budget {

@@ -67,7 +67,7 @@ pub const AXIS_KEYS: &[&str] = &[
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SpaceFile {
-    base: Option<toml::Table>,
+    base: Option<crate::pipeline::config::ConfigFile>,
     n: Option<NSet>,
     target: Option<String>,
     vary: toml::Table,
@@ -163,7 +163,10 @@ impl Space {
     pub fn from_toml(text: &str) -> Result<Space, Error> {
         let file: SpaceFile = crate::error::parse_toml(text)?;
         let mut base = match file.base {
-            Some(t) => Config::from_toml(&toml::to_string(&t).expect("a table serialises"))?,
+            Some(b) => b.onto(Config::baseline()).map_err(|e| match e {
+                Error::Config { key, problem } => space_error(&format!("base.{key}"), problem),
+                e => e,
+            })?,
             None => Config::baseline(),
         };
         if let Some(n) = file.n {

@@ -29,8 +29,8 @@ pub struct CalibrateArgs {
     )]
     targets: Vec<Target>,
     /// Number of sampled configurations per target (default: the committed sample's, 240
-    /// for ice40 and 120 for the slower xilinx and generic-fast mappings).
-    #[arg(long)]
+    /// for ice40 and 120 for the slower xilinx and generic-fast mappings); 1..=100000.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     count: Option<u64>,
     /// Seed of the sample.
     #[arg(long, default_value_t = 1)]
@@ -174,8 +174,13 @@ pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
         let records = load_records(&args.data, target)?;
         if records.is_empty() {
             bail!(
-                "{}: no calibration records (run without --fit-only to synthesise them)",
-                records_path(&args.data, target).display()
+                "{}: no calibration records{}",
+                records_path(&args.data, target).display(),
+                if args.fit_only {
+                    " (run without --fit-only to synthesise them)"
+                } else {
+                    ""
+                }
             );
         }
         let (coefficients, error) = fit(&records, target)?;

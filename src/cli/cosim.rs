@@ -124,7 +124,9 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     if args.lint && !Simulator::Verilator.installed() {
         bail!("--lint: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator)");
     }
-    if let Some(dir) = &args.vcd {
+    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
+        super::output::check_can_create(dir, "--vcd")?;
+    } else if let Some(dir) = &args.vcd {
         // An earlier cosim's traces (model.vcd begins with the model's header) are replaced;
         // other files of those names only with --force; never an input.
         let mut inputs = super::output::inputs(&args.config, None);
@@ -178,7 +180,9 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
     };
     let dp = super::datapath::load(&vectors.to_string_lossy(), None)?;
-    if let Some(dir) = &args.vcd {
+    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
+        super::output::check_can_create(dir, "--vcd")?;
+    } else if let Some(dir) = &args.vcd {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
@@ -247,7 +251,9 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
     );
     let log = simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
-    if let Some(dir) = &args.vcd {
+    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
+        super::output::check_can_create(dir, "--vcd")?;
+    } else if let Some(dir) = &args.vcd {
         let from = wd.join("rtl.vcd");
         std::fs::copy(&from, dir.join("rtl.vcd"))
             .with_context(|| format!("the simulator wrote no {}", from.display()))?;
@@ -275,7 +281,9 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         log::error!("cosim: FAIL: nothing was checked");
         return Ok(Outcome::CheckFailed);
     }
-    if let Some(dir) = &args.vcd {
+    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
+        super::output::check_can_create(dir, "--vcd")?;
+    } else if let Some(dir) = &args.vcd {
         let (model, rtl) = (dir.join("model.vcd"), dir.join("rtl.vcd"));
         if matches!(
             super::trace::compare_files(&model, &rtl)?,

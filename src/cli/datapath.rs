@@ -21,7 +21,8 @@ pub fn load(arg: &str, n: Option<&NSet>) -> Result<Datapath> {
             super::vectordir::open(path)?.config
         }
         None => {
-            if !path.exists() {
+            // A dangling symbolic link exists as a link: read_text names it.
+            if !path.exists() && path.symlink_metadata().is_err() {
                 bail!("config {arg}: no such file (and it is not a built-in name: baseline)");
             }
             let text = super::input::read_text(path, &format!("config {arg}"))?;

@@ -249,14 +249,14 @@ pub fn write_stimulus(
     let ii = arch.initiation_interval(dp.config()) as f64;
     let per_vector = 1.0 / (1.0 - bubble) + ii / (1.0 - stall);
     let expected = (items.len() as f64 * per_vector).ceil();
-    let limit_f = 20.0 * expected + 100.0 * arch.latency(dp.config()) as f64 + 1_000.0;
-    if limit_f > MAX_STIMULUS_CYCLES as f64 {
+    if expected > MAX_STIMULUS_CYCLES as f64 {
         bail!(
-            "--bubble {bubble} and --stall {stall} would need about {expected:.0} cycles for {} vectors; the stimulus is limited to {MAX_STIMULUS_CYCLES} cycles (lower the probabilities or use fewer vectors)",
-            items.len()
+            "--bubble {bubble} and --stall {stall} would need about {expected:.0} cycles for {} vectors; the stimulus is limited to {MAX_STIMULUS_CYCLES} cycles, about {:.0} vectors at these probabilities (lower them or use fewer vectors)",
+            items.len(),
+            (MAX_STIMULUS_CYCLES as f64 / per_vector).floor()
         );
     }
-    let limit = limit_f as u64;
+    let limit = (20.0 * expected + 100.0 * arch.latency(dp.config()) as f64 + 1_000.0) as u64;
     let trace_cycles = if vcd.is_some() { u64::MAX } else { 0 };
     let result = simulate(
         &dp,
@@ -282,20 +282,10 @@ pub fn write_stimulus(
             s.mismatches
         );
     }
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut cycles = String::new();
     for o in &result.outputs {
         writeln!(cycles, "{:08x}", o.cycle).expect("write to String");
     }
-    write_atomic(
-        &out.join("stim_valid.hex"),
-        bits_file(&result.valid_bits).as_bytes(),
-    )?;
-    write_atomic(
-        &out.join("stim_ready.hex"),
-        bits_file(&result.ready_bits).as_bytes(),
-    )?;
-    write_atomic(&out.join("expected_cycle.hex"), cycles.as_bytes())?;
     let info = serde_json::json!({
         "arch": arch.name(),
         "latency": arch.latency(dp.config()),
@@ -310,12 +300,25 @@ pub fn write_stimulus(
     });
     let mut json = serde_json::to_vec_pretty(&info)?;
     json.push(b'\n');
-    write_atomic(&out.join("stim.json"), &json)?;
+    // All or nothing, stim.json last (see STIMULUS_FILES).
+    let mut files = vec![
+        (
+            out.join("stim_valid.hex"),
+            bits_file(&result.valid_bits).into_bytes(),
+        ),
+        (
+            out.join("stim_ready.hex"),
+            bits_file(&result.ready_bits).into_bytes(),
+        ),
+        (out.join("expected_cycle.hex"), cycles.into_bytes()),
+        (out.join("stim.json"), json),
+    ];
     if let Some(path) = vcd {
         let mut buf = Vec::new();
         write_vcd(&mut buf, &dp, arch, &result.trace)?;
-        write_atomic(path, &buf)?;
+        files.push((path.to_path_buf(), buf));
     }
+    super::output::write_all_atomic(out, &files)?;
     Ok(StimulusInfo {
         n_vectors: items.len(),
         n_cycles: s.n_cycles,
@@ -338,10 +341,14 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
     // only with --force.
     let inputs = super::output::config_inputs_as("--vectors", &args.vectors.to_string_lossy());
     let earlier = args.out.join("stim.json").is_file();
-    for name in STIMULUS_FILES {
-        let path = args.out.join(name);
-        super::output::check_file_output(&path, "--out", &inputs, None, args.force || earlier)?;
-    }
+    super::output::check_files_in(
+        &args.out,
+        &STIMULUS_FILES,
+        "--out",
+        &inputs,
+        None,
+        args.force || earlier,
+    )?;
     if let Some(vcd) = &args.vcd {
         let mut inputs = inputs.clone();
         inputs.extend(STIMULUS_FILES.map(|f| ("--out", args.out.join(f))));

@@ -15,20 +15,30 @@ pub const MAX_BINARY_BYTES: u64 = 1 << 30;
 /// Refuses a path that is not a regular file (a FIFO or a device would block or never end),
 /// for inputs read as a stream without a size limit (VCD traces); `what` names it in errors.
 pub fn check_regular_file(path: &Path, what: &str) -> Result<()> {
-    let meta = std::fs::metadata(path).with_context(|| format!("{what}: cannot read it"))?;
+    regular_file(path, what).map(|_| ())
+}
+
+/// The metadata of a regular file (following symbolic links); a dangling link is named as one.
+fn regular_file(path: &Path, what: &str) -> Result<std::fs::Metadata> {
+    let meta = std::fs::metadata(path).or_else(|e| {
+        if let Ok(target) = std::fs::read_link(path) {
+            bail!(
+                "{what}: a symbolic link to {}, which cannot be read: {e}",
+                target.display()
+            );
+        }
+        Err(e).with_context(|| format!("{what}: cannot read it"))
+    })?;
     if !meta.is_file() {
         bail!("{what}: expected a regular file, got {}", kind(&meta));
     }
-    Ok(())
+    Ok(meta)
 }
 
 /// The bytes of a regular file of at most `max` bytes; `what` names it in errors
 /// (e.g. "config my.toml").
 pub fn read_bytes(path: &Path, what: &str, max: u64) -> Result<Vec<u8>> {
-    let meta = std::fs::metadata(path).with_context(|| format!("{what}: cannot read it"))?;
-    if !meta.is_file() {
-        bail!("{what}: expected a regular file, got {}", kind(&meta));
-    }
+    let meta = regular_file(path, what)?;
     if meta.len() > max {
         bail!(
             "{what}: expected at most {max} bytes, got {} bytes",

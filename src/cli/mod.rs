@@ -128,12 +128,28 @@ const EXAMPLES: &[(&str, &str)] = &[
     ),
     ("hdl", "specfx hdl params --config my.toml --format json"),
     (
+        "hdl params",
+        "specfx hdl params --config my.toml --format define --out specfx_params.vh",
+    ),
+    (
+        "hdl rom",
+        "specfx hdl rom --config fit-out/fitted.toml --out specfx_rom.v",
+    ),
+    (
+        "hdl stimulus",
+        "specfx hdl stimulus --vectors vec --arch folded --bubble 0.3 --stall 0.1 --out stim",
+    ),
+    (
         "cosim",
         "specfx cosim --config my.toml --sim verilator --arch folded --lint",
     ),
     (
         "trace",
         "specfx trace compare traces/model.vcd traces/rtl.vcd",
+    ),
+    (
+        "trace compare",
+        "specfx trace compare model.vcd build/tb_specfx.vcd",
     ),
     (
         "cost",
@@ -144,6 +160,10 @@ const EXAMPLES: &[(&str, &str)] = &[
     (
         "sweep",
         "specfx sweep --space space.toml --out sweep-out --shard 1/4",
+    ),
+    (
+        "sweep merge",
+        "specfx sweep merge --out sweep-all sweep-1 sweep-2 sweep-3 sweep-4",
     ),
     (
         "budget",
@@ -194,7 +214,13 @@ fn command() -> clap::Command {
          or an I/O error (one line on stderr, nothing written).",
     );
     for (name, example) in EXAMPLES {
-        cmd = cmd.mut_subcommand(*name, |c| c.after_help(format!("Example:\n  {example}")));
+        let help = format!("Example:\n  {example}");
+        cmd = match name.split_once(' ') {
+            Some((parent, sub)) => {
+                cmd.mut_subcommand(parent, |c| c.mut_subcommand(sub, |c| c.after_help(help)))
+            }
+            None => cmd.mut_subcommand(*name, |c| c.after_help(help)),
+        };
     }
     cmd
 }
@@ -233,7 +259,6 @@ fn completions(args: &CompletionsArgs) -> anyhow::Result<Outcome> {
 }
 
 fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
-    use anyhow::Context;
     let cmd = command();
     let render = |c: clap::Command| -> anyhow::Result<Vec<u8>> {
         let mut buf = Vec::new();
@@ -257,15 +282,19 @@ fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
                 let page = render(sub.clone().name(name.clone()))?;
                 pages.push((dir.join(format!("{name}.1")), page));
             }
-            for (path, page) in &pages {
-                debug_assert!(page.starts_with(MAN_HEADER.as_bytes()));
-                output::check_file_output(path, "--out", &[], Some(MAN_HEADER), args.force)?;
-            }
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create {}", dir.display()))?;
-            for (path, page) in &pages {
-                output::write_atomic(path, page)?;
-            }
+            let names: Vec<String> = pages
+                .iter()
+                .map(|(path, page)| {
+                    debug_assert!(page.starts_with(MAN_HEADER.as_bytes()));
+                    path.file_name()
+                        .expect("a page name")
+                        .to_string_lossy()
+                        .into_owned()
+                })
+                .collect();
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
+            output::check_files_in(dir, &names, "--out", &[], Some(MAN_HEADER), args.force)?;
+            output::write_all_atomic(dir, &pages)?;
         }
     }
     Ok(Outcome::Ok)
@@ -447,15 +476,44 @@ mod tests {
         }
     }
 
+    /// The long help of `specfx NAME` (NAME may be `hdl params`).
+    fn cmd_help(name: &str) -> String {
+        let mut cmd = command();
+        let mut words = name.split(' ');
+        let first = words.next().expect("a name");
+        let mut sub = cmd.find_subcommand_mut(first).expect("a command").clone();
+        for w in words {
+            sub = sub.find_subcommand_mut(w).expect("a command").clone();
+        }
+        sub.render_long_help().to_string()
+    }
+
     #[test]
     fn every_command_has_an_example_that_parses() {
         let cmd = command();
+        // Every command, and every command of a command (`hdl params`, `sweep merge`).
+        let mut names: Vec<String> = Vec::new();
         for sub in cmd.get_subcommands() {
-            let name = sub.get_name();
+            names.push(sub.get_name().to_string());
+            for inner in sub.get_subcommands() {
+                names.push(format!("{} {}", sub.get_name(), inner.get_name()));
+            }
+        }
+        assert!(names.iter().any(|n| n == "hdl stimulus"), "{names:?}");
+        for name in &names {
             let (_, example) = EXAMPLES
                 .iter()
-                .find(|(n, _)| *n == name)
+                .find(|(n, _)| n == name)
                 .unwrap_or_else(|| panic!("no example for `specfx {name}`"));
+            assert!(
+                example.starts_with(&format!("specfx {name} ")),
+                "the example of {name} runs another command: {example}"
+            );
+            let shown = cmd_help(name);
+            assert!(
+                shown.contains(example),
+                "specfx {name} --help does not show its example"
+            );
             // The example's arguments parse (single quotes group words; up to a shell
             // redirection or `&&`).
             let mut words: Vec<String> = Vec::new();

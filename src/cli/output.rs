@@ -18,11 +18,45 @@ pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
 /// `.<name>.<random>.tmp`, removed on failure) and a rename, so an interrupted run never
 /// leaves a half-written file under the final name. A directory at `path` is refused.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    log::debug!("writing {} ({} bytes)", path.display(), bytes.len());
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
+    persist(path, stage(path, bytes)?)
+}
+
+/// Writes several files all or none: every file to its temporary name first, then each
+/// renamed into place (a rename needs no space). When one cannot be written, none is, and the
+/// directories created for them (`dir` and any missing parent) are removed again.
+pub fn write_all_atomic(dir: &Path, files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
+    let missing: Vec<&Path> = dir
+        .ancestors()
+        .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+        .collect();
+    let staged = fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create {}", dir.display()))
+        .and_then(|()| {
+            files
+                .iter()
+                .map(|(path, bytes)| stage(path, bytes).map(|tmp| (path, tmp)))
+                .collect::<Result<Vec<_>>>()
+        });
+    let staged = match staged {
+        Ok(s) => s,
+        Err(e) => {
+            // Deepest first; a directory something else wrote into meanwhile stays.
+            for d in &missing {
+                let _ = fs::remove_dir(d);
+            }
+            return Err(e);
+        }
     };
+    for (path, tmp) in staged {
+        persist(path, tmp)?;
+    }
+    Ok(())
+}
+
+/// `bytes` in a temporary file beside `path` (see [`write_atomic`]), not yet renamed.
+fn stage(path: &Path, bytes: &[u8]) -> Result<tempfile::NamedTempFile> {
+    log::debug!("writing {} ({} bytes)", path.display(), bytes.len());
+    let dir = parent_of(path);
     let file_name = path
         .file_name()
         .with_context(|| format!("{}: not a file path", path.display()))?;
@@ -43,6 +77,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     tmp.write_all(bytes)
         .and_then(|()| tmp.flush())
         .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(tmp)
+}
+
+/// Renames a staged file into place.
+fn persist(path: &Path, tmp: tempfile::NamedTempFile) -> Result<()> {
     tmp.persist(path)
         .map(|_| ())
         .map_err(|e| e.error)
@@ -460,7 +499,85 @@ pub fn check_file_output(
             out.display()
         );
     }
+    let dir = parent_of(out);
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "{flag} {}: its directory {} does not exist",
+            out.display(),
+            dir.display()
+        );
+    }
+    probe(dir, out, flag)
+}
+
+/// Checks before any work the files a command will write into the directory `dir`, which it
+/// creates when missing: each as [`check_file_output`] when `dir` exists, else that `dir` can
+/// be created.
+pub fn check_files_in(
+    dir: &Path,
+    names: &[&str],
+    flag: &str,
+    inputs: &[(&str, PathBuf)],
+    own_header: Option<&str>,
+    force: bool,
+) -> Result<()> {
+    if !dir.is_dir() {
+        return check_can_create(dir, flag);
+    }
+    for name in names {
+        check_file_output(&dir.join(name), flag, inputs, own_header, force)?;
+    }
     Ok(())
+}
+
+/// The directory a path is in (`.` for a bare name).
+fn parent_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// Checks before any work that the directory `dir` can be created (or, if it exists, written
+/// into): its nearest existing ancestor is a directory that takes a new entry.
+pub fn check_can_create(dir: &Path, flag: &str) -> Result<()> {
+    let existing = dir
+        .ancestors()
+        .find(|d| d.as_os_str().is_empty() || d.exists())
+        .map(|d| {
+            if d.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                d
+            }
+        })
+        .unwrap_or(Path::new("."));
+    if !existing.is_dir() {
+        anyhow::bail!(
+            "{flag} {}: {} is not a directory",
+            dir.display(),
+            existing.display()
+        );
+    }
+    probe(existing, dir, flag)
+}
+
+/// Creates and removes a probe file in `dir`: whether it takes a new entry (permissions, a
+/// read-only file system).
+fn probe(dir: &Path, out: &Path, flag: &str) -> Result<()> {
+    match tempfile::Builder::new()
+        .prefix(".specfx-probe.")
+        .tempfile_in(dir)
+    {
+        Ok(_) => Ok(()),
+        // The kind only: the error names the probe's random path.
+        Err(e) => anyhow::bail!(
+            "{flag} {}: cannot write into {}: {}",
+            out.display(),
+            dir.display(),
+            e.kind()
+        ),
+    }
 }
 
 /// The files a `--config` (or `--vectors`) argument reads: none for a built-in name; the

@@ -361,10 +361,10 @@ impl<'de> Deserialize<'de> for SquarePatch {
     }
 }
 
-/// What a configuration file may say.
+/// What a configuration file may say (also a design space's `[base]`).
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct ConfigFile {
+pub(crate) struct ConfigFile {
     name: Option<String>,
     variant: Option<Variant>,
     k: Option<u32>,
@@ -382,7 +382,8 @@ struct ConfigFile {
 }
 
 impl ConfigFile {
-    fn onto(self, base: Config) -> Result<Config, Error> {
+    /// The configuration `base` with every key the file sets replaced, checked.
+    pub(crate) fn onto(self, base: Config) -> Result<Config, Error> {
         let k = self.k.unwrap_or(base.k);
         if !crate::reference::lobe::K_RANGE.contains(&k) {
             return Err(Error::Config {

@@ -96,8 +96,9 @@ impl FromStr for ImageBudget {
         }
         };
         let mut bounds = Vec::new();
-        for part in s.split(',').flat_map(|p| p.split(" and ")) {
-            let part = part.trim();
+        let parts = crate::analysis::optimize::bound_parts(s).map_err(|why| bad(s.trim(), &why))?;
+        for part in &parts {
+            let part = part.as_str();
             let Some((lhs, rhs)) = part.split_once("<=") else {
                 return Err(bad(part, "no <="));
             };
@@ -128,6 +129,9 @@ impl FromStr for ImageBudget {
                 .filter(|v: &f64| v.is_finite() && *v >= 0.0)
                 .ok_or_else(|| bad(part, "no non-negative number"))?;
             let limit = if percent { value / 100.0 } else { value };
+            if metric == ImageMetric::Differing && limit > 1.0 {
+                return Err(bad(part, "a share of pixels is at most 100% (or 1)"));
+            }
             bounds.push(ImageBound {
                 metric,
                 material,
@@ -135,7 +139,8 @@ impl FromStr for ImageBudget {
             });
         }
         Ok(ImageBudget {
-            text: s.trim().to_string(),
+            // One canonical spelling: no newline or other separator survives into a report.
+            text: parts.join(" and "),
             bounds,
         })
     }

@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests that drive the built `specfx` binary.
 
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// Runs the built `specfx` binary with `args` and returns its output.
 #[allow(dead_code)]
@@ -73,4 +74,41 @@ pub fn snapshot(dir: &std::path::Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
     walk(dir, dir, &mut v);
     v.sort();
     v
+}
+
+/// Runs `specfx args...` with its file size limited to `blocks` 512-byte blocks (SIGXFSZ
+/// ignored, so a write past the limit fails with EFBIG as on a full disk), killed if it runs
+/// for more than a minute; returns its output and whether it finished by itself.
+#[allow(dead_code)]
+pub fn limited(blocks: u32, args: &[&str]) -> (Output, bool) {
+    let mut line = format!(
+        "trap '' XFSZ; ulimit -f {blocks}; exec '{}'",
+        env!("CARGO_BIN_EXE_specfx")
+    );
+    for a in args {
+        line.push_str(&format!(" '{a}'"));
+    }
+    run_guarded(Command::new("sh").args(["-c", &line]))
+}
+
+/// Runs a command, killing it after a minute: (output, finished by itself).
+#[allow(dead_code)]
+pub fn run_guarded(cmd: &mut Command) -> (Output, bool) {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let finished = loop {
+        if child.try_wait().unwrap().is_some() {
+            break true;
+        }
+        if start.elapsed() > Duration::from_secs(60) {
+            child.kill().unwrap();
+            break false;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    (child.wait_with_output().unwrap(), finished)
 }
