@@ -223,11 +223,14 @@ mod tests {
         assert!(e.ends_with(r"got 'RND\n'"), "{e}");
         let e = "clamp\u{2028}x".parse::<Cutoff>().unwrap_err().to_string();
         assert!(e.starts_with(r"unknown cutoff 'clamp\u{2028}x'"), "{e}");
-        // Tabs and escapes too; quotes and non-ASCII letters are shown as they are.
+        // Escapes too; quotes and non-ASCII letters are shown as they are. (A budget's words
+        // are separated by any white space, a tab included, and shown with one space.)
         let e = "out <=\t1 ulp\u{1b}[2J 'é'".parse::<Budget>().unwrap_err();
         assert_eq!(
             e.to_string(),
-            r"budget: unit 'ulp\u{1b}[2J 'é'' does not fit this metric in 'out <=\t1 ulp\u{1b}[2J 'é''; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'"
+            r"budget: unit 'ulp\u{1b}[2J 'é'' does not fit this metric in 'out <= 1 ulp\u{1b}[2J 'é''; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'"
         );
+        let e = "s1.2\t".parse::<Format>().unwrap_err().to_string();
+        assert!(e.ends_with(r"got 's1.2\t'"), "{e}");
     }
 }

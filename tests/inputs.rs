@@ -11,41 +11,6 @@ use std::process::Output;
 
 use sha2::{Digest, Sha256};
 
-/// A 3x3 image of a lit sphere.
-const SCENE: &str = r#"
-[image]
-width = 3
-height = 3
-
-[camera]
-position = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-fov_deg = 30.0
-
-[shading]
-model = "phong"
-ambient = 0.03
-
-[[light]]
-kind = "directional"
-direction = [0.0, 0.0, 1.0]
-colour = [1.0, 1.0, 1.0]
-intensity = 1.0
-
-[[material]]
-name = "m"
-n = 16
-k_s = 0.1
-k_d = 0.5
-colour = [0.8, 0.6, 0.4]
-
-[[object]]
-kind = "sphere"
-material = "m"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-"#;
-
 fn run_in(dir: &Path, args: &[&str]) -> Output {
     common::specfx_in(dir, args)
 }
@@ -277,7 +242,7 @@ fn no_command_writes_over_one_of_its_inputs() {
     let dir = work.path();
     std::fs::write(dir.join("c.toml"), "k = 4\n").unwrap();
     vectors(dir);
-    std::fs::write(dir.join("s.toml"), SCENE).unwrap();
+    std::fs::write(dir.join("s.toml"), common::sphere_scene(0.1, 16, 1.0, 0.03)).unwrap();
     let cases: &[(&[&str], &str)] = &[
         (
             &["optimize", "--config", "c.toml", "--out", "c.toml"],
@@ -496,7 +461,7 @@ fn markdown_outputs_carry_no_raw_html_from_user_strings() {
     let dir = work.path();
     // A scene whose file name is HTML: render.md names the scene.
     let name = "<img src=x onerror=alert(1)>[a](javascript:x).toml";
-    std::fs::write(dir.join(name), SCENE).unwrap();
+    std::fs::write(dir.join(name), common::sphere_scene(0.1, 16, 1.0, 0.03)).unwrap();
     let o = run_in(dir, &["render", "--scene", name, "--out", "r"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let md = std::fs::read_to_string(dir.join("r/render.md")).unwrap();

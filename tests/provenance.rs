@@ -194,41 +194,13 @@ fn one_configuration_written_two_ways_has_one_hash() {
     }
 }
 
-/// A unit sphere seen from (0, 0, 5), 3 x 3 pixels.
-const SPHERE: &str = r#"[image]
-width = 3
-height = 3
-
-[camera]
-position = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-fov_deg = 30.0
-
-[[light]]
-kind = "directional"
-direction = [0.0, 0.0, 1.0]
-
-[[material]]
-name = "m"
-n = 64
-k_s = 0.5
-k_d = 0.5
-colour = [0.8, 0.6, 0.4]
-
-[[object]]
-kind = "sphere"
-material = "m"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-"#;
-
 #[test]
 fn every_result_directory_records_version_and_inputs() {
     let dir = temp("every");
     let cfg = dir.join("narrow.toml");
     std::fs::write(&cfg, NARROW).unwrap();
     let scene = dir.join("sphere.toml");
-    std::fs::write(&scene, SPHERE).unwrap();
+    std::fs::write(&scene, common::sphere_scene(0.5, 64, 1.0, 0.03)).unwrap();
     let out = |name: &str| dir.join(name);
     let runs: [(&str, Vec<&str>, Option<&str>); 7] = [
         (

@@ -11,45 +11,6 @@ fn code(x: f64) -> u16 {
     common::srgb8(x)
 }
 
-/// A unit sphere at the origin seen from (0, 0, 5) in a 3x3 image, lit from the camera.
-fn sphere_scene(k_s: f64, n: u32, intensity: f64, ambient: f64) -> String {
-    format!(
-        r#"
-[image]
-width = 3
-height = 3
-
-[camera]
-position = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-fov_deg = 30.0
-
-[shading]
-model = "phong"
-ambient = {ambient}
-
-[[light]]
-kind = "directional"
-direction = [0.0, 0.0, 1.0]
-colour = [1.0, 0.5, 0.25]
-intensity = {intensity}
-
-[[material]]
-name = "m"
-n = {n}
-k_s = {k_s}
-k_d = 0.5
-colour = [0.8, 0.6, 0.4]
-
-[[object]]
-kind = "sphere"
-material = "m"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-"#
-    )
-}
-
 fn datapath_for(scene: &Scene) -> Datapath {
     let mut cfg = Config::baseline();
     cfg.n = specfx::nset::NSet::from_values(&scene.exponents()).unwrap();
@@ -63,7 +24,7 @@ fn datapath_for(scene: &Scene) -> Datapath {
 #[test]
 fn a_sphere_lit_head_on_has_the_closed_form_centre_pixel() {
     let (k_s, n, intensity, ambient) = (0.002, 100, 0.4, 0.05);
-    let scene = Scene::from_toml(&sphere_scene(k_s, n, intensity, ambient)).unwrap();
+    let scene = Scene::from_toml(&common::sphere_scene(k_s, n, intensity, ambient)).unwrap();
     let dp = datapath_for(&scene);
     let r = render(&scene, &dp, &|_, _| {});
     let light = [1.0, 0.5, 0.25];
@@ -100,7 +61,7 @@ fn a_sphere_lit_head_on_has_the_closed_form_centre_pixel() {
 /// form; with k_s = 0 every path is the Lambert term, max(0, N.L) k_d colour.
 #[test]
 fn a_diffuse_sphere_matches_lambert_off_centre() {
-    let scene = Scene::from_toml(&sphere_scene(0.0, 16, 1.0, 0.0)).unwrap();
+    let scene = Scene::from_toml(&common::sphere_scene(0.0, 16, 1.0, 0.0)).unwrap();
     let dp = datapath_for(&scene);
     let r = render(&scene, &dp, &|_, _| {});
     // Pixel (x = 1, y = 0): screen y = (1 - 2 * 0.5 / 3) tan(15 deg), direction (0, sy, -1)
@@ -148,7 +109,7 @@ fn a_diffuse_sphere_matches_lambert_off_centre() {
 fn flip_is_zero_exactly_where_the_images_agree() {
     use specfx::scene::render::{flip_errors, image_error};
     let scene = Scene::from_toml(
-        &sphere_scene(0.02, 500, 1.0, 0.03)
+        &common::sphere_scene(0.02, 500, 1.0, 0.03)
             .replace("width = 3\nheight = 3", "width = 64\nheight = 48"),
     )
     .unwrap();
@@ -182,7 +143,7 @@ fn the_default_scene_and_the_examples_are_valid() {
 /// Every bad scene names the key (or line) at fault.
 #[test]
 fn bad_scenes_name_what_is_wrong() {
-    let good = sphere_scene(0.1, 64, 1.0, 0.03);
+    let good = common::sphere_scene(0.1, 64, 1.0, 0.03);
     for (from, to, expect) in [
         ("radius = 1.0", "radius = nan", "object[0].radius"),
         ("radius = 1.0", "radius = 0.0", "object[0].radius"),
@@ -246,7 +207,7 @@ fn bad_scenes_name_what_is_wrong() {
 /// do not; 8192 x 8192 pixels pass with one light and not with two.
 #[test]
 fn lights_are_limited_before_any_work() {
-    let good = sphere_scene(0.1, 64, 1.0, 0.03);
+    let good = common::sphere_scene(0.1, 64, 1.0, 0.03);
     let light = "[[light]]\nkind = \"directional\"\ndirection = [0.0, 0.0, 1.0]\n";
     let with = |lights: usize, size: u32| {
         let size = format!("width = {size}\nheight = {size}");
@@ -274,7 +235,7 @@ fn lights_are_limited_before_any_work() {
 /// 0.03 and Blinn-Phong.
 #[test]
 fn a_scene_without_shading_gets_the_documented_defaults() {
-    let good = sphere_scene(0.1, 64, 1.0, 0.5);
+    let good = common::sphere_scene(0.1, 64, 1.0, 0.5);
     let table = "[shading]\nmodel = \"phong\"\nambient = 0.5\n";
     assert!(good.contains(table));
     let without = Scene::from_toml(&good.replacen(table, "", 1)).unwrap();
@@ -290,7 +251,7 @@ fn render_writes_the_images_and_the_table() {
     let scene = dir.path().join("s.toml");
     std::fs::write(
         &scene,
-        sphere_scene(0.05, 300, 1.0, 0.03)
+        common::sphere_scene(0.05, 300, 1.0, 0.03)
             .replace("width = 3\nheight = 3", "width = 40\nheight = 30"),
     )
     .unwrap();
@@ -462,7 +423,7 @@ mod meshes {
 /// in closed form, and the scene reads the mesh through the loader the command gives it.
 #[test]
 fn a_mesh_facing_the_camera_is_lambert() {
-    let text = sphere_scene(0.0, 16, 1.0, 0.0).replace(
+    let text = common::sphere_scene(0.0, 16, 1.0, 0.0).replace(
         "kind = \"sphere\"\nmaterial = \"m\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
         "kind = \"mesh\"\nmaterial = \"m\"\nfile = \"sq.obj\"\nscale = 2.0",
     );

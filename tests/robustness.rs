@@ -754,6 +754,17 @@ const CASES: &[Case] = &[
         inputs: &[],
         expect: "--out /proc/st: cannot write into /proc",
     },
+    Case {
+        args: &["cosim", "--sim", "icarus", "--vcd", "/proc/traces"],
+        inputs: &[],
+        expect: "--vcd /proc/traces: cannot write into /proc",
+    },
+    // A negative number reaches the option's own check (clap took it for an option).
+    Case {
+        args: &["stability", "--tol", "-1", "--out", "{dir}/st"],
+        inputs: &[],
+        expect: "'-1' for '--tol <TOL>': the tolerance must be a positive number",
+    },
 ];
 
 fn files_in(dir: &Path) -> Vec<PathBuf> {

@@ -180,9 +180,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
     };
     let dp = super::datapath::load(&vectors.to_string_lossy(), None)?;
-    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
-        super::output::check_can_create(dir, "--vcd")?;
-    } else if let Some(dir) = &args.vcd {
+    if let Some(dir) = &args.vcd {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));

@@ -204,13 +204,7 @@ pub const FIT_FILES: [&str; 11] = [
 
 /// Runs `specfx fit`.
 pub fn run(args: &FitArgs) -> Result<Outcome> {
-    let scene = super::render::load_scene(args.scene.as_deref())?;
-    let label = args
-        .scene
-        .as_ref()
-        .map_or("the built-in scene".to_string(), |p| {
-            p.display().to_string()
-        });
+    let (scene, label) = super::render::load_scene(args.scene.as_deref())?;
     let out_dir = super::output::OutDir::begin(
         &args.out,
         "fit",

@@ -213,6 +213,7 @@ fn command() -> clap::Command {
         "Exit codes: 0 success; 1 the command ran but a check it performs failed; 2 bad input \
          or an I/O error (one line on stderr, nothing written).",
     );
+    cmd = negative_values(cmd);
     for (name, example) in EXAMPLES {
         let help = format!("Example:\n  {example}");
         cmd = match name.split_once(' ') {
@@ -221,6 +222,27 @@ fn command() -> clap::Command {
             }
             None => cmd.mut_subcommand(*name, |c| c.after_help(help)),
         };
+    }
+    cmd
+}
+
+/// Lets every option of `cmd` and its commands take a negative number (`--tol -1`), so that
+/// the option's own check says what is wrong with it instead of clap's "unexpected argument".
+fn negative_values(mut cmd: clap::Command) -> clap::Command {
+    let ids: Vec<clap::Id> = cmd
+        .get_arguments()
+        .filter(|a| a.get_action().takes_values())
+        .map(|a| a.get_id().clone())
+        .collect();
+    for id in ids {
+        cmd = cmd.mut_arg(id, |a| a.allow_negative_numbers(true));
+    }
+    let subs: Vec<String> = cmd
+        .get_subcommands()
+        .map(|c| c.get_name().to_string())
+        .collect();
+    for sub in subs {
+        cmd = cmd.mut_subcommand(sub, negative_values);
     }
     cmd
 }
@@ -314,14 +336,7 @@ fn one_line(text: &str) -> String {
         }
         if !line.is_empty() {
             // A value clap echoes may hold control characters (a lone `\r` moves the cursor).
-            let shown = line.chars().map(|c| {
-                if c.is_control() {
-                    c.escape_debug().to_string()
-                } else {
-                    c.to_string()
-                }
-            });
-            parts.push(shown.collect());
+            parts.push(error_text(line));
         }
     }
     let mut out = String::new();
@@ -349,6 +364,38 @@ pub enum Outcome {
     Ok,
     /// The command ran, but a check it performs failed (exit code 1).
     CheckFailed,
+}
+
+/// The most worker threads `RAYON_NUM_THREADS` may ask for (as `throughput --threads`).
+const MAX_THREADS: usize = 1024;
+
+/// Checks `RAYON_NUM_THREADS` (which rayon reads itself) before any work: unset, empty or 0
+/// means one thread per core; more than [`MAX_THREADS`] would only spend memory on stacks.
+fn check_thread_count(value: Option<&std::ffi::OsStr>) -> Result<(), String> {
+    let Some(value) = value else { return Ok(()) };
+    let text = value.to_string_lossy();
+    // Exactly as rayon parses it (it takes anything else for "one per core").
+    match text.parse::<usize>() {
+        _ if text.is_empty() => Ok(()),
+        Ok(n) if n <= MAX_THREADS => Ok(()),
+        _ => Err(format!(
+            "RAYON_NUM_THREADS: expected a number of worker threads in 0..={MAX_THREADS} (0: one per core), got '{}'",
+            error_text(&text)
+        )),
+    }
+}
+
+/// User text on one line (control characters escaped).
+fn error_text(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_debug().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 /// Parses the arguments, runs the command and maps the result to an exit code.
@@ -384,6 +431,11 @@ pub fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Err(e) = check_thread_count(std::env::var_os("RAYON_NUM_THREADS").as_deref()) {
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), "specfx: error: {e}");
+        return ExitCode::from(2);
+    }
     logging::init(
         logging::Verbosity::from_flags(cli.quiet, cli.verbose),
         cli.color,
@@ -471,8 +523,46 @@ mod tests {
             control.starts_with(r"error: invalid value '16..x\r' for '--n <N>'"),
             "{control}"
         );
+        // A negative number reaches the option's own check, which says what it must be.
+        let negative = err(&["stability", "--tol", "-1"]);
+        assert!(
+            negative.contains(
+                "invalid value '-1' for '--tol <TOL>': the tolerance must be a positive number"
+            ),
+            "{negative}"
+        );
+        let negative = err(&[
+            "hdl",
+            "stimulus",
+            "--vectors",
+            "v",
+            "--out",
+            "o",
+            "--bubble",
+            "-0.5",
+        ]);
+        assert!(
+            negative.contains("invalid value '-0.5' for '--bubble"),
+            "{negative}"
+        );
         for e in [missing, typo, sub, value, control] {
             assert!(!e.contains('\n') && !e.contains("Usage"), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_thread_count_is_checked() {
+        use std::ffi::OsStr;
+        for ok in [None, Some(""), Some("0"), Some("1"), Some("1024")] {
+            assert_eq!(check_thread_count(ok.map(OsStr::new)), Ok(()), "{ok:?}");
+        }
+        for bad in ["1025", "100000", "-1", "two", "1\n", " 2"] {
+            let e = check_thread_count(Some(OsStr::new(bad))).unwrap_err();
+            assert!(
+                e.starts_with("RAYON_NUM_THREADS: expected a number of worker threads in 0..=1024"),
+                "{e}"
+            );
+            assert!(!e.contains('\n'), "{e}");
         }
     }
 

@@ -42,15 +42,9 @@ pub struct RenderArgs {
 
 /// Runs `specfx render`.
 pub fn run(args: &RenderArgs) -> Result<Outcome> {
-    let scene = load_scene(args.scene.as_deref())?;
+    let (scene, label) = load_scene(args.scene.as_deref())?;
     let ns = NSet::from_values(&scene.exponents())?;
     let dp: Datapath = super::datapath::load(&args.config, Some(&ns))?;
-    let label = args
-        .scene
-        .as_ref()
-        .map_or("the built-in scene".to_string(), |p| {
-            p.display().to_string()
-        });
     let out_dir = super::output::OutDir::begin(
         &args.out,
         "render",
@@ -183,9 +177,13 @@ pub fn inputs_csv(inputs: &[InputsOfN], lsb: f64) -> String {
     String::from_utf8(csv).expect("the CSV is UTF-8")
 }
 
-/// Reads a scene file (meshes relative to it), or the built-in scene.
-pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
-    Ok(match path {
+/// Reads a scene file (meshes relative to it), or the built-in scene; returns it with how
+/// documents name it (its path, or "the built-in scene").
+pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String)> {
+    let label = path.map_or("the built-in scene".to_string(), |p| {
+        p.display().to_string()
+    });
+    let scene = match path {
         None => Scene::default_scene(),
         Some(path) => {
             let text = super::input::read_text(path, &format!("scene {}", path.display()))?;
@@ -203,5 +201,6 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
             Scene::from_toml_with(&text, &load)
                 .with_context(|| format!("scene {}", path.display()))?
         }
-    })
+    };
+    Ok((scene, label))
 }

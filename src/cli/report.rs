@@ -395,9 +395,10 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     let mut resume = super::resume::Resume::open(dir, key, resumed)?;
     if resumed {
         log::info!(
-            "specfx report: resuming the interrupted run in {} ({} finished steps kept; --restart starts afresh)",
+            "specfx report: resuming the interrupted run in {} ({} finished {} kept; --restart starts afresh)",
             args.out.display(),
-            resume.n_reusable()
+            resume.n_reusable(),
+            if resume.n_reusable() == 1 { "step" } else { "steps" }
         );
     }
     *super::output::RESUME_HINT.lock().expect("hint") = Some(format!(

@@ -112,3 +112,43 @@ pub fn run_guarded(cmd: &mut Command) -> (Output, bool) {
     };
     (child.wait_with_output().unwrap(), finished)
 }
+
+/// A unit sphere at the origin seen from (0, 0, 5) in a 3x3 image, lit from the camera.
+#[allow(dead_code)]
+pub fn sphere_scene(k_s: f64, n: u32, intensity: f64, ambient: f64) -> String {
+    format!(
+        r#"
+[image]
+width = 3
+height = 3
+
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+fov_deg = 30.0
+
+[shading]
+model = "phong"
+ambient = {ambient}
+
+[[light]]
+kind = "directional"
+direction = [0.0, 0.0, 1.0]
+colour = [1.0, 0.5, 0.25]
+intensity = {intensity}
+
+[[material]]
+name = "m"
+n = {n}
+k_s = {k_s}
+k_d = 0.5
+colour = [0.8, 0.6, 0.4]
+
+[[object]]
+kind = "sphere"
+material = "m"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+"#
+    )
+}
