@@ -245,6 +245,41 @@ fn a_scene_without_shading_gets_the_documented_defaults() {
     assert_eq!(without.shading.model, specfx::scene::Model::BlinnPhong);
 }
 
+/// A scene path holding line breaks and Markdown cannot add a heading or a table row to
+/// `render.md`: the path is shown on its title line, escaped.
+#[test]
+fn the_scene_path_cannot_inject_markdown() {
+    let dir = std::env::temp_dir().join(format!("specfx-render-md-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let sub = dir.join("d\n\n# INJECTED\n| a | b |\n");
+    std::fs::create_dir_all(&sub).unwrap();
+    let scene = sub.join("s.toml");
+    std::fs::write(&scene, common::sphere_scene(0.1, 16, 1.0, 0.03)).unwrap();
+    let out = dir.join("out");
+    let o = common::specfx(&[
+        "render",
+        "-q",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(out.join("render.md")).unwrap();
+    let title = md.lines().next().unwrap();
+    assert!(
+        title.starts_with("# ") && title.contains("INJECTED"),
+        "{title}"
+    );
+    assert!(
+        !md.lines()
+            .skip(1)
+            .any(|l| l.contains("INJECTED") || l.starts_with("| a |")),
+        "{md}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn render_writes_the_images_and_the_table() {
     let dir = tempfile::tempdir().unwrap();
@@ -329,7 +364,10 @@ mod meshes {
     #[test]
     fn bad_meshes_get_clear_errors() {
         let nan = obj("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap_err();
-        assert!(nan.contains("vertex 2 is not finite"), "{nan}");
+        assert!(
+            nan.contains("line 2: expected `v x y z` (three finite numbers"),
+            "{nan}"
+        );
         let range = obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap_err();
         assert!(range.contains("m.obj"), "{range}");
         let none = obj("v 0 0 0\nv 1 0 0\n").unwrap_err();

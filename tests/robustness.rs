@@ -759,6 +759,55 @@ const CASES: &[Case] = &[
         inputs: &[],
         expect: "--vcd /proc/traces: cannot write into /proc",
     },
+    // Found from outside (issue 14, fifth pass).
+    Case {
+        args: &["sim", "--vcd", "{dir}/s.vcd", "--vcd-cycles", "1000000000"],
+        inputs: &[],
+        expect: "1000000000 is not in 1..=131072",
+    },
+    Case {
+        args: &[
+            "cosim", "--sim", "icarus", "--cases", "corner", "--bubble", "0.99", "--vcd", "{dir}/t",
+        ],
+        inputs: &[],
+        expect: "with --vcd, the trace is limited to 131072 cycles",
+    },
+    Case {
+        args: &["render", "--scene", "{dir}/s.toml", "--out", "{dir}/m", "--force"],
+        inputs: &[
+            Input::File(
+                "s.toml",
+                scene!("width = 4\nheight = 4", "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m/ok.obj\"\n"),
+            ),
+            Input::File("m/ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+        ],
+        expect: "would replace the directory that holds the input a mesh of --scene",
+    },
+    Case {
+        args: &["optimize", "--budget", "shape_total <= 1 lsb8 shape_quant <= 1", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "two bounds need ',' or 'and' between them",
+    },
+    Case {
+        args: &["optimize", "--budget", "dsps <= 1.5 on ice40", "--out", "{dir}/o.toml"],
+        inputs: &[],
+        expect: "a count of cells is a whole number",
+    },
+    Case {
+        args: &["stability", "--float", "powf,powf", "--out", "{dir}/st"],
+        inputs: &[],
+        expect: "--float: 'powf' is listed twice",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/sp.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("sp.toml", "[vary]\nk = [3, 3]\n")],
+        expect: "vary.k: expected distinct values, got 3 again (value 2)",
+    },
+    Case {
+        args: &["sweep", "--space", "{dir}/sp.toml", "--out", "{dir}/sw"],
+        inputs: &[Input::File("sp.toml", "[base]\nname = \"a b\"\n[vary]\nk = [3]\n")],
+        expect: "base.name: expected 1..=64 ASCII letters",
+    },
     // A negative number reaches the option's own check (clap took it for an option).
     Case {
         args: &["stability", "--tol", "-1", "--out", "{dir}/st"],
@@ -834,7 +883,11 @@ fn bad_input_gets_one_line_and_exit_code_2_and_leaves_nothing() {
         std::fs::create_dir_all(&dir).unwrap();
         for input in case.inputs {
             match input {
-                Input::File(name, text) => std::fs::write(dir.join(name), text).unwrap(),
+                Input::File(name, text) => {
+                    let path = dir.join(name);
+                    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+                    std::fs::write(path, text).unwrap()
+                }
                 Input::Fifo(name) => {
                     let ok = Command::new("mkfifo")
                         .arg(dir.join(name))

@@ -159,6 +159,9 @@ impl FromStr for Budget {
             } else {
                 return Err(bad(part, "no <= or >="));
             };
+            if rhs.contains("<=") || rhs.contains(">=") {
+                return Err(bad(part, "two bounds need ',' or 'and' between them"));
+            }
             let on = rhs.split_once(" on ");
             let (rhs, target) = match on {
                 Some((r, t)) => (
@@ -229,6 +232,9 @@ impl FromStr for Budget {
             };
             if !value.is_finite() || value < 0.0 {
                 return Err(bad(part, "the limit must be a finite number >= 0"));
+            }
+            if metric.is_cost() && value.fract() != 0.0 {
+                return Err(bad(part, "a count of cells is a whole number"));
             }
             if metric == Metric::Correct && limit > 1.0 {
                 return Err(bad(part, "a share of inputs is at most 100%"));

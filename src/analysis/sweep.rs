@@ -96,6 +96,17 @@ fn expand(key: &str, v: &toml::Value) -> Result<Vec<toml::Value>, Error> {
                     format!("expected 1..={MAX_AXIS_VALUES} values, got {}", items.len()),
                 ));
             }
+            // A value twice would be the same point twice, costed and charted twice.
+            if let Some((i, v)) = items
+                .iter()
+                .enumerate()
+                .find(|(i, v)| items[..*i].contains(v))
+            {
+                return Err(space_error(
+                    &format!("vary.{key}"),
+                    format!("expected distinct values, got {v} again (value {})", i + 1),
+                ));
+            }
             Ok(items.clone())
         }
         toml::Value::String(s) if s.contains("..") => {
@@ -169,6 +180,9 @@ impl Space {
             })?,
             None => Config::baseline(),
         };
+        // Each point is named after the base (the name reaches reports and file headers).
+        crate::pipeline::config::check_name(&base.name)
+            .map_err(|problem| space_error("base.name", problem))?;
         if let Some(n) = file.n {
             base.n = n;
         }

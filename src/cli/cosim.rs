@@ -180,9 +180,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
     };
     let dp = super::datapath::load(&vectors.to_string_lossy(), None)?;
-    if let Some(dir) = &args.vcd {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    }
+    // The --vcd directory is made with the model's trace, once the stimulus is known to fit.
     let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
     let stim = write_stimulus(&vectors, args.run, wd, model_vcd.as_deref())?;
     for port in [
@@ -249,9 +247,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
     );
     let log = simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
-    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
-        super::output::check_can_create(dir, "--vcd")?;
-    } else if let Some(dir) = &args.vcd {
+    if let Some(dir) = &args.vcd {
         let from = wd.join("rtl.vcd");
         std::fs::copy(&from, dir.join("rtl.vcd"))
             .with_context(|| format!("the simulator wrote no {}", from.display()))?;
@@ -279,9 +275,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         log::error!("cosim: FAIL: nothing was checked");
         return Ok(Outcome::CheckFailed);
     }
-    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
-        super::output::check_can_create(dir, "--vcd")?;
-    } else if let Some(dir) = &args.vcd {
+    if let Some(dir) = &args.vcd {
         let (model, rtl) = (dir.join("model.vcd"), dir.join("rtl.vcd"));
         if matches!(
             super::trace::compare_files(&model, &rtl)?,

@@ -249,15 +249,30 @@ pub fn write_stimulus(
     let ii = arch.initiation_interval(dp.config()) as f64;
     let per_vector = 1.0 / (1.0 - bubble) + ii / (1.0 - stall);
     let expected = (items.len() as f64 * per_vector).ceil();
-    if expected > MAX_STIMULUS_CYCLES as f64 {
+    // With a trace, every cycle is kept in memory: a tighter limit.
+    let (max, what) = match vcd {
+        Some(_) => (
+            specfx::cycle::vcd::MAX_TRACE_CYCLES,
+            "with --vcd, the trace",
+        ),
+        None => (MAX_STIMULUS_CYCLES, "the stimulus"),
+    };
+    if expected > max as f64 {
+        let fit = (max as f64 / per_vector).floor();
+        let advice = if fit < 1.0 {
+            "lower them".to_string()
+        } else {
+            format!("about {fit:.0} vectors fit at these probabilities: lower them or use fewer vectors")
+        };
         bail!(
-            "--bubble {bubble} and --stall {stall} would need about {expected:.0} cycles for {} vectors; the stimulus is limited to {MAX_STIMULUS_CYCLES} cycles, about {:.0} vectors at these probabilities (lower them or use fewer vectors)",
-            items.len(),
-            (MAX_STIMULUS_CYCLES as f64 / per_vector).floor()
+            "--bubble {bubble} and --stall {stall} would need about {expected:.0} cycles for {} vectors; {what} is limited to {max} cycles ({advice})",
+            items.len()
         );
     }
-    let limit = (20.0 * expected + 100.0 * arch.latency(dp.config()) as f64 + 1_000.0) as u64;
-    let trace_cycles = if vcd.is_some() { u64::MAX } else { 0 };
+    // The run stops at the limit: a stimulus that has not drained by then is refused below.
+    let limit = (20.0 * expected + 100.0 * arch.latency(dp.config()) as f64 + 1_000.0)
+        .min(max as f64) as u64;
+    let trace_cycles = if vcd.is_some() { max } else { 0 };
     let result = simulate(
         &dp,
         arch,
@@ -318,7 +333,7 @@ pub fn write_stimulus(
         write_vcd(&mut buf, &dp, arch, &result.trace)?;
         files.push((path.to_path_buf(), buf));
     }
-    super::output::write_all_atomic(out, &files)?;
+    super::output::write_all_atomic(&files)?;
     Ok(StimulusInfo {
         n_vectors: items.len(),
         n_cycles: s.n_cycles,

@@ -187,7 +187,7 @@ const EXAMPLES: &[(&str, &str)] = &[
     ),
     (
         "fit",
-        "specfx fit --scene examples/scenes/vessel_bifurcation.toml --out fitted.toml",
+        "specfx fit --scene examples/scenes/vessel_bifurcation.toml --budget 'max_lsb <= 4' --out fit-out",
     ),
     ("furnace", "specfx furnace --out furnace-out"),
     (
@@ -316,7 +316,7 @@ fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
                 .collect();
             let names: Vec<&str> = names.iter().map(String::as_str).collect();
             output::check_files_in(dir, &names, "--out", &[], Some(MAN_HEADER), args.force)?;
-            output::write_all_atomic(dir, &pages)?;
+            output::write_all_atomic(&pages)?;
         }
     }
     Ok(Outcome::Ok)

@@ -22,15 +22,27 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Writes several files all or none: every file to its temporary name first, then each
-/// renamed into place (a rename needs no space). When one cannot be written, none is, and the
-/// directories created for them (`dir` and any missing parent) are removed again.
-pub fn write_all_atomic(dir: &Path, files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
-    let missing: Vec<&Path> = dir
-        .ancestors()
-        .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
-        .collect();
-    let staged = fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create {}", dir.display()))
+/// renamed into place (a rename needs no space). The files' directories are created as
+/// needed; when one file cannot be written, none is, and the directories created for them are
+/// removed again.
+pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
+    let mut missing: Vec<PathBuf> = Vec::new();
+    for (path, _) in files {
+        for d in parent_of(path).ancestors() {
+            if d.as_os_str().is_empty() || d.exists() {
+                break;
+            }
+            if !missing.iter().any(|m| m == d) {
+                missing.push(d.to_path_buf());
+            }
+        }
+    }
+    let staged = files
+        .iter()
+        .try_for_each(|(path, _)| {
+            let dir = parent_of(path);
+            fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+        })
         .and_then(|()| {
             files
                 .iter()
@@ -41,6 +53,7 @@ pub fn write_all_atomic(dir: &Path, files: &[(PathBuf, Vec<u8>)]) -> Result<()> 
         Ok(s) => s,
         Err(e) => {
             // Deepest first; a directory something else wrote into meanwhile stays.
+            missing.sort_by_key(|d| std::cmp::Reverse(d.components().count()));
             for d in &missing {
                 let _ = fs::remove_dir(d);
             }
@@ -628,8 +641,34 @@ fn begins_with(path: &Path, header: Option<&str>) -> bool {
 /// [`refuse_over_inputs`].
 pub fn inputs(config: &str, scene: Option<&Path>) -> Vec<(&'static str, PathBuf)> {
     let mut v = config_inputs_as("--config", config);
-    v.extend(scene.map(|p| ("--scene", p.to_path_buf())));
+    if let Some(scene) = scene {
+        v.push(("--scene", scene.to_path_buf()));
+        v.extend(
+            mesh_files(scene)
+                .into_iter()
+                .map(|p| ("a mesh of --scene", p)),
+        );
+    }
     v
+}
+
+/// The mesh files a scene file names (relative to its directory); none when it cannot be
+/// read (the scene's own error comes later).
+fn mesh_files(scene: &Path) -> Vec<PathBuf> {
+    let dir = scene.parent().unwrap_or(Path::new(""));
+    let table = fs::read_to_string(scene)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok());
+    let objects = table
+        .as_ref()
+        .and_then(|t| t.get("object"))
+        .and_then(|o| o.as_array());
+    objects
+        .into_iter()
+        .flatten()
+        .filter_map(|o| o.get("file").and_then(|f| f.as_str()))
+        .map(|f| dir.join(f))
+        .collect()
 }
 
 /// [`config_input`]'s files, each labelled with the flag that named them.

@@ -88,6 +88,9 @@ fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
                             .join(", ")
                     );
                 };
+                if v.iter().any(|q: &MapPath| q.name() == name) {
+                    bail!("--float: '{name}' is listed twice");
+                }
                 v.push(MapPath::Float(*p));
             }
             v

@@ -94,6 +94,12 @@ fn parse_failure(e: &std::io::Error, line: u64) -> String {
         .get_ref()
         .and_then(|i| i.downcast_ref::<vcd::ParseError>())
     {
+        // A time, a width or a real value: say what was expected, not only Rust's reason.
+        Some(p) if matches!(p.kind(), vcd::ParseErrorKind::ParseIntError(_)) => format!(
+            "line {}: expected an unsigned decimal number below 2^64 ({})",
+            p.line(),
+            p.kind()
+        ),
         Some(p) => format!("line {}: {}", p.line(), p.kind()),
         None => format!("line {line}: {e}"),
     }
@@ -698,6 +704,11 @@ $var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end $enddefinitions
             let e = second_error(&GOOD.replacen(from, to, 1));
             assert!(e.starts_with(expect), "{to}: {e}");
         }
+        let e = second_error(&GOOD.replacen("#10", "#1x0", 1));
+        assert_eq!(
+            e,
+            "line 4: expected an unsigned decimal number below 2^64 (invalid digit found in string)"
+        );
         // The line is said once: the parser's own errors carry it as "at line N".
         let e = second_error(&GOOD.replacen("#6", "#6 q", 1));
         assert_eq!(e, "line 4: unexpected character at start of command");

@@ -161,6 +161,10 @@ fn value(dp: &Datapath, t: &CycleTrace, source: Source, width: u32) -> Option<Wo
     Some(Word::new(raw, width))
 }
 
+/// The longest trace specfx writes, in cycles (2^17): every register of every traced cycle is
+/// kept in memory, several kilobytes a cycle, until the trace is written.
+pub const MAX_TRACE_CYCLES: u64 = 1 << 17;
+
 /// The first bytes of every trace [`write_vcd`] writes (a simulator's dump begins with
 /// `$date` or a comment): how a command recognises its own earlier trace before replacing it.
 pub const VCD_HEADER: &str = "$timescale 1 ns $end\n$scope module tb_specfx $end\n";

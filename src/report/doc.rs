@@ -36,12 +36,15 @@ pub enum Block {
 
 /// Escapes text for Markdown outside its `code` spans: `&`, `<` and `>` as entities (no raw
 /// HTML such as `<script>` gets through), `\\`, `[` and `]` with a backslash (no links or
-/// images). Code spans are kept as they are: Markdown shows their content literally.
+/// images). Code spans are kept as they are: Markdown shows their content literally. A control
+/// character (a line break, a tab) is shown as its Rust escape (`\n`) everywhere, so that text
+/// cannot start a heading, a list or a table row of its own.
 ///
 /// # Examples
 /// ```
 /// use specfx::report::doc::md_escape;
 /// assert_eq!(md_escape("<img onerror=x> [a](b) `<b>`"), "&lt;img onerror=x&gt; \\[a\\](b) `<b>`");
+/// assert_eq!(md_escape("a\n# b `c\nd`"), "a\\\\n# b `c\\nd`");
 /// ```
 pub fn md_escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
@@ -50,11 +53,21 @@ pub fn md_escape(s: &str) -> String {
             out.push('`');
         }
         if i % 2 == 1 {
-            out.push_str(part);
+            for ch in part.chars() {
+                if ch.is_control() {
+                    out.extend(ch.escape_debug());
+                } else {
+                    out.push(ch);
+                }
+            }
             continue;
         }
         for ch in part.chars() {
             match ch {
+                // The escape's backslash escaped in turn, so that Markdown shows `\n`.
+                _ if ch.is_control() => {
+                    out.push_str(&ch.escape_debug().to_string().replace('\\', "\\\\"))
+                }
                 '&' => out.push_str("&amp;"),
                 '<' => out.push_str("&lt;"),
                 '>' => out.push_str("&gt;"),

@@ -102,6 +102,9 @@ impl FromStr for ImageBudget {
             let Some((lhs, rhs)) = part.split_once("<=") else {
                 return Err(bad(part, "no <="));
             };
+            if rhs.contains("<=") {
+                return Err(bad(part, "two bounds need ',' or 'and' between them"));
+            }
             let lhs = lhs.trim();
             let (name, material) = match lhs.split_once('[') {
                 Some((name, rest)) => match rest.strip_suffix(']') {

@@ -239,10 +239,12 @@ fn check_obj(text: &str) -> Result<(), String> {
             Some("v") => {
                 let numbers: Vec<&str> = words.collect();
                 if !(3..=7).contains(&numbers.len())
-                    || numbers.iter().any(|w| w.parse::<f32>().is_err())
+                    || numbers
+                        .iter()
+                        .any(|w| !w.parse::<f32>().is_ok_and(f32::is_finite))
                 {
                     return Err(format!(
-                        "line {}: expected `v x y z` (three numbers, then optionally w or a colour), got '{}'",
+                        "line {}: expected `v x y z` (three finite numbers, then optionally w or a colour), got '{}'",
                         i + 1,
                         shown()
                     ));
@@ -372,11 +374,21 @@ fn check_ascii_stl(bytes: &[u8]) -> Result<(), String> {
 }
 
 fn read_stl(bytes: &[u8], fail: impl Fn(String) -> Error) -> Result<Indexed, Error> {
+    // A byte-order mark before an ASCII STL's `solid` is not part of it.
+    let bytes = match bytes.strip_prefix("\u{feff}".as_bytes()) {
+        Some(rest) if rest.starts_with(b"solid ") => rest,
+        _ => bytes,
+    };
     let binary = stl_is_binary(bytes);
     if binary {
         check_binary_stl(bytes).map_err(&fail)?;
-    } else {
-        check_ascii_stl(bytes).map_err(&fail)?;
+    } else if let Err(ascii) = check_ascii_stl(bytes) {
+        // Not text after `solid `: a binary file whose header starts so, of the wrong size.
+        let text = std::str::from_utf8(bytes).is_ok_and(|t| !t.contains('\0'));
+        return Err(fail(match check_binary_stl(bytes) {
+            Err(size) if !text => size,
+            _ => ascii,
+        }));
     }
     // stl_io takes any file starting with `solid ` for ASCII.
     let mut owned;
@@ -516,8 +528,15 @@ mod tests {
             ),
             ("f 1 2 -4\n", "line 4: vertex index -4 is out of range"),
             ("f 0 1 2\n", "line 4: vertex index 0 is out of range"),
-            ("v 1 2\n", "line 4: expected `v x y z` (three numbers"),
+            (
+                "v 1 2\n",
+                "line 4: expected `v x y z` (three finite numbers",
+            ),
             ("v 1 2 z\n", "line 4: expected `v x y z`"),
+            (
+                "v 1 2 1e39\n",
+                "line 4: expected `v x y z` (three finite numbers",
+            ),
         ] {
             let e = err(format!("{v}{tail}").as_bytes(), MeshFormat::Obj);
             assert!(e.starts_with(&format!("m: {expect}")), "{tail}: {e}");
@@ -536,6 +555,9 @@ mod tests {
         let facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
         let good = format!("solid t\n{facet}endsolid t\n");
         let m = Mesh::parse(good.as_bytes(), MeshFormat::Stl, 1.0, [0.0; 3], "m").unwrap();
+        assert_eq!(m.triangles.len(), 1);
+        let bom = format!("\u{feff}{good}");
+        let m = Mesh::parse(bom.as_bytes(), MeshFormat::Stl, 1.0, [0.0; 3], "m").unwrap();
         assert_eq!(m.triangles.len(), 1);
         for (from, to, expect) in [
             (
@@ -570,6 +592,15 @@ mod tests {
         let e = err(&bin, MeshFormat::Stl);
         assert_eq!(e, "m: binary STL: its header says 2 triangles, which take 184 bytes, but the file has 144");
         assert!(err(&bin[..50], MeshFormat::Stl).contains("got 50 bytes"));
+        // Its header starting with `solid ` and its size wrong: the size is what is said.
+        let mut solid_bin = bin.clone();
+        solid_bin[..6].copy_from_slice(b"solid ");
+        solid_bin[90] = 0xff;
+        let e = err(&solid_bin, MeshFormat::Stl);
+        assert!(
+            e.starts_with("m: binary STL: its header says 2 triangles"),
+            "{e}"
+        );
         // A binary header that starts with `solid ` (some exporters write one) is still binary.
         let mut tri = vec![0u8; 12];
         for v in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
