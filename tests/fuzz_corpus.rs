@@ -178,3 +178,8 @@ fn mesh_obj_corpus() {
 fn mesh_stl_corpus() {
     assert!(replay("mesh_stl") > 0);
 }
+
+#[test]
+fn trace_corpus() {
+    assert!(replay("trace") > 0);
+}

@@ -711,7 +711,12 @@ const CASES: &[Case] = &[
     Case {
         args: &["calibrate", "--count", "0", "--data", "{dir}/cal"],
         inputs: &[],
-        expect: "'0' for '--count <COUNT>': 0 is not in 1..=100000",
+        expect: "'0' for '--count <COUNT>': expected a whole number of configurations in 1..=100000",
+    },
+    Case {
+        args: &["calibrate", "--count", "-1", "--data", "{dir}/cal"],
+        inputs: &[],
+        expect: "'-1' for '--count <COUNT>': expected a whole number of configurations in 1..=100000",
     },
     Case {
         args: &["sweep", "--space", "{dir}/sp.toml", "--out", "{dir}/sw"],

@@ -9,6 +9,7 @@ use std::fmt::Display;
 
 use specfx::analysis::optimize::Budget;
 use specfx::analysis::sweep::{Space, MAX_POINTS};
+use specfx::cycle::compare::compare;
 use specfx::fixed::{Format, Overflow, Rounding};
 use specfx::golden::verify::{VerifiedManifest, CSV_FILE};
 use specfx::nset::{NSet, N_MAX};
@@ -32,6 +33,7 @@ pub const TARGETS: &[(&str, Check)] = &[
     ("manifest", manifest),
     ("mesh_obj", mesh_obj),
     ("mesh_stl", mesh_stl),
+    ("trace", trace),
 ];
 
 /// A refused input: its error is one line; not accepted.
@@ -392,4 +394,20 @@ pub fn format(data: &[u8]) -> bool {
         Err(e) => refused(text, &e),
     };
     format || rounding || overflow
+}
+
+/// A VCD trace (`specfx trace compare`): the trace compared with itself. It is read without a
+/// panic or a stack overflow and refused with one line, or it agrees with itself: no width
+/// differs and no known bit does.
+pub fn trace(data: &[u8]) -> bool {
+    match compare(data, data) {
+        Err(e) => refused(&String::from_utf8_lossy(data), &e),
+        Ok(c) => {
+            assert!(
+                c.first_difference.is_none() && c.width_mismatches.is_empty(),
+                "a trace differs from itself: {c:?}"
+            );
+            true
+        }
+    }
 }

@@ -30,7 +30,7 @@ pub struct CalibrateArgs {
     targets: Vec<Target>,
     /// Number of sampled configurations per target (default: the committed sample's, 240
     /// for ice40 and 120 for the slower xilinx and generic-fast mappings); 1..=100000.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    #[arg(long, value_parser = parse_count)]
     count: Option<u64>,
     /// Seed of the sample.
     #[arg(long, default_value_t = 1)]
@@ -161,6 +161,15 @@ fn collect(args: &CalibrateArgs, target: Target, hdl_ref: &Path) -> Result<()> {
         .map(|r| serde_json::to_string(r).map(|l| l + "\n"))
         .collect::<Result<_, _>>()?;
     super::output::write_atomic(&path, text.as_bytes())
+}
+
+/// A `--count`: a whole number in 1..=100000 (a negative one too gets the range, not a
+/// parser's reason).
+fn parse_count(s: &str) -> Result<u64, String> {
+    match s.parse::<u64>() {
+        Ok(n) if (1..=100_000).contains(&n) => Ok(n),
+        _ => Err("expected a whole number of configurations in 1..=100000".to_string()),
+    }
 }
 
 /// Runs `specfx calibrate`.

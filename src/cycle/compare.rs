@@ -178,19 +178,25 @@ fn trace_error(which: usize, problem: String) -> Error {
     Error::Trace { which, problem }
 }
 
-/// Every identifier code the file declares, with its variable's width (the widest, when one
-/// code is declared twice).
-fn declared(items: &[ScopeItem], out: &mut HashMap<IdCode, u32>) {
+/// Every identifier code the file declares, with its variable's width. One code declared
+/// twice (a signal seen in two scopes) must have one width.
+fn declared(items: &[ScopeItem], out: &mut HashMap<IdCode, u32>) -> Result<(), String> {
     for item in items {
         match item {
-            ScopeItem::Scope(s) => declared(&s.items, out),
+            ScopeItem::Scope(s) => declared(&s.items, out)?,
             ScopeItem::Var(v) => {
-                let w = out.entry(v.code).or_insert(v.size);
-                *w = (*w).max(v.size);
+                let w = *out.entry(v.code).or_insert(v.size);
+                if w != v.size {
+                    return Err(format!(
+                        "identifier '{}' is declared with widths {w} and {} ({})",
+                        v.code, v.size, v.reference
+                    ));
+                }
             }
             _ => {}
         }
     }
+    Ok(())
 }
 
 /// The file's variables in declaration order, full names unique (the first kept).
@@ -409,6 +415,14 @@ impl<R: BufRead> Reader<R> {
             Some(Command::ChangeScalar(id, _)) => (id, 1),
             Some(Command::ChangeVector(id, v)) => (id, v.len()),
             Some(Command::ChangeReal(id, _)) | Some(Command::ChangeString(id, _)) => (id, 0),
+            // Declarations belong to the header: one among the values would go unread.
+            Some(
+                Command::ScopeDef(..)
+                | Command::Upscope
+                | Command::VarDef(..)
+                | Command::Enddefinitions
+                | Command::Timescale(..),
+            ) => return fail("a declaration after $enddefinitions".to_string()),
             _ => return Ok(()),
         };
         match self.declared.get(id) {
@@ -519,7 +533,7 @@ fn header<R: BufRead>(which: usize, p: &mut vcd::Parser<R>) -> Result<Header, Er
         }
     }
     let mut ids = HashMap::new();
-    declared(&h.items, &mut ids);
+    declared(&h.items, &mut ids).map_err(|e| trace_error(which, e))?;
     Ok(Header {
         vars,
         declared: ids,
@@ -704,6 +718,10 @@ $var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end $enddefinitions
             let e = second_error(&GOOD.replacen(from, to, 1));
             assert!(e.starts_with(expect), "{to}: {e}");
         }
+        let e = second_error(&GOOD.replacen("#10", "$var wire 1 % w $end #10", 1));
+        assert_eq!(e, "line 4: a declaration after $enddefinitions");
+        let e = second_error(&GOOD.replacen("4 # v", "4 # v $end $var wire 1 # w", 1));
+        assert_eq!(e, "identifier '#' is declared with widths 4 and 1 (w)");
         let e = second_error(&GOOD.replacen("#10", "#1x0", 1));
         assert_eq!(
             e,
