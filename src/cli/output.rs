@@ -299,7 +299,13 @@ impl OutDir {
         std::fs::create_dir_all(&parent)
             .with_context(|| format!("cannot create {}", parent.display()))?;
         let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
-        if staging.exists() {
+        if std::fs::symlink_metadata(&staging).is_ok() {
+            if !ours(&staging) {
+                anyhow::bail!(
+                    "{}: exists and is not a staging directory specfx made; remove it or pass another --out",
+                    staging.display()
+                );
+            }
             std::fs::remove_dir_all(&staging)
                 .with_context(|| format!("cannot remove {}", staging.display()))?;
         }
@@ -411,18 +417,37 @@ fn stale(parent: &Path, name: &str) -> Vec<(PathBuf, bool)> {
                 .map(|pid| (pid, *tag == ".partial-"))
         });
         if let Some((pid, partial)) = tagged {
-            // Only what specfx wrote: a directory with its marker (or still empty, killed
-            // before the marker); a user's directory of the same shape is left alone.
             let path = e.path();
-            let ours = path.join(MARKER).is_file()
-                || std::fs::read_dir(&path).is_ok_and(|mut d| d.next().is_none());
-            if ours && pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            if ours(&path)
+                && pid != std::process::id()
+                && !Path::new(&format!("/proc/{pid}")).exists()
+            {
                 found.push((path, partial));
             }
         }
     }
     found.sort();
     found
+}
+
+/// Whether `path` is a directory specfx made: a real directory (not a symbolic link) owned by
+/// this user, holding its marker as a regular file (or still empty: killed before writing the
+/// marker). A user's directory of the same name, or a link to one, is left alone.
+fn ours(path: &Path) -> bool {
+    let Ok(meta) = std::fs::symlink_metadata(path) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt as _;
+        // SAFETY: geteuid has no preconditions and cannot fail.
+        if meta.uid() != unsafe { libc::geteuid() } {
+            return false;
+        }
+    }
+    meta.is_dir()
+        && (std::fs::symlink_metadata(path.join(MARKER)).is_ok_and(|m| m.is_file())
+            || std::fs::read_dir(path).is_ok_and(|mut d| d.next().is_none()))
 }
 
 /// Removes the directories [`stale`] finds.
@@ -697,6 +722,56 @@ mod tests {
         std::fs::write(dir.join(MARKER), format!("{command}\n")).unwrap();
         std::fs::write(dir.join("done.txt"), "kept").unwrap();
         dir
+    }
+
+    #[test]
+    fn a_link_named_like_a_staging_directory_is_never_taken_over() {
+        let tmp = tempfile::tempdir().unwrap();
+        let target = tmp.path().join("o");
+        // A user's directory that even holds a marker, linked under a dead process's staging
+        // name and under a moved-aside name.
+        let users = tmp.path().join("users");
+        std::fs::create_dir(&users).unwrap();
+        std::fs::write(users.join(MARKER), "report\n").unwrap();
+        std::fs::write(users.join("notes.txt"), "mine").unwrap();
+        for tag in [".partial-", ".old-"] {
+            std::os::unix::fs::symlink(&users, tmp.path().join(format!(".o{tag}999999999")))
+                .unwrap();
+        }
+        let (out, resumed) = OutDir::begin_resumable(&target, "report", false, &[], false).unwrap();
+        assert!(!resumed);
+        assert!(!std::fs::symlink_metadata(out.path()).unwrap().is_symlink());
+        std::fs::write(out.path().join("page.html"), "x").unwrap();
+        out.commit().unwrap();
+        assert!(!std::fs::symlink_metadata(&target).unwrap().is_symlink());
+        assert_eq!(
+            std::fs::read_to_string(users.join("notes.txt")).unwrap(),
+            "mine"
+        );
+        assert!(!users.join("page.html").exists());
+        for tag in [".partial-", ".old-"] {
+            let link = tmp.path().join(format!(".o{tag}999999999"));
+            assert!(
+                std::fs::symlink_metadata(link).unwrap().is_symlink(),
+                "left alone"
+            );
+        }
+
+        // A link at this process's own staging name is refused, not followed or removed.
+        let own = tmp
+            .path()
+            .join(format!(".p.partial-{}", std::process::id()));
+        std::os::unix::fs::symlink(&users, &own).unwrap();
+        let err = OutDir::begin(&tmp.path().join("p"), "report", false, &[])
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            err.contains("is not a staging directory specfx made"),
+            "{err}"
+        );
+        assert!(std::fs::symlink_metadata(&own).unwrap().is_symlink());
+        assert!(users.join("notes.txt").exists());
     }
 
     #[test]

@@ -196,9 +196,18 @@ fn still_true(staging: &Path, path: &Path, key: &str) -> Option<Checkpoint<serde
     (found == checkpoint.files).then_some(checkpoint)
 }
 
-/// Adds every file under `path` (or `path` itself), relative to `root`, with its sha256.
+/// Adds every file under `path` (or `path` itself), relative to `root`, with its sha256. Only
+/// real directories and regular files count: a symbolic link (which would make the result
+/// point outside itself) or any other kind of file is an error, so a checkpoint holding one is
+/// never reused.
 fn hash_tree(root: &Path, path: &Path, out: &mut BTreeMap<String, String>) -> Result<()> {
-    if path.is_dir() {
+    let kind = std::fs::symlink_metadata(path)
+        .with_context(|| format!("cannot read {}", path.display()))?
+        .file_type();
+    if !kind.is_dir() && !kind.is_file() {
+        anyhow::bail!("{}: is not a regular file or directory", path.display());
+    }
+    if kind.is_dir() {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(path)
             .with_context(|| format!("cannot read {}", path.display()))?
             .map(|e| e.map(|e| e.path()))
@@ -317,5 +326,41 @@ mod tests {
         r.finish().unwrap();
         assert!(!dir.join(CHECKPOINTS).exists());
         assert!(dir.join("a/x.txt").exists());
+    }
+
+    #[test]
+    fn a_checkpointed_file_replaced_by_a_symlink_is_not_reused() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = &tmp.path().join("staging");
+        std::fs::create_dir(dir).unwrap();
+        std::fs::write(dir.join(MARKER), "report\n").unwrap();
+        let mut r = Resume::open(dir, "k".into(), false).unwrap();
+        assert_eq!(step_a(&mut r, dir, "one"), (7, true));
+        // An outside copy with the very same bytes, linked in place of the step's file: its
+        // hash holds, yet the result would point outside itself.
+        let outside = tmp.path().join("outside.txt");
+        std::fs::write(&outside, "one").unwrap();
+        std::fs::remove_file(dir.join("a/x.txt")).unwrap();
+        std::os::unix::fs::symlink(&outside, dir.join("a/x.txt")).unwrap();
+        let mut r = Resume::open(dir, "k".into(), true).unwrap();
+        assert_eq!(r.n_reusable(), 0);
+        assert_eq!(step_a(&mut r, dir, "two"), (7, true), "runs again");
+        let kind = std::fs::symlink_metadata(dir.join("a/x.txt")).unwrap();
+        assert!(kind.is_file(), "a regular file again");
+        assert_eq!(std::fs::read_to_string(&outside).unwrap(), "one");
+
+        // The same with the step's whole directory linked to an outside copy.
+        let copy = tmp.path().join("copy");
+        std::fs::create_dir(&copy).unwrap();
+        std::fs::write(copy.join("x.txt"), "two").unwrap();
+        std::fs::remove_dir_all(dir.join("a")).unwrap();
+        std::os::unix::fs::symlink(&copy, dir.join("a")).unwrap();
+        let r = Resume::open(dir, "k".into(), true).unwrap();
+        assert_eq!(r.n_reusable(), 0);
+        assert!(
+            std::fs::symlink_metadata(dir.join("a")).is_err(),
+            "the link is removed"
+        );
+        assert!(copy.join("x.txt").exists(), "not what it points to");
     }
 }
