@@ -1,7 +1,8 @@
 //! Traces: the model's VCD (`specfx hdl stimulus --vcd`) against the testbench's dump of the
 //! same run in Icarus Verilog and Verilator (`specfx cosim --vcd`), compared with
 //! `specfx trace compare` signal by signal; a mutated RTL found at its first differing cycle
-//! and signal; the comparison's rules on hand-written traces.
+//! and signal (by `cosim --vcd` too, beside the failing vectors); the comparison's rules on
+//! hand-written traces, signals in one file only among them.
 
 mod common;
 use common::{config_path, specfx};
@@ -422,9 +423,6 @@ fn a_mutated_rounding_is_found_at_its_first_cycle_and_signal() {
     let cycle = j + 5;
     let signal = "tb_specfx.dut.g_pipelined.u_core.g_square[2].y_q";
     let (model, rtl) = (traces.join("model.vcd"), traces.join("rtl.vcd"));
-    let o = trace_compare(&model, &rtl);
-    assert_eq!(o.status.code(), Some(1));
-    let out = String::from_utf8_lossy(&o.stdout);
     let want = format!(
         "first difference: cycle {cycle}, {signal} = {:05x} in {}, {:05x} in {}\n",
         sq2[j],
@@ -432,6 +430,27 @@ fn a_mutated_rounding_is_found_at_its_first_cycle_and_signal() {
         truncated[j],
         rtl.display()
     );
+    // cosim compared the traces although vectors failed (issue 25): the first differing
+    // register follows the failing vectors and their summary, and the failure names it.
+    let out = String::from_utf8_lossy(&o.stdout);
+    let (vectors_part, traces_part) = out
+        .split_once(" failed\n")
+        .unwrap_or_else(|| panic!("no summary in {out}"));
+    assert!(vectors_part.starts_with("mismatch i="), "{out}");
+    assert!(!vectors_part.ends_with(" 0"), "{out}");
+    assert!(traces_part.starts_with(&want), "want {want}got {out}");
+    assert!(traces_part.ends_with("TRACES DIFFER\n"), "{out}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "vectors failed; the model's and the RTL's traces first differ at cycle {cycle}, {signal}\n"
+        )),
+        "{err}"
+    );
+
+    let o = trace_compare(&model, &rtl);
+    assert_eq!(o.status.code(), Some(1));
+    let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.starts_with(&want), "want {want}got {out}");
     assert!(out.contains("g_square[2].r_square.g_regs.g_stage[0].r"));
     assert!(out.ends_with("TRACES DIFFER\n"));
@@ -601,5 +620,122 @@ fn hand_written_traces_check_dont_care_widths_and_exit_codes() {
             "{err}"
         );
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A signal in one file only (issue 25): the model's register the RTL's dump lacks is a
+/// difference (it was never compared), unless --ignore-missing accepts it or --ignore leaves
+/// it out; a register of the RTL in a scope the model has signals in, which the model lacks,
+/// too; a variable of 0 bits is refused with its file and line.
+#[test]
+fn a_signal_in_one_file_only_is_a_difference_unless_ignored() {
+    let dir = temp_dir("missing");
+    let v4 = "$var wire 4 $ v [3:0] $end";
+    let values = ["0001", "0010", "0011"];
+    let rtl = write(&dir, "rtl.vcd", &tiny(&values, v4, false));
+    // The issue's reproduction: a register `ghost` beside the testbench, 1 from the first
+    // cycle on, equal everywhere else.
+    let extra = "$scope module extra $end $var reg 1 ~~ ghost $end $upscope $end";
+    let ghost_text = tiny(&values, v4, false)
+        .replacen("$enddefinitions", &format!("{extra}\n$enddefinitions"), 1)
+        .replacen("#5\n1!\n", "#5\n1!\n1~~\n", 1);
+    let ghost = write(&dir, "ghost.vcd", &ghost_text);
+    let run = |extra_args: &[&str], first: &Path| {
+        let mut args = vec!["trace", "compare"];
+        args.extend_from_slice(extra_args);
+        args.extend([first.to_str().unwrap(), rtl.to_str().unwrap()]);
+        specfx(&args)
+    };
+    let o = run(&[], &ghost);
+    assert_eq!(o.status.code(), Some(1));
+    let out = String::from_utf8_lossy(&o.stdout);
+    // clk, rst, cycle and v compared over cycles 0, 1 and 2; ghost only in the model's.
+    assert!(
+        out.starts_with(&format!(
+            "compared 4 signals over 3 cycles; 1 signals only in {}, 0 only in {}; 0 width mismatches; 0 signals differ\n  only in {}: extra.ghost\n",
+            ghost.display(),
+            rtl.display(),
+            ghost.display()
+        )),
+        "{out}"
+    );
+    assert!(
+        out.ends_with(
+            "TRACES DIFFER: 1 signals missing from one file (--ignore-missing accepts them)\n"
+        ),
+        "{out}"
+    );
+    for waiver in [
+        &["--ignore-missing"][..],
+        &["--ignore", "extra.ghost"],
+        &["--ignore", "extra.*"],
+    ] {
+        let o = run(waiver, &ghost);
+        ok(&o);
+        assert!(String::from_utf8_lossy(&o.stdout).ends_with("traces agree\n"));
+    }
+    // Where the RTL has a register of a scope the model covers and the model has not.
+    let core = "$scope module dut $end $var wire 1 % a $end";
+    let model = write(
+        &dir,
+        "model.vcd",
+        &tiny(&values, &format!("{v4} {core} $upscope $end"), false),
+    );
+    let with_q = |decl: &str| format!("{v4} {core} {decl} $upscope $end");
+    let q = write(
+        &dir,
+        "q.vcd",
+        &tiny(&values, &with_q("$var reg 1 & q $end"), false),
+    );
+    let o = trace_compare(&model, &q);
+    assert_eq!(o.status.code(), Some(1));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let want = format!(
+        "  1 registers only in {}, in scopes {} has signals in: tb_specfx.dut.q\n",
+        q.display(),
+        model.display()
+    );
+    assert!(out.contains(&want), "{out}");
+    // A wire there is no register; the testbench's own registers are not the RTL's.
+    for (name, decl) in [
+        ("wire.vcd", with_q("$var wire 1 & q $end")),
+        (
+            "tb.vcd",
+            format!("{v4} $var reg 1 & held $end {core} $upscope $end"),
+        ),
+    ] {
+        let o = trace_compare(&model, &write(&dir, name, &tiny(&values, &decl, false)));
+        ok(&o);
+    }
+
+    // A variable of 0 bits: one line naming the file and the line of its declaration (the
+    // eighth: $timescale, tb_specfx's scope, clk, rst, cycle, v, $upscope, then extra).
+    let zero = write(
+        &dir,
+        "zero.vcd",
+        &ghost_text.replace("reg 1 ~~", "reg 0 ~~"),
+    );
+    for (a, b) in [(&zero, &rtl), (&rtl, &zero)] {
+        let o = trace_compare(a, b);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(o.stdout.is_empty());
+        assert_eq!(
+            String::from_utf8_lossy(&o.stderr),
+            format!(
+                "specfx: error: {}: line 8: $var 'ghost' has width 0 (a variable has at least 1 bit)\n",
+                zero.display()
+            )
+        );
+    }
+    // An ignored name no signal has is bad input, not a silent waiver.
+    let o = run(&["--ignore", "extra.ghots"], &ghost);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("specfx: error: unknown signal to ignore 'extra.ghots'"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -95,7 +95,8 @@ pub struct CosimArgs {
     hdl_ref: Option<PathBuf>,
     /// Write both traces of the run into this directory, the RTL's (every signal of the
     /// testbench) as rtl.vcd and the model's (under the RTL's names) as model.vcd, and compare
-    /// them signal by signal (`specfx trace compare`; exit code 1 when they differ).
+    /// them signal by signal (`specfx trace compare`; exit code 1 when they differ), also
+    /// when a vector failed: the first differing cycle and register are printed beside it.
     #[arg(long)]
     vcd: Option<PathBuf>,
     /// Replace rtl.vcd and model.vcd in the --vcd directory when they are not an earlier
@@ -143,7 +144,10 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         let rtl = dir.join("rtl.vcd");
         super::output::check_file_output(&rtl, "--vcd", &inputs, None, args.force || earlier)?;
     }
+    // Absolute: the simulator runs in the work directory.
     let hdl = super::cost::hdl_ref_dir(args.hdl_ref.as_deref());
+    let hdl = std::path::absolute(&hdl)
+        .with_context(|| format!("--hdl-ref {}: cannot resolve it", hdl.display()))?;
     let rtl = rtl_sources(&hdl)?;
     let tb = hdl.join("tb/tb_specfx.v");
     if !tb.is_file() {
@@ -247,49 +251,79 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
     );
     let log = simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
-    if let Some(dir) = &args.vcd {
-        let from = wd.join("rtl.vcd");
-        std::fs::copy(&from, dir.join("rtl.vcd"))
-            .with_context(|| format!("the simulator wrote no {}", from.display()))?;
-    }
+    let verdict = parse_log(&log);
+    // The RTL's trace: a testbench that ran to its summary must have written it; one that
+    // died may have written none, and then there is nothing to compare.
+    let traces = match &args.vcd {
+        Some(dir) => {
+            let from = wd.join("rtl.vcd");
+            if verdict.is_ok() || from.is_file() {
+                std::fs::copy(&from, dir.join("rtl.vcd"))
+                    .with_context(|| format!("the simulator wrote no {}", from.display()))?;
+                Some((dir.join("model.vcd"), dir.join("rtl.vcd")))
+            } else {
+                log::error!("cosim: the simulation wrote no trace to compare");
+                None
+            }
+        }
+        None => None,
+    };
     if args.keep {
         let kept = work.keep();
         log::info!("cosim: work directory {}", kept.display());
     }
-    let verdict = match parse_log(&log) {
-        Ok(v) => v,
-        Err(e) => {
-            log::error!("cosim: FAIL: {e}");
-            return Ok(Outcome::CheckFailed);
+    let failure = match &verdict {
+        Ok(v) => {
+            for line in &v.problems {
+                super::output::outln!("{line}")?;
+            }
+            super::output::outln!("{} passed, {} failed", v.passed, v.failed)?;
+            if v.failed != 0 {
+                Some(format!(
+                    "{} of {} vectors failed",
+                    v.failed,
+                    v.failed + v.passed
+                ))
+            } else if v.passed == 0 {
+                Some("nothing was checked".to_string())
+            } else {
+                None
+            }
         }
+        Err(e) => Some(e.to_string()),
     };
-    for line in &verdict.problems {
-        super::output::outln!("{line}")?;
-    }
-    super::output::outln!("{} passed, {} failed", verdict.passed, verdict.failed)?;
-    if verdict.failed != 0 {
-        log::error!("cosim: FAIL ({}, {})", sim.name(), args.run.arch);
-        return Ok(Outcome::CheckFailed);
-    }
-    if verdict.passed == 0 {
-        log::error!("cosim: FAIL: nothing was checked");
-        return Ok(Outcome::CheckFailed);
-    }
-    if let Some(dir) = &args.vcd {
-        let (model, rtl) = (dir.join("model.vcd"), dir.join("rtl.vcd"));
-        if matches!(
-            super::trace::compare_files(&model, &rtl)?,
-            Outcome::CheckFailed
-        ) {
-            log::error!(
-                "cosim: FAIL: the model's and the RTL's traces differ ({}, {})",
-                sim.name(),
-                args.run.arch
-            );
-            return Ok(Outcome::CheckFailed);
+    // The traces are compared whenever both exist: where a vector failed, the first
+    // differing register tells where the RTL went wrong. A trace that cannot be read then
+    // does not hide the failure.
+    let mut traces_differ = None;
+    if let Some((model, rtl)) = &traces {
+        let options = specfx::cycle::compare::Options::default();
+        match super::trace::compare_files(model, rtl, &options) {
+            Ok(c) if c.agrees() => {}
+            Ok(c) => {
+                traces_differ = Some(match &c.first_difference {
+                    Some(d) => format!(
+                        "the model's and the RTL's traces first differ at cycle {}, {}",
+                        d.cycle, d.signal
+                    ),
+                    None => "the model's and the RTL's traces differ".to_string(),
+                })
+            }
+            Err(e) if failure.is_some() => {
+                log::error!("cosim: the traces cannot be compared: {e:#}");
+            }
+            Err(e) => return Err(e),
         }
     }
-    Ok(Outcome::Ok)
+    let at = format!("({}, {})", sim.name(), args.run.arch);
+    match (failure, traces_differ) {
+        (None, None) => Ok(Outcome::Ok),
+        (failure, differ) => {
+            let why: Vec<String> = failure.into_iter().chain(differ).collect();
+            log::error!("cosim: FAIL {at}: {}", why.join("; "));
+            Ok(Outcome::CheckFailed)
+        }
+    }
 }
 
 fn choose_simulator(asked: Option<Simulator>) -> Result<Simulator> {

@@ -10,7 +10,7 @@ use clap::{Args, Subcommand};
 
 use super::output::print_with;
 use super::Outcome;
-use specfx::cycle::compare::{compare, Comparison};
+use specfx::cycle::compare::{compare_with, Comparison, Missing, Options};
 use specfx::error::Error;
 
 /// Arguments of `specfx trace`.
@@ -23,8 +23,10 @@ pub struct TraceArgs {
 #[derive(Debug, Subcommand)]
 enum TraceCommand {
     /// Compares two VCD traces of the testbench: the model's first (its `x` bits are
-    /// don't-care), then the RTL's. Exit code 0 when they agree, 1 when they differ, 2 on bad
-    /// input.
+    /// don't-care), then the RTL's. A signal of the first file that the second lacks, or a
+    /// register (`$var reg`) of the second file in a scope where the first file has signals
+    /// (below tb_specfx) that the first lacks, is a difference unless --ignore-missing.
+    /// Exit code 0 when they agree, 1 when they differ, 2 on bad input.
     Compare(CompareArgs),
 }
 
@@ -35,6 +37,17 @@ struct CompareArgs {
     first: PathBuf,
     /// The RTL's trace (the testbench's `rtl.vcd`, Icarus Verilog or Verilator).
     second: PathBuf,
+    /// Accept signals in one file only: list them, but do not count them as a difference.
+    /// Without it, a signal of the first file that the second lacks makes the traces differ
+    /// (it was never compared), and so does a register of the second file in a scope the
+    /// first file has signals in (below tb_specfx) that the first lacks.
+    #[arg(long)]
+    ignore_missing: bool,
+    /// Leave a signal out altogether, neither compared nor missing: its full name as the
+    /// comparison prints it (tb_specfx.dut.g_folded.u_core.x), or a prefix followed by `*`
+    /// (tb_specfx.extra.*). Repeat for more; each must match a signal of either file.
+    #[arg(long, value_name = "NAME")]
+    ignore: Vec<String>,
 }
 
 /// How many names a list of signals shows before "and N more".
@@ -48,12 +61,25 @@ pub fn run(args: &TraceArgs) -> Result<Outcome> {
 }
 
 fn run_compare(args: &CompareArgs) -> Result<Outcome> {
-    compare_files(&args.first, &args.second)
+    let options = Options {
+        missing: if args.ignore_missing {
+            Missing::Ignore
+        } else {
+            Missing::Differ
+        },
+        ignore: args.ignore.clone(),
+    };
+    let c = compare_files(&args.first, &args.second, &options)?;
+    Ok(if c.agrees() {
+        Outcome::Ok
+    } else {
+        Outcome::CheckFailed
+    })
 }
 
-/// Compares two trace files (the model's first) and prints the comparison: `Ok` when they
-/// agree, `CheckFailed` when they differ, an error naming the file when one cannot be read.
-pub fn compare_files(first: &Path, second: &Path) -> Result<Outcome> {
+/// Compares two trace files (the model's first) and prints the comparison; an error naming
+/// the file when one cannot be read.
+pub fn compare_files(first: &Path, second: &Path, options: &Options) -> Result<Comparison> {
     let paths = [first, second];
     let open = |p: &Path| -> Result<BufReader<File>> {
         let what = format!("trace {}", p.display());
@@ -63,7 +89,7 @@ pub fn compare_files(first: &Path, second: &Path) -> Result<Outcome> {
         ))
     };
     let (a, b) = (open(first)?, open(second)?);
-    let c = match compare(a, b) {
+    let c = match compare_with(a, b, options) {
         Ok(c) => c,
         Err(Error::Trace { which, problem }) => {
             anyhow::bail!("{}: {problem}", paths[which].display())
@@ -72,11 +98,7 @@ pub fn compare_files(first: &Path, second: &Path) -> Result<Outcome> {
     };
     let names = [first.display().to_string(), second.display().to_string()];
     print_with(|w| write_comparison(w, &c, &names))?;
-    Ok(if c.agrees() {
-        Outcome::Ok
-    } else {
-        Outcome::CheckFailed
-    })
+    Ok(c)
 }
 
 fn list(names: &[String]) -> String {
@@ -134,6 +156,24 @@ fn write_comparison(
     if !c.only_first.is_empty() {
         writeln!(w, "  only in {}: {}", files[0], list(&c.only_first))?;
     }
+    if !c.registers_only_second.is_empty() {
+        writeln!(
+            w,
+            "  {} registers only in {}, in scopes {} has signals in: {}",
+            c.registers_only_second.len(),
+            files[1],
+            files[0],
+            list(&c.registers_only_second)
+        )?;
+    }
+    if !c.ignored.is_empty() {
+        writeln!(
+            w,
+            "  {} signals ignored (--ignore): {}",
+            c.ignored.len(),
+            list(&c.ignored)
+        )?;
+    }
     if !c.never_known.is_empty() {
         writeln!(
             w,
@@ -150,12 +190,21 @@ fn write_comparison(
             files[0], c.cycles_only_first, files[1], c.cycles_only_second
         )?;
     }
+    let missing = c.missing_signals();
+    if missing > 0 && c.missing == Missing::Ignore {
+        writeln!(
+            w,
+            "  {missing} signals missing from one file, accepted (--ignore-missing)"
+        )?;
+    }
     let verdict = if c.agrees() {
-        "traces agree"
+        "traces agree".to_string()
     } else if c.signals_compared == 0 || c.cycles_compared == 0 {
-        "TRACES DIFFER: nothing to compare"
+        "TRACES DIFFER: nothing to compare".to_string()
+    } else if c.first_difference.is_none() && c.width_mismatches.is_empty() {
+        format!("TRACES DIFFER: {missing} signals missing from one file (--ignore-missing accepts them)")
     } else {
-        "TRACES DIFFER"
+        "TRACES DIFFER".to_string()
     };
     writeln!(w, "{verdict}")
 }

@@ -11,17 +11,22 @@
 //!    reported and not compared); at every cycle sampled in both files, a bit that is `x` or
 //!    `z` in the **first** file is don't-care (the model writes `x` where a register holds no
 //!    valid data), and every other bit must be equal in the second.
+//! 4. A signal in one file only was never compared: by default ([`Missing::Differ`]) the files
+//!    then differ when it is the first file's, or a register of the second file in a scope
+//!    the first file has signals in (below [`TESTBENCH`]); [`Options`] accepts them or leaves
+//!    named signals out.
 //!
 //! A file must be well-formed VCD: scopes nested at most [`MAX_SCOPE_DEPTH`] deep, a header of
-//! at most [`MAX_HEADER_BYTES`], every value change for a declared identifier and no wider
-//! than its variable, time never going back. Anything else is an error naming the line.
+//! at most [`MAX_HEADER_BYTES`], every variable at least 1 bit wide, every value change for a
+//! declared identifier and no wider than its variable, time never going back. Anything else is
+//! an error naming the line.
 //!
 //! Reads from any `io::BufRead`; the files are the caller's business.
 
 use std::collections::HashMap;
 use std::io::{BufRead, Read};
 
-use vcd::{Command, IdCode, ReferenceIndex, ScopeItem, Value, VarType};
+use vcd::{Command, IdCode, ReferenceIndex, ScopeItem, ScopeType, Value, VarType};
 
 use crate::error::Error;
 
@@ -35,12 +40,65 @@ pub const CYCLE: &str = "tb_specfx.cycle";
 pub const MAX_SCOPE_DEPTH: usize = 256;
 /// The longest header (everything up to `$enddefinitions`) a trace may have: 64 MiB.
 pub const MAX_HEADER_BYTES: u64 = 64 << 20;
+/// The testbench's scope: its own variables (bookkeeping) are not the RTL's registers.
+pub const TESTBENCH: &str = "tb_specfx";
+/// Variables the reference RTL declares `reg` that hold no state, so that the model has no
+/// register of that name: the folded core's `always @*` step multiplexer.
+pub const COMBINATIONAL_REGS: &[&str] = &["tb_specfx.dut.g_folded.u_core.step_result"];
+
+/// What a comparison makes of a signal that only one file has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Missing {
+    /// The files differ when a signal of the first file is not in the second, or a register
+    /// of the second file (`$var reg`, outside functions and tasks, but
+    /// [`COMBINATIONAL_REGS`]) sits in a scope below [`TESTBENCH`] in which the first file
+    /// declares signals, and the first file lacks it.
+    #[default]
+    Differ,
+    /// Such signals are listed, and are no difference.
+    Ignore,
+}
+
+/// How [`compare_with`] compares two traces.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Options {
+    /// What a signal in one file only makes of the comparison.
+    pub missing: Missing,
+    /// Signals left out altogether (neither compared nor missing): each a full name
+    /// (`tb_specfx.dut.g_folded.u_core.x`), or a prefix followed by `*` (`tb_specfx.extra.*`),
+    /// that must match a signal of one of the files.
+    pub ignore: Vec<String>,
+}
+
+impl Options {
+    /// Whether `name` is one of [`Options::ignore`]'s.
+    fn ignores(&self, name: &str) -> bool {
+        self.ignore.iter().any(|p| matches(p, name))
+    }
+}
+
+/// Whether an ignored name (a full name, or a prefix followed by `*`) matches `name`.
+fn matches(pattern: &str, name: &str) -> bool {
+    match pattern.strip_suffix('*') {
+        Some(prefix) => name.starts_with(prefix),
+        None => name == pattern,
+    }
+}
 
 /// The trace with its header checked for depth and length (read whole, so that the parser,
 /// which recurses per scope, cannot overflow the stack), followed by the rest of it.
 fn guarded<R: BufRead>(which: usize, mut r: R) -> Result<impl BufRead, Error> {
     let mut header = Vec::new();
     let (mut depth, mut line, mut skipping) = (0usize, 0u64, false);
+    // Inside a `$var`: the field the next token is (1 type, 2 width, 3 id, 4 reference), 0
+    // outside; the line of a width of 0, refused once the variable's name is known.
+    let (mut var_field, mut zero_width) = (0usize, None::<u64>);
+    let zero_width_error = |at: u64, name: &str| {
+        trace_error(
+            which,
+            format!("line {at}: $var {name}has width 0 (a variable has at least 1 bit)"),
+        )
+    };
     loop {
         let start = header.len();
         let room = MAX_HEADER_BYTES + 1 - start as u64;
@@ -61,10 +119,35 @@ fn guarded<R: BufRead>(which: usize, mut r: R) -> Result<impl BufRead, Error> {
         }
         line += 1;
         let mut done = false;
-        for token in header[start..].split(|b| b.is_ascii_whitespace()) {
+        for token in header[start..]
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|t| !t.is_empty())
+        {
             match token {
-                b"$end" => skipping = false,
+                b"$end" => {
+                    if let Some(at) = zero_width.take() {
+                        return Err(zero_width_error(at, ""));
+                    }
+                    skipping = false;
+                    var_field = 0;
+                }
                 _ if skipping => {}
+                _ if var_field > 0 => {
+                    if var_field == 2 && token.iter().all(|&b| b == b'0') {
+                        zero_width = Some(line);
+                    }
+                    if var_field == 4 {
+                        if let Some(at) = zero_width.take() {
+                            let name = String::from_utf8_lossy(token);
+                            return Err(zero_width_error(
+                                at,
+                                &format!("'{}' ", name.escape_debug()),
+                            ));
+                        }
+                    }
+                    var_field += 1;
+                }
+                b"$var" => var_field = 1,
                 b"$comment" | b"$date" | b"$version" => skipping = true,
                 b"$scope" => {
                     depth += 1;
@@ -136,10 +219,17 @@ pub struct Difference {
 pub struct Comparison {
     /// Signals in both files with equal widths, compared at every common cycle.
     pub signals_compared: usize,
-    /// Signals only in the first file.
+    /// Signals only in the first file: a difference unless [`Missing::Ignore`].
     pub only_first: Vec<String>,
     /// Signals only in the second file.
     pub only_second: Vec<String>,
+    /// The registers among [`Comparison::only_second`] in scopes the first file covers (see
+    /// [`Missing::Differ`]): a difference unless [`Missing::Ignore`].
+    pub registers_only_second: Vec<String>,
+    /// What signals in one file only make of the comparison.
+    pub missing: Missing,
+    /// Signals of either file left out by [`Options::ignore`].
+    pub ignored: Vec<String>,
     /// Signals in both files with different widths.
     pub width_mismatches: Vec<WidthMismatch>,
     /// Cycles sampled in both files.
@@ -158,20 +248,32 @@ pub struct Comparison {
 }
 
 impl Comparison {
-    /// Whether the files agree: something was compared, no width differs, no value differs.
+    /// Whether the files agree: something was compared, no width differs, no value differs,
+    /// and no signal is missing from one file (unless [`Missing::Ignore`]).
     pub fn agrees(&self) -> bool {
         self.signals_compared > 0
             && self.cycles_compared > 0
             && self.width_mismatches.is_empty()
             && self.first_difference.is_none()
+            && (self.missing == Missing::Ignore || self.missing_signals() == 0)
+    }
+
+    /// The signals missing from one file that make a difference under [`Missing::Differ`]:
+    /// [`Comparison::only_first`] and [`Comparison::registers_only_second`].
+    pub fn missing_signals(&self) -> usize {
+        self.only_first.len() + self.registers_only_second.len()
     }
 }
 
-/// A variable of a file: full name, width, identifier.
+/// A variable of a file: full name, width, identifier, scope, whether it is a register.
 struct Var {
     name: String,
     width: u32,
     code: IdCode,
+    /// The full name of its scope.
+    scope: String,
+    /// Declared `reg`, outside a function or task.
+    register: bool,
 }
 
 fn trace_error(which: usize, problem: String) -> Error {
@@ -201,7 +303,7 @@ fn declared(items: &[ScopeItem], out: &mut HashMap<IdCode, u32>) -> Result<(), S
 
 /// The file's variables in declaration order, full names unique (the first kept).
 fn variables(items: &[ScopeItem]) -> Vec<Var> {
-    fn walk(items: &[ScopeItem], path: &mut Vec<String>, out: &mut Vec<Var>) {
+    fn walk(items: &[ScopeItem], path: &mut Vec<String>, in_function: bool, out: &mut Vec<Var>) {
         for item in items {
             match item {
                 ScopeItem::Scope(s) => {
@@ -210,7 +312,9 @@ fn variables(items: &[ScopeItem]) -> Vec<Var> {
                     if !top {
                         path.push(s.identifier.clone());
                     }
-                    walk(&s.items, path, out);
+                    let function = in_function
+                        || matches!(s.scope_type, ScopeType::Function | ScopeType::Task);
+                    walk(&s.items, path, function, out);
                     if !top {
                         path.pop();
                     }
@@ -229,6 +333,8 @@ fn variables(items: &[ScopeItem]) -> Vec<Var> {
                         name: name.join("."),
                         width: v.size,
                         code: v.code,
+                        scope: path.join("."),
+                        register: v.var_type == VarType::Reg && !in_function,
                     });
                 }
                 _ => {}
@@ -236,7 +342,7 @@ fn variables(items: &[ScopeItem]) -> Vec<Var> {
         }
     }
     let mut out = Vec::new();
-    walk(items, &mut Vec::new(), &mut out);
+    walk(items, &mut Vec::new(), false, &mut out);
     let mut seen = std::collections::HashSet::new();
     out.retain(|v| seen.insert(v.name.clone()));
     out
@@ -540,8 +646,9 @@ fn header<R: BufRead>(which: usize, p: &mut vcd::Parser<R>) -> Result<Header, Er
     })
 }
 
-/// Compares two VCD traces of the testbench (see the module documentation); `first`'s `x` and
-/// `z` bits are don't-care.
+/// Compares two VCD traces of the testbench (see the module documentation) with the default
+/// [`Options`]: `first`'s `x` and `z` bits are don't-care, a signal missing from one file is a
+/// difference ([`Missing::Differ`]).
 ///
 /// # Errors
 /// [`Error::Trace`] (naming the file, 0 or 1) when a file is not VCD or lacks `tb_specfx.clk`
@@ -562,17 +669,78 @@ fn header<R: BufRead>(which: usize, p: &mut vcd::Parser<R>) -> Result<Header, Er
 /// assert_eq!(c.cycles_compared, 2); // cycle 0: v is x in the model, don't-care
 /// ```
 pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, Error> {
+    compare_with(first, second, &Options::default())
+}
+
+/// Compares two VCD traces of the testbench (see the module documentation) as `options` say:
+/// signals [`Options::ignore`] names are left out, and [`Options::missing`] decides whether a
+/// signal in one file only makes a difference.
+///
+/// # Errors
+/// [`Error::Trace`] (naming the file, 0 or 1) when a file is not VCD or lacks `tb_specfx.clk`
+/// or `tb_specfx.cycle`; [`Error::UnknownName`] when an ignored name matches no signal.
+///
+/// # Examples
+/// ```
+/// use specfx::cycle::compare::{compare_with, Missing, Options};
+/// let model = "$scope module tb_specfx $end $var reg 1 ! clk $end
+/// $var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end
+/// $scope module extra $end $var reg 1 ~~ ghost $end $upscope $end $enddefinitions $end
+/// #0 0! b0 \" b101 # 1~~ #5 1! #6 b1 \" #10 0! #15 1!\n";
+/// let rtl = model.replace("$scope module extra $end $var reg 1 ~~ ghost $end $upscope $end", "")
+///     .replace(" 1~~", "");
+/// let strict = compare_with(model.as_bytes(), rtl.as_bytes(), &Options::default()).unwrap();
+/// assert_eq!(strict.only_first, ["extra.ghost"]);
+/// assert!(!strict.agrees()); // every value is equal, but ghost was never compared
+/// let waived = Options { missing: Missing::Ignore, ..Options::default() };
+/// assert!(compare_with(model.as_bytes(), rtl.as_bytes(), &waived).unwrap().agrees());
+/// let ignored = Options { ignore: vec!["extra.*".into()], ..Options::default() };
+/// assert!(compare_with(model.as_bytes(), rtl.as_bytes(), &ignored).unwrap().agrees());
+/// ```
+pub fn compare_with(
+    first: impl BufRead,
+    second: impl BufRead,
+    options: &Options,
+) -> Result<Comparison, Error> {
     let mut pa = vcd::Parser::new(guarded(0, first)?);
     let mut pb = vcd::Parser::new(guarded(1, second)?);
     let ha = header(0, &mut pa)?;
     let hb = header(1, &mut pb)?;
     let (va, vb) = (&ha.vars, &hb.vars);
-    let by_name_b: HashMap<&str, &Var> = vb.iter().map(|v| (v.name.as_str(), v)).collect();
-    let by_name_a: HashMap<&str, &Var> = va.iter().map(|v| (v.name.as_str(), v)).collect();
+    if let Some(p) = options
+        .ignore
+        .iter()
+        .find(|p| !va.iter().chain(vb).any(|v| matches(p, &v.name)))
+    {
+        return Err(Error::UnknownName {
+            what: "signal to ignore",
+            expected: "the full name of a signal of either trace, or a prefix followed by *",
+            got: p.clone(),
+        });
+    }
+    let mut ignored: Vec<String> = Vec::new();
+    for v in va.iter().chain(vb) {
+        if options.ignores(&v.name) && !ignored.contains(&v.name) {
+            ignored.push(v.name.clone());
+        }
+    }
+    let (va, vb): (Vec<&Var>, Vec<&Var>) = (
+        va.iter().filter(|v| !options.ignores(&v.name)).collect(),
+        vb.iter().filter(|v| !options.ignores(&v.name)).collect(),
+    );
+    let by_name_b: HashMap<&str, &Var> = vb.iter().map(|v| (v.name.as_str(), *v)).collect();
+    let by_name_a: HashMap<&str, &Var> = va.iter().map(|v| (v.name.as_str(), *v)).collect();
+    // The scopes the first file covers: those below the testbench's it declares signals in.
+    let below_testbench = format!("{TESTBENCH}.");
+    let covered: std::collections::HashSet<&str> = va
+        .iter()
+        .map(|v| v.scope.as_str())
+        .filter(|s| s.starts_with(&below_testbench))
+        .collect();
     let mut compared: Vec<(&str, u32)> = Vec::new();
     let mut width_mismatches = Vec::new();
     let mut only_first = Vec::new();
-    for a in va {
+    for a in &va {
         match by_name_b.get(a.name.as_str()) {
             None => only_first.push(a.name.clone()),
             Some(b) if b.width != a.width => width_mismatches.push(WidthMismatch {
@@ -583,11 +751,21 @@ pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, 
             Some(_) => compared.push((&a.name, a.width)),
         }
     }
-    let only_second: Vec<String> = vb
+    let only_second: Vec<&Var> = vb
         .iter()
         .filter(|b| !by_name_a.contains_key(b.name.as_str()))
+        .copied()
+        .collect();
+    let registers_only_second = only_second
+        .iter()
+        .filter(|b| {
+            b.register
+                && covered.contains(b.scope.as_str())
+                && !COMBINATIONAL_REGS.contains(&b.name.as_str())
+        })
         .map(|b| b.name.clone())
         .collect();
+    let only_second = only_second.iter().map(|b| b.name.clone()).collect();
     let names: Vec<&str> = compared.iter().map(|c| c.0).collect();
     let layout = Layout::new(compared.iter().map(|c| c.1));
 
@@ -650,6 +828,9 @@ pub fn compare(first: impl BufRead, second: impl BufRead) -> Result<Comparison, 
         signals_compared: compared.len(),
         only_first,
         only_second,
+        registers_only_second,
+        missing: options.missing,
+        ignored,
         width_mismatches,
         cycles_compared,
         cycles_only_first: matched.iter().filter(|&&m| !m).count() as u64,
@@ -718,6 +899,26 @@ $var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end $enddefinitions
             let e = second_error(&GOOD.replacen(from, to, 1));
             assert!(e.starts_with(expect), "{to}: {e}");
         }
+        // A variable of no bit, its width on the line named, wherever its name is.
+        let e = second_error(&GOOD.replacen("4 # v", "0 # v", 1));
+        assert_eq!(
+            e,
+            "line 2: $var 'v' has width 0 (a variable has at least 1 bit)"
+        );
+        let e = second_error(&GOOD.replacen("4 # v $end", "000\n#\nv\n$end", 1));
+        assert_eq!(
+            e,
+            "line 2: $var 'v' has width 0 (a variable has at least 1 bit)"
+        );
+        let e = second_error(&GOOD.replacen("4 # v $end", "0 $end", 1));
+        assert_eq!(
+            e,
+            "line 2: $var has width 0 (a variable has at least 1 bit)"
+        );
+        // A 0 elsewhere in a declaration is no width, nor one in a comment.
+        let named = GOOD.replacen("# v $end", "# 0 $end $comment $var wire 0 % w $end", 1);
+        let r = compare(GOOD.as_bytes(), named.as_bytes());
+        assert!(r.is_ok(), "{r:?}");
         let e = second_error(&GOOD.replacen("#10", "$var wire 1 % w $end #10", 1));
         assert_eq!(e, "line 4: a declaration after $enddefinitions");
         let e = second_error(&GOOD.replacen("4 # v", "4 # v $end $var wire 1 # w", 1));
@@ -766,6 +967,76 @@ $var integer 32 \" cycle $end $var wire 4 # v $end $upscope $end $enddefinitions
             e.starts_with("the header (up to $enddefinitions) is longer than"),
             "{e}"
         );
+    }
+
+    /// GOOD with `extra` declared inside its scope.
+    fn with(extra: &str) -> String {
+        GOOD.replacen(" $upscope", &format!(" {extra} $upscope"), 1)
+    }
+
+    #[test]
+    fn a_signal_in_one_file_only_differs_unless_ignored() {
+        let model = with("$scope module dut $end $var wire 1 % a $end $upscope $end");
+        let rtl = |q: &str| {
+            with(&format!(
+                "$scope module dut $end $var wire 1 % a $end {q} $upscope $end"
+            ))
+        };
+        let run = |first: &str, second: &str, options: &Options| {
+            compare_with(first.as_bytes(), second.as_bytes(), options).unwrap()
+        };
+        let strict = Options::default();
+        assert!(run(&model, &rtl(""), &strict).agrees());
+        // The model's signal the RTL lacks.
+        let c = run(&model, GOOD, &strict);
+        assert_eq!(c.only_first, ["tb_specfx.dut.a"]);
+        assert!(!c.agrees() && c.first_difference.is_none());
+        // The RTL's register in a scope the model has signals in; not a wire, not in a
+        // function, not the testbench's own, not in a scope the model does not have.
+        let c = run(&model, &rtl("$var reg 1 & q $end"), &strict);
+        assert_eq!(c.registers_only_second, ["tb_specfx.dut.q"]);
+        assert!(!c.agrees());
+        for agreeing in [
+            rtl("$var wire 1 & q $end"),
+            rtl("$scope function f $end $var reg 1 & q $end $upscope $end"),
+            rtl("$scope module u $end $var reg 1 & q $end $upscope $end"),
+            with("$scope module dut $end $var wire 1 % a $end $upscope $end $var reg 1 & q $end"),
+        ] {
+            let c = run(&model, &agreeing, &strict);
+            assert!(c.agrees(), "{agreeing}: {c:?}");
+            assert_eq!(c.only_second.len(), 1);
+        }
+        // Accepted as a policy, or left out by name or prefix.
+        let waived = Options {
+            missing: Missing::Ignore,
+            ..Options::default()
+        };
+        assert!(run(&model, &rtl("$var reg 1 & q $end"), &waived).agrees());
+        assert!(run(&model, GOOD, &waived).agrees());
+        for pattern in ["tb_specfx.dut.a", "tb_specfx.dut.*", "tb_specfx.d*"] {
+            let o = Options {
+                ignore: vec![pattern.into()],
+                ..Options::default()
+            };
+            let c = run(&model, GOOD, &o);
+            assert!(c.agrees(), "{pattern}: {c:?}");
+            assert_eq!(c.ignored, ["tb_specfx.dut.a"]);
+        }
+        // An ignored name must be a signal's; ignoring everything compares nothing.
+        let o = Options {
+            ignore: vec!["tb_specfx.dut.b".into()],
+            ..Options::default()
+        };
+        let e = compare_with(model.as_bytes(), GOOD.as_bytes(), &o).unwrap_err();
+        assert!(e
+            .to_string()
+            .starts_with("unknown signal to ignore 'tb_specfx.dut.b'"));
+        let o = Options {
+            ignore: vec!["*".into()],
+            ..Options::default()
+        };
+        let c = run(&model, GOOD, &o);
+        assert_eq!((c.signals_compared, c.agrees()), (0, false));
     }
 
     #[test]
