@@ -5,7 +5,9 @@
 //! longer found exactly once, so the set follows the RTL as it changes), and is run on a
 //! configuration whose vectors exercise the broken part: the per-n constants' routing (which a
 //! stream sorted by n exercised only at n boundaries), timing, handshake, rounding, overflow
-//! and clamping. The unmutated RTL passes on every configuration used.
+//! and clamping, and a rounding constant one LSB off in one stage (caught by the vectors on
+//! and next to every stage's rounding boundary). The unmutated RTL passes on every
+//! configuration used.
 
 mod common;
 
@@ -84,6 +86,18 @@ const MUTANTS: &[Mutant] = &[
         file: "rtl/specfx_quant.v",
         from: "wire tie_up = (RND == 2) ? 1'b1 :",
         to: "wire tie_up = (RND == 2) ? 1'b0 :",
+        config: "baseline",
+        arch: "pipelined",
+        flags: &[],
+    },
+    // One LSB too much rounding constant in the output stage only: it rounds up the exact
+    // values one LSB below the tie, 8 of the baseline's 33 million inputs (none of which the
+    // corner cases or 1000 random draws held before the rounding-boundary cases).
+    Mutant {
+        name: "output stage adds its rounding constant one LSB too large",
+        file: "rtl/specfx_mul_out.v",
+        from: ".x(product), .y(out)",
+        to: ".x(product + 1'b1), .y(out)",
         config: "baseline",
         arch: "pipelined",
         flags: &[],

@@ -386,10 +386,12 @@ fn check_coverage(config: &str, dir: &Path, m: &Value, printed: &str) {
     // Events and cut flags from the scalar model, row by row.
     let mut events = vec![[0u64; 3]; names.len()];
     let mut cut = 0u64;
+    let mut cut_flags = Vec::with_capacity(rows.len());
     for r in rows {
         let nc = dp.constants_for(r[inn] as u32).unwrap();
         let p = dp.eval(r[ic], nc);
         cut += u64::from(p.cut);
+        cut_flags.push(p.cut);
         for (stage_idx, e) in events.iter_mut().enumerate() {
             match p.events[stage_idx] {
                 Event::Wrapped => e[0] += 1,
@@ -433,6 +435,7 @@ fn check_coverage(config: &str, dir: &Path, m: &Value, printed: &str) {
             .count() as u64;
         assert!(got[1] <= at_end, "{config} stage {name}");
     }
+    check_rounding_boundaries(&dp, &csv, stages, &cut_flags);
     // The printed summary states the same counts.
     let line = printed
         .lines()
@@ -450,6 +453,154 @@ fn check_coverage(config: &str, dir: &Path, m: &Value, printed: &str) {
         )),
         "{line}"
     );
+    let bounds: Vec<String> = stages
+        .iter()
+        .filter(|s| s["dropped_bits"].as_u64().unwrap() > 0)
+        .map(|s| {
+            format!(
+                "{} {}/{}",
+                s["stage"].as_str().unwrap(),
+                s["at_boundary"],
+                s["next_to_boundary"]
+            )
+        })
+        .collect();
+    if !bounds.is_empty() {
+        assert!(
+            line.contains(&format!(
+                ", rounding boundaries (on/next to): {}",
+                bounds.join(", ")
+            )),
+            "{line}"
+        );
+    }
+}
+
+/// Where an exact value `x` with `s` dropped bits lies against the rounding boundary, from the
+/// definition (docs/arithmetic.md 2.1): the residue `r = x mod 2^s` equal to the boundary
+/// (`2^(s-1)` for the round-to-nearest modes, 0 for TRN and TRN_ZERO) is "on" (0), one beside
+/// it modulo 2^s is "next to" (1).
+fn boundary_class(x: i128, s: i64, rounding: &str) -> Option<usize> {
+    if s < 1 {
+        return None;
+    }
+    let nearest = !matches!(rounding, "TRN" | "TRN_ZERO");
+    if s > 126 {
+        // |x| < 2^126: only TRN's boundary 0 and its neighbours -1 and 1 are in reach.
+        return match (nearest, x) {
+            (false, 0) => Some(0),
+            (false, -1 | 1) => Some(1),
+            _ => None,
+        };
+    }
+    let m = 1i128 << s;
+    let b = if nearest { m / 2 } else { 0 };
+    let r = x.rem_euclid(m);
+    if r == b {
+        Some(0)
+    } else if r == (b - 1).rem_euclid(m) || r == (b + 1).rem_euclid(m) {
+        Some(1)
+    } else {
+        None
+    }
+}
+
+/// Each stage's rounding-boundary counts recomputed from the CSV: the exact value a stage
+/// quantizes is rebuilt from the ports (`probe_d * in_slope`, `probe_t + in_offset` aligned or
+/// 0 when cut, the square of the previous probe, `probe_sqk * in_coef`) with the fraction
+/// bits of the header's formats.
+fn check_rounding_boundaries(dp: &Datapath, csv: &Csv, stages: &[Value], cut: &[bool]) {
+    let cfg = dp.config();
+    let k = cfg.k as usize;
+    let col = |p: &str| csv.col(p);
+    let frac = |p: &str| csv.format(p).frac;
+    let sq = |i: usize| format!("probe_sq{i}");
+    // (stage name, rounding, frac of the exact value, frac of the result, exact of a row).
+    type Exact<'a> = Box<dyn Fn(usize) -> i128 + 'a>;
+    let mut quantized: Vec<(String, String, i32, i32, Exact)> = Vec::new();
+    let (cd, cs, ct, co) = (
+        col("probe_d"),
+        col("in_slope"),
+        col("probe_t"),
+        col("in_offset"),
+    );
+    let rows = &csv.rows;
+    quantized.push((
+        "t".into(),
+        cfg.t.rounding.to_string(),
+        frac("probe_d") + frac("in_slope"),
+        frac("probe_t"),
+        Box::new(move |i| i128::from(rows[i][cd]) * i128::from(rows[i][cs])),
+    ));
+    let (ft, fo) = (frac("probe_t"), frac("in_offset"));
+    let fs = ft.max(fo);
+    quantized.push((
+        "b".into(),
+        cfg.b.rounding.to_string(),
+        fs,
+        frac("probe_b"),
+        Box::new(move |i| {
+            if cut[i] {
+                0
+            } else {
+                (i128::from(rows[i][ct]) << (fs - ft)) + (i128::from(rows[i][co]) << (fs - fo))
+            }
+        }),
+    ));
+    for i in 1..=k {
+        let prev = if i == 1 {
+            "probe_b".to_string()
+        } else {
+            sq(i - 1)
+        };
+        let cp = col(&prev);
+        quantized.push((
+            format!("sq{i}"),
+            cfg.square[i - 1].rounding.to_string(),
+            2 * frac(&prev),
+            frac(&sq(i)),
+            Box::new(move |r| i128::from(rows[r][cp]).pow(2)),
+        ));
+    }
+    let (clast, ccoef) = (col(&sq(k)), col("in_coef"));
+    quantized.push((
+        "out".into(),
+        cfg.out.rounding.to_string(),
+        frac(&sq(k)) + frac("in_coef"),
+        frac("expected_out"),
+        Box::new(move |r| i128::from(rows[r][clast]) * i128::from(rows[r][ccoef])),
+    ));
+    for s in stages {
+        let name = s["stage"].as_str().unwrap();
+        match quantized.iter().find(|q| q.0 == name) {
+            None => {
+                // d and coef do not round.
+                assert!(s["rounding"].is_null(), "{name}");
+                assert_eq!(s["dropped_bits"], 0, "{name}");
+                assert_eq!(
+                    (&s["at_boundary"], &s["next_to_boundary"]),
+                    (&0.into(), &0.into())
+                );
+            }
+            Some((_, rounding, f_in, f_out, exact)) => {
+                let dropped = i64::from(*f_in) - i64::from(*f_out);
+                let mut counts = [0u64; 2];
+                for i in 0..rows.len() {
+                    if let Some(c) = boundary_class(exact(i), dropped, rounding) {
+                        counts[c] += 1;
+                    }
+                }
+                assert_eq!(s["dropped_bits"], dropped.max(0), "{name}");
+                if dropped > 0 {
+                    assert_eq!(s["rounding"], rounding.as_str(), "{name}");
+                } else {
+                    assert!(s["rounding"].is_null(), "{name}");
+                }
+                let got = [&s["at_boundary"], &s["next_to_boundary"]].map(|v| v.as_u64().unwrap());
+                assert_eq!(got, counts, "{} stage {name}", cfg.name);
+            }
+        }
+    }
 }
 
 #[test]
@@ -480,11 +631,16 @@ fn coverage_figures_match_the_csv() {
         ),
     ];
     let mut overflow_seen = [false; 3];
+    let mut boundary_seen = [false; 2];
     for (config, args) in &runs {
         let mut a = vec!["--config", config.as_str(), "--force"];
         a.extend_from_slice(args);
         let (d, m, printed) = vectors(dir.path(), "v", &a);
         check_coverage(config, &d, &m, &printed);
+        for s in m["coverage"]["stages"].as_array().unwrap() {
+            boundary_seen[0] |= s["at_boundary"].as_u64().unwrap() > 0;
+            boundary_seen[1] |= s["next_to_boundary"].as_u64().unwrap() > 0;
+        }
         for s in m["coverage"]["stages"].as_array().unwrap() {
             for (i, key) in ["wrapped", "saturated", "zeroed"].iter().enumerate() {
                 overflow_seen[i] |= s[key].as_u64().unwrap() > 0;
@@ -494,6 +650,7 @@ fn coverage_figures_match_the_csv() {
     // The runs exercise wrapping and saturating stages (so the event counts are checked on
     // something other than zeros).
     assert!(overflow_seen[0] && overflow_seen[1], "{overflow_seen:?}");
+    assert_eq!(boundary_seen, [true, true]);
 }
 
 #[test]
@@ -648,4 +805,107 @@ fn a_bad_order_is_refused() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("shuffled"));
     assert!(!out.exists());
+}
+
+/// Issue 25, item 4: a wrapping t behind the clamp cutoff on a 2^30-code input was refused
+/// ("corner-case scan"), even for `--cases random:10`. Its cutoff switches are now found
+/// without a scan, every one of them.
+#[test]
+fn a_wrapping_t_on_a_wide_input_gets_every_cut_switch() {
+    let dir = temp_dir();
+    let cfg = dir.path().join("wide_wrap.toml");
+    let toml = "n = \"17,1024\"\n[c]\nformat = \"u1.30\"\n[d]\nformat = \"s1.30\"\n[t]\noverflow = \"WRAP\"\n";
+    std::fs::write(&cfg, toml).unwrap();
+    let (d, m, _) = vectors(
+        dir.path(),
+        "v",
+        &["--config", cfg.to_str().unwrap(), "--cases", "random:10"],
+    );
+    // By hand: t = (n/16)(c - 1) before wrapping, kept modulo 4 in [-2, 2) by s2.16; the
+    // base t + 1 is cut when the kept t is below -1, i.e. the unwrapped t lies in
+    // [-2 + 4j, -1 + 4j). n = 17: t >= -17/16 never wraps, one switch (t = -1). n = 1024:
+    // t >= -64, the 16 intervals j = -15..=0 each entered and left: 32 switches.
+    let switches = &m["coverage"]["directed"]["cut_switches"];
+    assert_eq!(switches["found"], 33, "{switches}");
+    assert_eq!(switches["complete"], true);
+    assert_eq!(switches["n_sampled"], serde_json::json!([]));
+    // Every switch is in the vectors with the code before it, as the scalar model says.
+    let dp = datapath_of(toml);
+    let inputs: BTreeSet<(i64, i64)> = Csv::read(&d).inputs().into_iter().collect();
+    let mut seen: BTreeMap<i64, usize> = BTreeMap::new();
+    for &(n, c) in &inputs {
+        if c > 0 && c <= dp.one_code() && inputs.contains(&(n, c - 1)) {
+            let nc = dp.constants_for(n as u32).unwrap();
+            if dp.eval(c, nc).cut != dp.eval(c - 1, nc).cut {
+                *seen.entry(n).or_default() += 1;
+            }
+        }
+    }
+    assert_eq!(seen, BTreeMap::from([(17, 1), (1024, 32)]));
+    // The rounding-boundary search looked at the highest codes below 1.0 only.
+    let ties = &m["coverage"]["directed"]["ties"];
+    assert_eq!(ties["exhaustive"], false);
+    assert_eq!(ties["codes_per_n"], (1u64 << 25) / 2);
+}
+
+/// Issue 25, item 5: inputs on and next to every rounding stage's boundary are vectors. The
+/// oracle is a scan of every input with the public scalar `eval`, the exact values rebuilt
+/// from docs/arithmetic.md section 3.2 (t: d * slope, 3 bits dropped; sq_i: the previous
+/// square, 16 bits; out: sq4 * coef, 16 bits; b drops none), the boundary being half an
+/// output LSB (RND).
+#[test]
+fn every_rounding_boundary_the_model_reaches_has_vectors() {
+    let dir = temp_dir();
+    let (d, m, _) = vectors(dir.path(), "v", &["--n", "16..=120", "--cases", "corner"]);
+    let dp = datapath_of_file("baseline");
+    let inputs: BTreeSet<(i64, i64)> = Csv::read(&d).inputs().into_iter().collect();
+    // (stage, offset from the tie, negative) -> every (n, c) reaching it.
+    type Class = (&'static str, i128, bool);
+    let mut reached: BTreeMap<Class, Vec<(i64, i64)>> = BTreeMap::new();
+    for n in 16..=120u32 {
+        let nc = dp.constants_for(n).unwrap();
+        for c in 0..=32768i64 {
+            let p = dp.eval(c, nc);
+            let v = |i: usize| i128::from(p.values[i]);
+            let mut exact = vec![("t", v(0) * i128::from(n), 3)];
+            for (i, name) in ["sq1", "sq2", "sq3", "sq4"].into_iter().enumerate() {
+                exact.push((name, v(2 + i) * v(2 + i), 16));
+            }
+            exact.push(("out", v(6) * i128::from(nc.coef_raw), 16));
+            for (stage, x, s) in exact {
+                let offset = x.rem_euclid(1 << s) - (1 << (s - 1));
+                if offset.abs() <= 1 {
+                    reached
+                        .entry((stage, offset, x < 0))
+                        .or_default()
+                        .push((i64::from(n), c));
+                }
+            }
+        }
+    }
+    // The outside run of the issue found the out values one LSB below the tie at n = 25, 82,
+    // 111, 183, ...: in 16..=120, those three.
+    let below: BTreeSet<i64> = reached[&("out", -1, false)].iter().map(|p| p.0).collect();
+    assert_eq!(below, BTreeSet::from([25, 82, 111]));
+    for (class, all) in &reached {
+        let ns: BTreeSet<i64> = all.iter().map(|p| p.0).collect();
+        let held = all.iter().filter(|p| inputs.contains(p)).count();
+        assert!(
+            held >= ns.len().min(8),
+            "{class:?}: {held} of {} inputs over {} n",
+            all.len(),
+            ns.len()
+        );
+    }
+    assert!(reached.keys().any(|k| k.0 == "out" && k.1 == 0));
+    let ties = &m["coverage"]["directed"]["ties"];
+    assert_eq!(ties["exhaustive"], true);
+    assert_eq!(ties["codes_searched"], 105 * 32769);
+    // Per stage, the classes reached and at most 8 vectors each.
+    for st in ties["stages"].as_array().unwrap() {
+        let name = st["stage"].as_str().unwrap();
+        let classes = reached.keys().filter(|k| k.0 == name).count() as u64;
+        assert_eq!(st["classes"], classes, "{name}");
+        assert!(st["vectors"].as_u64().unwrap() <= 8 * classes, "{name}");
+    }
 }

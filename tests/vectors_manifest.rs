@@ -84,6 +84,20 @@ fn manifests_of_every_test_configuration_follow_the_schema() {
             "sorted".into(),
         ],
     ];
+    // A wrapping t on a 2^30-code input: cutoff switches by bisection, the rounding boundaries
+    // searched near 1.0 only (not exhaustive).
+    let wide = dir.path().join("wide_wrap.toml");
+    std::fs::write(
+        &wide,
+        "n = \"17,1024\"\n[c]\nformat = \"u1.30\"\n[d]\nformat = \"s1.30\"\n[t]\noverflow = \"WRAP\"\n",
+    )
+    .unwrap();
+    runs.push(vec![
+        "--config".into(),
+        wide.to_string_lossy().into_owned(),
+        "--cases".into(),
+        "random:10".into(),
+    ]);
     let mut configs: Vec<String> =
         std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/configs"))
             .unwrap()
@@ -106,6 +120,7 @@ fn manifests_of_every_test_configuration_follow_the_schema() {
     }
     let mut orders = std::collections::BTreeSet::new();
     let mut some_without = false;
+    let mut directed = std::collections::BTreeSet::new();
     for args in &runs {
         let a: Vec<&str> = args.iter().map(String::as_str).collect();
         let m = write_manifest(dir.path(), &a);
@@ -115,9 +130,17 @@ fn manifests_of_every_test_configuration_follow_the_schema() {
             .as_array()
             .unwrap()
             .is_empty();
+        let d = &m["coverage"]["directed"];
+        directed.insert(if d.is_null() {
+            "null".to_string()
+        } else {
+            format!("exhaustive {}", d["ties"]["exhaustive"])
+        });
     }
     assert_eq!(orders.len(), 2);
     assert!(some_without);
+    // An exhaustive selection, directed cases searched exhaustively and near 1.0 only.
+    assert_eq!(directed.len(), 3, "{directed:?}");
 }
 
 #[test]
@@ -127,7 +150,25 @@ fn broken_manifests_fail_the_schema() {
     let good = write_manifest(dir.path(), &["--n", "16,100", "--cases", "corner"]);
     assert_eq!(errors(&v, &good), "");
     type Break = fn(&mut Value);
-    let breaks: [(&str, Break); 12] = [
+    let breaks: [(&str, Break); 16] = [
+        ("no directed cases", |m| {
+            m["coverage"].as_object_mut().unwrap().remove("directed");
+        }),
+        ("a stage without its boundary count", |m| {
+            m["coverage"]["stages"][1]
+                .as_object_mut()
+                .unwrap()
+                .remove("at_boundary");
+        }),
+        ("an unknown rounding", |m| {
+            m["coverage"]["stages"][1]["rounding"] = "ROUND".into()
+        }),
+        ("a tie search without its extent", |m| {
+            m["coverage"]["directed"]["ties"]
+                .as_object_mut()
+                .unwrap()
+                .remove("exhaustive");
+        }),
         ("no coverage", |m| {
             m.as_object_mut().unwrap().remove("coverage");
         }),

@@ -30,7 +30,13 @@ pub struct VectorsArgs {
     /// Exponents, replacing the configuration's set.
     #[arg(long)]
     n: Option<NSet>,
-    /// Which cases: corner, exhaustive, random:N, comma-separated.
+    /// Which cases: corner, exhaustive, random:N, comma-separated. Unless exhaustive, the
+    /// directed cases are always included: corner cases (ends of the code range, 0, 1.0 and
+    /// above, every cutoff switch +-1 code), up to 4 codes with a non-zero output per n, and
+    /// inputs on and next to every stage's rounding boundary (ties; at most 8 per stage and
+    /// class, searched over every code up to 1.0 where at most 2^25 codes lie there over all
+    /// n, the highest codes below 1.0 otherwise). The manifest's coverage.directed says what
+    /// they cover.
     #[arg(long, default_value = "corner,random:1000")]
     cases: CaseSelection,
     /// Seed of the random cases and of the interleaved order.
@@ -80,8 +86,9 @@ pub fn write_dir(
     force: bool,
     inputs: &[(&str, PathBuf)],
 ) -> Result<(u64, Coverage)> {
-    let mut cases = cases::select(dp, selection, seed)
+    let chosen = cases::select(dp, selection, seed)
         .with_context(|| format!("config {}", dp.config().name))?;
+    let mut cases = chosen.cases;
     cases::order(&mut cases, order, seed);
     let staged = super::output::OutDir::begin(out, "vectors", force, inputs)?;
     let partial = staged.path().to_path_buf();
@@ -103,13 +110,14 @@ pub fn write_dir(
     } else {
         super::progress::Progress::off("vectors", "vectors", cases.len() as u64)
     };
-    let coverage = {
+    let mut coverage = {
         let mut writers: Vec<&mut dyn Write> =
             hex.iter_mut().map(|w| w as &mut dyn Write).collect();
         let mut progress = |done: u64| bar.set_position(done);
         write_vectors(dp, &cases, &mut csv, &mut writers, &mut progress)
             .with_context(|| format!("cannot write vectors to {}", partial.display()))?
     };
+    coverage.directed = chosen.directed;
     bar.finish();
     let mut sha256 = BTreeMap::new();
     let (digest, mut w) = csv.finish();

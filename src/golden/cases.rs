@@ -10,6 +10,8 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use crate::error::Error;
+use crate::golden::switches::cut_switches;
+use crate::golden::ties::{self, TieSearch};
 use crate::pipeline::datapath::CutStructure;
 use crate::pipeline::{Datapath, ProbeColumns};
 
@@ -66,9 +68,10 @@ pub const ORDER_STREAM: u64 = 1;
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct CaseSelection {
-    /// Corner cases: c = 0, 1.0, codes above 1.0, the ends of the code range and the cutoff
-    /// boundary +-1 code, for every n. They are always included, as are up to
-    /// [`LIVE_CODES`] codes with a non-zero output per n ([`live_codes`]); naming them is
+    /// Corner cases: c = 0, 1.0, codes above 1.0, the ends of the code range and every
+    /// cutoff switch +-1 code, for every n. They are always included, as are up to
+    /// [`LIVE_CODES`] codes with a non-zero output per n ([`live_codes`]) and the inputs on
+    /// and next to every stage's rounding boundary ([`ties::search`]); naming them is
     /// optional.
     pub corner: bool,
     /// Every input code for every n.
@@ -132,27 +135,31 @@ impl fmt::Display for CaseSelection {
     }
 }
 
-/// The most cutoff evaluations a corner-case scan may take per exponent, where the cut codes
-/// are not proven to be a prefix and every code up to 1.0 must be looked at.
-pub const MAX_SCAN_CODES: u64 = 1 << 22;
-
 /// The most (n, c) cases a selection may hold.
 pub const MAX_CASES: u64 = 1 << 26;
+
+/// The corner codes of one n, and whether they hold every cutoff switch.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Corners {
+    /// The codes, ascending.
+    pub codes: BTreeSet<i64>,
+    /// The cutoff's switches found ([`crate::golden::switches::Switches::codes`]).
+    pub switches: u64,
+    /// Whether those are every switch of the n (see [`cut_switches`]).
+    pub complete: bool,
+}
 
 /// The corner codes of one n: the ends of the code range, 0, 1.0 and its neighbours, and
 /// every place where the cutoff switches between two consecutive codes, +-1 code.
 ///
-/// The switching points cost what they are: none without a cutoff, one bisection where the
-/// cut codes are proven to be a prefix ([`Datapath::first_live_code`]); only a clamp behind a
-/// wrapping or zeroing t scans every code up to 1.0, at most [`MAX_SCAN_CODES`] of them.
-///
-/// # Errors
-/// When a scan would take more than [`MAX_SCAN_CODES`] evaluations.
-pub fn corner_codes(
-    dp: &Datapath,
-    n: u32,
-    cols: &mut ProbeColumns,
-) -> Result<BTreeSet<i64>, Error> {
+/// The switching points cost what they are, and no scan of every code up to 1.0 is needed:
+/// none without a cutoff, one bisection where the cut codes are proven to be a prefix
+/// ([`Datapath::first_live_code`]), and behind a wrapping or zeroing t one bisection per
+/// boundary of t (see [`crate::golden::switches`]); only when t has more than
+/// [`crate::golden::switches::MAX_BISECTIONS`] boundaries in the n's range of products are the switches
+/// scanned (up to [`crate::golden::switches::MAX_SCAN_CODES`] codes) or, beyond that, sampled
+/// ([`Corners::complete`] is then false).
+pub fn corner_codes(dp: &Datapath, n: u32) -> Corners {
     let codes = dp.input_codes();
     let (lo, hi) = (*codes.start(), *codes.end());
     let one = dp.one_code();
@@ -166,52 +173,23 @@ pub fn corner_codes(
         add(&mut set, c);
     }
     let Some(nc) = dp.constants_for(n) else {
-        return Ok(set);
+        return Corners {
+            codes: set,
+            switches: 0,
+            complete: true,
+        };
     };
-    let last = hi.min(one);
-    match dp.cut_structure() {
-        CutStructure::Never => {}
-        CutStructure::Prefix => {
-            let live = dp.first_live_code(nc, lo..last + 1);
-            if live > lo && live <= last {
-                for x in [live - 2, live - 1, live, live + 1] {
-                    add(&mut set, x);
-                }
-            }
-        }
-        CutStructure::Scan => {
-            let n_codes =
-                u64::try_from((i128::from(last) - i128::from(lo) + 1).max(0)).unwrap_or(u64::MAX);
-            if n_codes > MAX_SCAN_CODES {
-                return Err(Error::OutOfRange {
-                    what: "the corner-case scan",
-                    expected: format!(
-                        "at most {MAX_SCAN_CODES} codes up to 1.0 per n when t wraps or zeroes under the clamp cutoff (every code must be looked at)"
-                    ),
-                    got: format!("{n_codes} codes of c.format {}", dp.config().c.format),
-                });
-            }
-            const CHUNK: i64 = 4096;
-            let mut prev: Option<bool> = None;
-            let mut start = lo;
-            while start <= last {
-                let end = (start + CHUNK - 1).min(last);
-                let chunk: Vec<i64> = (start..=end).collect();
-                dp.eval_batch(nc, &chunk, cols);
-                for (i, &cut) in cols.cut.iter().enumerate() {
-                    if prev.is_some_and(|p| p != cut) {
-                        let c = chunk[i];
-                        for x in [c - 2, c - 1, c, c + 1] {
-                            add(&mut set, x);
-                        }
-                    }
-                    prev = Some(cut);
-                }
-                start = end + 1;
-            }
+    let found = cut_switches(dp, nc, lo, hi.min(one));
+    for &c in &found.codes {
+        for x in [c - 2, c - 1, c, c + 1] {
+            add(&mut set, x);
         }
     }
-    Ok(set)
+    Corners {
+        codes: set,
+        switches: found.codes.len() as u64,
+        complete: found.complete,
+    }
 }
 
 /// The most codes [`live_codes`] scans per exponent, down from 1.0, when its candidates hold
@@ -360,19 +338,51 @@ pub fn order(cases: &mut [(u32, i64)], order: Order, seed: u64) {
     }
 }
 
+/// The directed cases of a selection: what the cutoff-switch analysis and the
+/// rounding-boundary search found (the manifest's `coverage.directed`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Directed {
+    /// The cutoff's switches among the corner cases.
+    pub cut_switches: CutSwitches,
+    /// The inputs on and next to every rounding stage's boundary.
+    pub ties: TieSearch,
+}
+
+/// The cutoff's switches over every n (see [`corner_codes`]).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct CutSwitches {
+    /// The switches found, over all n (each gives the corner cases c - 2..=c + 1).
+    pub found: u64,
+    /// Whether every switch of every n was found.
+    pub complete: bool,
+    /// The n whose switches were sampled rather than all found (empty when complete).
+    pub n_sampled: Vec<u32>,
+}
+
+/// A selection's cases and, unless it is exhaustive, what its directed cases cover.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Selection {
+    /// The (n, c_raw) pairs, sorted by n then c, without duplicates.
+    pub cases: Vec<(u32, i64)>,
+    /// The directed cases' report; `None` for an exhaustive selection (every input is a case).
+    pub directed: Option<Directed>,
+}
+
 /// The (n, c_raw) pairs of a selection, sorted by n then c, without duplicates (put them in
 /// the written order with [`order`]). Unless the selection is exhaustive, every n gets its
 /// corner cases ([`corner_codes`]; `corner` only says so explicitly) and up to
-/// [`LIVE_CODES`] codes with a non-zero output ([`live_codes`]).
+/// [`LIVE_CODES`] codes with a non-zero output ([`live_codes`]), and the selection holds the
+/// rounding-boundary inputs of every stage that rounds ([`ties::search`]). None of these
+/// visits every code of a wide input: a random-only selection costs about the same on `u1.30`
+/// as on `u1.15`.
 ///
 /// Random pairs are drawn from ChaCha8 seeded with `seed`, uniformly over the n set and the
 /// input codes, until `random` pairs not already selected have been added (or every pair is
 /// selected). The same arguments give the same cases on every machine.
 ///
 /// # Errors
-/// When the selection would hold more than [`MAX_CASES`] cases, or a corner-case scan is too
-/// long (see [`corner_codes`]).
-pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Vec<(u32, i64)>, Error> {
+/// When the selection would hold more than [`MAX_CASES`] cases.
+pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Selection, Error> {
     let ns = dp.config().n.values();
     let codes = dp.input_codes();
     let (lo, hi) = (*codes.start(), *codes.end());
@@ -383,16 +393,17 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Vec<(u32,
         0
     };
     let asked = exhaustive.saturating_add(sel.random);
+    let too_many = |asked: u64| Error::OutOfRange {
+        what: "the number of vectors",
+        expected: format!("at most {MAX_CASES}"),
+        got: format!(
+            "{asked} ({} exponents x {per_n} input codes exhaustive, {} random)",
+            ns.len(),
+            sel.random
+        ),
+    };
     if asked > MAX_CASES {
-        return Err(Error::OutOfRange {
-            what: "the number of vectors",
-            expected: format!("at most {MAX_CASES}"),
-            got: format!(
-                "{asked} ({} exponents x {per_n} input codes exhaustive, {} random)",
-                ns.len(),
-                sel.random
-            ),
-        });
+        return Err(too_many(asked));
     }
     if sel.exhaustive {
         // Every pair: the random draws could add nothing.
@@ -400,14 +411,39 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Vec<(u32,
         for &n in ns {
             all.extend((lo..=hi).map(|c| (n, c)));
         }
-        return Ok(all);
+        return Ok(Selection {
+            cases: all,
+            directed: None,
+        });
     }
     let mut set: BTreeSet<(u32, i64)> = BTreeSet::new();
-    // Corner cases and live codes are always included, whatever else is selected.
+    // Corner cases, live codes and rounding ties are always included, whatever else is
+    // selected.
     let mut cols = ProbeColumns::default();
+    let mut cut = CutSwitches {
+        found: 0,
+        complete: true,
+        n_sampled: Vec::new(),
+    };
     for &n in ns {
-        set.extend(corner_codes(dp, n, &mut cols)?.into_iter().map(|c| (n, c)));
+        let corners = corner_codes(dp, n);
+        cut.found += corners.switches;
+        if !corners.complete {
+            cut.complete = false;
+            cut.n_sampled.push(n);
+        }
+        set.extend(corners.codes.into_iter().map(|c| (n, c)));
         set.extend(live_codes(dp, n, &mut cols).into_iter().map(|c| (n, c)));
+    }
+    let ties = ties::search(dp);
+    set.extend(ties.cases);
+    let directed = Directed {
+        cut_switches: cut,
+        ties: ties.report,
+    };
+    let wanted = set.len() as u64 + sel.random;
+    if wanted > MAX_CASES {
+        return Err(too_many(wanted));
     }
     if sel.random > 0 {
         let total = ns.len() as u128 * (i128::from(hi) - i128::from(lo) + 1) as u128;
@@ -419,7 +455,10 @@ pub fn select(dp: &Datapath, sel: &CaseSelection, seed: u64) -> Result<Vec<(u32,
             set.insert((n, c));
         }
     }
-    Ok(set.into_iter().collect())
+    Ok(Selection {
+        cases: set.into_iter().collect(),
+        directed: Some(directed),
+    })
 }
 
 #[cfg(test)]
@@ -522,6 +561,8 @@ mod tests {
         let dp = datapath("n = \"3,5\"\n[c]\nformat = \"u1.3\"\n[d]\nformat = \"s1.3\"\n");
         let sel: CaseSelection = "exhaustive,random:5".parse().unwrap();
         let got = select(&dp, &sel, 1).unwrap();
+        assert!(got.directed.is_none());
+        let got = got.cases;
         let want: Vec<(u32, i64)> = [3, 5]
             .into_iter()
             .flat_map(|n| (0..16).map(move |c| (n, c)))

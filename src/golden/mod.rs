@@ -5,6 +5,8 @@
 //! byte-for-byte deterministic for the same configuration, cases, order and seed.
 
 pub mod cases;
+pub mod switches;
+pub mod ties;
 pub mod verify;
 
 use std::collections::BTreeMap;
@@ -13,12 +15,12 @@ use std::io::{self, Write};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
-use crate::fixed::Format;
+use crate::fixed::{Format, Rounding};
 use crate::pipeline::fast::EventCounts;
-use crate::pipeline::{Config, Datapath, ProbeColumns, Variant};
+use crate::pipeline::{Config, Datapath, NConstants, ProbeColumns, Variant};
 use crate::report::csv::CsvWriter;
 
-pub use cases::{CaseSelection, Order};
+pub use cases::{CaseSelection, Directed, Order, Selection};
 
 /// What a port carries for one vector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -299,11 +301,14 @@ pub fn write_vectors(
     let mut hex_text: Vec<Vec<u8>> = vec![Vec::new(); ports.len()];
     // values[i * n_stages + stage_idx]: the chunk's probes, in the order of the chunk.
     let mut values: Vec<i64> = Vec::new();
+    let mut cuts: Vec<bool> = Vec::new();
     let mut by_n: Vec<usize> = Vec::new();
     let mut codes: Vec<i64> = Vec::new();
     for chunk in cases.chunks(WRITE_CHUNK) {
         values.clear();
         values.resize(chunk.len() * n_stages, 0);
+        cuts.clear();
+        cuts.resize(chunk.len(), false);
         by_n.clear();
         by_n.extend(0..chunk.len());
         by_n.sort_by_key(|&i| chunk[i].0);
@@ -320,6 +325,7 @@ pub fn write_vectors(
                 for (stage_idx, col) in cols.values.iter().enumerate() {
                     values[i * n_stages + stage_idx] = col[j];
                 }
+                cuts[i] = cols.cut[j];
             }
         }
         for text in &mut hex_text {
@@ -330,7 +336,7 @@ pub fn write_vectors(
                 .constants_for(n)
                 .expect("cases are drawn from the configuration's n set");
             let row = &values[i * n_stages..(i + 1) * n_stages];
-            coverage.add_row(n, row);
+            coverage.add_row(nc, row, cuts[i]);
             for (port, text) in ports.iter().zip(&mut hex_text) {
                 let raw = match port.source {
                     Source::C => c,
@@ -383,6 +389,17 @@ pub struct StageCoverage {
     pub saturated: u64,
     /// Vectors whose quantization at this stage overflowed to zero (`SAT_ZERO`).
     pub zeroed: u64,
+    /// The stage's rounding mode where its quantization drops fraction bits; `None` for d and
+    /// coef, and for a stage whose exact value is already on its grid (or shifted left).
+    pub rounding: Option<Rounding>,
+    /// The fraction bits the stage's quantization drops (0 when it drops none).
+    pub dropped_bits: u64,
+    /// Vectors whose exact value before this stage's quantization lies on its rounding
+    /// boundary: a tie (half an LSB dropped) for the round-to-nearest modes, a value on the
+    /// grid for `TRN` and `TRN_ZERO` ([`ties::RoundingStage::boundary`]).
+    pub at_boundary: u64,
+    /// Vectors whose exact value lies one exact LSB below or above that boundary.
+    pub next_to_boundary: u64,
 }
 
 /// What a vector set exercises: non-zero outputs overall and per n, each stage's range and
@@ -411,6 +428,10 @@ pub struct Coverage {
     pub input_clamped: u64,
     /// One entry per stage, in pipeline order.
     pub stages: Vec<StageCoverage>,
+    /// What the selection's directed cases cover (cutoff switches, rounding-boundary
+    /// inputs): [`Selection::directed`], set by whoever selected the cases ([`write_vectors`]
+    /// sees only the cases and leaves it `None`); `None` for an exhaustive selection.
+    pub directed: Option<Directed>,
 }
 
 impl Coverage {
@@ -428,6 +449,7 @@ impl Coverage {
     ///     cut: 1,
     ///     input_clamped: 0,
     ///     stages: Vec::new(),
+    ///     directed: None,
     /// };
     /// assert_eq!(
     ///     c.summary(),
@@ -457,6 +479,18 @@ impl Coverage {
             s.push_str(&format!(" (none for n = {}{more})", shown.join(", ")));
         }
         s.push_str(&format!(", {} cut", self.cut));
+        let boundaries: Vec<String> = self
+            .stages
+            .iter()
+            .filter(|st| st.dropped_bits > 0)
+            .map(|st| format!("{} {}/{}", st.stage, st.at_boundary, st.next_to_boundary))
+            .collect();
+        if !boundaries.is_empty() {
+            s.push_str(&format!(
+                ", rounding boundaries (on/next to): {}",
+                boundaries.join(", ")
+            ));
+        }
         let events: Vec<String> = self
             .stages
             .iter()
@@ -492,6 +526,9 @@ struct CoverageCounter<'a> {
     min: Vec<i64>,
     max: Vec<i64>,
     events: Vec<EventCounts>,
+    /// The stages that drop bits, and per stage index: vectors on and next to its boundary.
+    rounding: Vec<ties::RoundingStage>,
+    boundary: Vec<[u64; 2]>,
 }
 
 impl<'a> CoverageCounter<'a> {
@@ -507,6 +544,8 @@ impl<'a> CoverageCounter<'a> {
             min: vec![i64::MAX; n_stages],
             max: vec![i64::MIN; n_stages],
             events: vec![[0; 3]; n_stages],
+            rounding: ties::rounding_stages(dp),
+            boundary: vec![[0; 2]; n_stages],
         }
     }
 
@@ -521,8 +560,15 @@ impl<'a> CoverageCounter<'a> {
         self.input_clamped += cols.input_clamped.iter().filter(|&&c| c).count() as u64;
     }
 
-    /// Counts one row's values.
-    fn add_row(&mut self, n: u32, row: &[i64]) {
+    /// Counts one row's values (`cut`: the row's base was cut).
+    fn add_row(&mut self, nc: &NConstants, row: &[i64], cut: bool) {
+        let n = nc.n;
+        for st in &self.rounding {
+            let x = ties::exact_input(self.dp, nc, st.stage_idx, |s| row[s], cut);
+            if let Some(b) = st.boundary(x) {
+                self.boundary[st.stage_idx][usize::from(b.offset != 0)] += 1;
+            }
+        }
         self.n_rows += 1;
         for ((lo, hi), &v) in self.min.iter_mut().zip(self.max.iter_mut()).zip(row) {
             *lo = (*lo).min(v);
@@ -558,6 +604,8 @@ impl<'a> CoverageCounter<'a> {
                     0.0
                 };
                 let [wrapped, saturated, zeroed] = self.events[stage_idx];
+                let [at_boundary, next_to_boundary] = self.boundary[stage_idx];
+                let rounding = self.rounding.iter().find(|r| r.stage_idx == stage_idx);
                 StageCoverage {
                     stage: s.name.clone(),
                     format: s.format.to_string(),
@@ -569,6 +617,10 @@ impl<'a> CoverageCounter<'a> {
                     wrapped,
                     saturated,
                     zeroed,
+                    rounding: rounding.map(|r| r.rounding),
+                    dropped_bits: rounding.map_or(0, |r| r.dropped_bits.unsigned_abs()),
+                    at_boundary,
+                    next_to_boundary,
                 }
             })
             .collect();
@@ -590,6 +642,7 @@ impl<'a> CoverageCounter<'a> {
             cut: self.cut,
             input_clamped: self.input_clamped,
             stages,
+            directed: None,
         }
     }
 }
