@@ -1,6 +1,9 @@
 //! `specfx calibrate`: synthesises a seeded sample of configurations with yosys (resumably,
 //! in parallel) into `data/calibration/<target>.jsonl`, then fits the analytic model's
 //! coefficients to the records and prints them beside the committed ones with the fit error.
+//! A configuration yosys fails on is not a record (never stored, tried again by the next run);
+//! a fit over no record is an error; everything that can be refused is refused before the
+//! first synthesis.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -10,7 +13,7 @@ use clap::Args;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::cost::{hdl_ref_dir, run_yosys};
+use super::cost::run_yosys;
 use super::output::{print_json, print_with};
 use super::Outcome;
 use specfx::hdl::calibrate::{calibration, fit, read_records, sample, Calibration, Record};
@@ -56,7 +59,8 @@ pub struct TargetFit {
     pub fitted: Calibration,
     /// The calibration the model uses (compiled in).
     pub committed: Calibration,
-    /// Records yosys failed on (left out of the fit).
+    /// Configurations yosys failed on in this run: not records (left out of the fit, not
+    /// stored), tried again by the next run.
     pub failed: usize,
 }
 
@@ -64,59 +68,96 @@ fn records_path(dir: &Path, target: Target) -> PathBuf {
     dir.join(format!("{}.jsonl", target.name()))
 }
 
-/// Reads a target's records (none when the file does not exist).
-pub fn load_records(dir: &Path, target: Target) -> Result<Vec<Record>> {
-    let path = records_path(dir, target);
-    if !path.exists() {
+/// Reads a target's records (none when the file does not exist): a regular file only.
+pub fn load_records(path: &Path) -> Result<Vec<Record>> {
+    if !path.exists() && !path.is_symlink() {
         return Ok(Vec::new());
     }
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("cannot read {}", path.display()))?;
-    Ok(read_records(&text, &path.display().to_string())?)
+    let shown = path.display().to_string();
+    // A record is about a kilobyte: --count's largest sample is about 110 MB.
+    let bytes = super::input::read_bytes(path, &shown, super::input::MAX_BINARY_BYTES)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        anyhow::anyhow!(
+            "{shown}: expected UTF-8 text, got an invalid byte at offset {}",
+            e.utf8_error().valid_up_to()
+        )
+    })?;
+    Ok(read_records(&text, &shown)?)
 }
 
-/// Synthesises the sample's missing records of a target and appends them, in index order.
-fn collect(args: &CalibrateArgs, target: Target, hdl_ref: &Path) -> Result<()> {
-    let path = records_path(&args.data, target);
-    let mut records = load_records(&args.data, target)?;
-    if records
+/// The records as their file holds them: in index order, one JSON line each.
+fn records_text(records: &[Record]) -> Result<String> {
+    Ok(records
         .iter()
-        .any(|r| sample(args.seed, r.index).0 != r.config)
-    {
-        bail!(
-            "{}: its records were drawn with another seed or sampler; use another --data directory",
-            path.display()
-        );
+        .map(|r| serde_json::to_string(r).map(|l| l + "\n"))
+        .collect::<Result<_, _>>()?)
+}
+
+/// One target's work, planned (and everything about it checked) before any synthesis.
+struct Plan {
+    target: Target,
+    /// Its records file.
+    path: PathBuf,
+    /// The records already there.
+    records: Vec<Record>,
+    /// The sample's indexes still to synthesise (none with `--fit-only`).
+    todo: Vec<u64>,
+}
+
+/// The records file of a collecting run, appended one line per record as it finishes (so that
+/// an interrupted run resumes); created, with its directory, at the first record.
+struct RecordLog {
+    path: PathBuf,
+    dir: PathBuf,
+    file: Option<std::fs::File>,
+}
+
+impl RecordLog {
+    /// Appends one line; a failed write is taken back (the file keeps its complete lines only)
+    /// and named.
+    fn append(&mut self, line: &str) -> Result<()> {
+        let cannot = || format!("cannot write {}", self.path.display());
+        if self.file.is_none() {
+            std::fs::create_dir_all(&self.dir)
+                .with_context(|| format!("cannot create {}", self.dir.display()))?;
+            let file = std::fs::OpenOptions::new()
+                .create(true)
+                .append(true)
+                .open(&self.path)
+                .with_context(cannot)?;
+            self.file = Some(file);
+        }
+        let file = self.file.as_mut().expect("opened above");
+        let before = file.metadata().with_context(cannot)?.len();
+        if let Err(e) = file.write_all(line.as_bytes()).and_then(|()| file.flush()) {
+            let _ = file.set_len(before);
+            return Err(e).with_context(cannot);
+        }
+        Ok(())
     }
-    let have: std::collections::BTreeSet<u64> = records.iter().map(|r| r.index).collect();
-    let count = args.count.unwrap_or(match target {
-        Target::Ice40 => 240,
-        _ => 120,
-    });
-    let todo: Vec<u64> = (0..count).filter(|i| !have.contains(i)).collect();
-    if todo.is_empty() && records.windows(2).all(|w| w[0].index < w[1].index) {
-        return Ok(());
-    }
-    std::fs::create_dir_all(&args.data)
-        .with_context(|| format!("cannot create {}", args.data.display()))?;
+}
+
+/// Synthesises a target's missing records, appending each to its file as it finishes and to
+/// the plan's records. Returns the configurations yosys failed on (index and first error
+/// line): not records, never stored, so a later run tries them again.
+fn collect(args: &CalibrateArgs, plan: &mut Plan, hdl_ref: &Path) -> Result<Vec<(u64, String)>> {
+    let target = plan.target;
     let bar = super::progress::Progress::new(
         &format!("calibrate {}", target.name()),
         "configurations",
-        todo.len() as u64,
+        plan.todo.len() as u64,
     );
-    let file = std::sync::Mutex::new(
-        std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&path)
-            .with_context(|| format!("cannot write {}", path.display()))?,
-    );
-    let done: Result<Vec<Record>> = todo
+    let log = std::sync::Mutex::new(RecordLog {
+        path: plan.path.clone(),
+        dir: args.data.clone(),
+        file: None,
+    });
+    let done: Result<Vec<std::result::Result<Record, (u64, String)>>> = plan
+        .todo
         .par_iter()
         .map(|&index| {
             let (config, arch) = sample(args.seed, index);
             let dp = Datapath::new(config.clone())?;
-            // A configuration yosys itself fails on is recorded as failed, not retried.
             let r = match run_yosys(&dp, arch, target, hdl_ref) {
                 Ok((y, _, _)) => Record {
                     index,
@@ -126,41 +167,37 @@ fn collect(args: &CalibrateArgs, target: Target, hdl_ref: &Path) -> Result<()> {
                     carries: y.carries,
                     dsps: y.dsps,
                     ffs: y.ffs,
-                    failed: None,
                 },
-                Err(e) => Record {
-                    index,
-                    arch,
-                    config,
-                    luts: 0,
-                    carries: 0,
-                    dsps: 0,
-                    ffs: 0,
-                    failed: Some(format!("{:#}", e).lines().next().unwrap_or("").to_string()),
-                },
+                Err(e) => {
+                    let first = format!("{e:#}").lines().next().unwrap_or("").to_string();
+                    log::debug!(
+                        "calibrate {}: configuration {index}: {first}",
+                        target.name()
+                    );
+                    bar.inc(1);
+                    return Ok(Err((index, first)));
+                }
             };
-            // One line per record as it finishes, so an interrupted run resumes.
             let line = serde_json::to_string(&r)? + "\n";
-            file.lock()
-                .expect("no writer panics")
-                .write_all(line.as_bytes())?;
+            log.lock().expect("no writer panics").append(&line)?;
             log::debug!(
                 "calibrate {}: configuration {index} synthesised",
                 target.name()
             );
             bar.inc(1);
-            Ok(r)
+            Ok(Ok(r))
         })
         .collect();
     bar.finish();
-    records.extend(done?);
-    // Rewrite in index order: the committed file is the same whatever the finishing order.
-    records.sort_by_key(|r| r.index);
-    let text: String = records
-        .iter()
-        .map(|r| serde_json::to_string(r).map(|l| l + "\n"))
-        .collect::<Result<_, _>>()?;
-    super::output::write_atomic(&path, text.as_bytes())
+    let mut failed = Vec::new();
+    for r in done? {
+        match r {
+            Ok(r) => plan.records.push(r),
+            Err(f) => failed.push(f),
+        }
+    }
+    failed.sort_by_key(|f| f.0);
+    Ok(failed)
 }
 
 /// A `--count`: a whole number in 1..=100000 (a negative one too gets the range, not a
@@ -172,27 +209,111 @@ fn parse_count(s: &str) -> Result<u64, String> {
     }
 }
 
-/// Runs `specfx calibrate`.
-pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
-    let hdl_ref = hdl_ref_dir(args.hdl_ref.as_deref());
-    let mut fits = Vec::new();
-    for &target in &args.targets {
-        if !args.fit_only {
-            collect(args, target, &hdl_ref)?;
-        }
-        let records = load_records(&args.data, target)?;
-        if records.is_empty() {
+/// Plans every target and checks everything that can be refused (the targets, the reference
+/// Verilog, the data directory and its files, the tools) before the first synthesis.
+fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
+    for (i, t) in args.targets.iter().enumerate() {
+        if args.targets[..i].contains(t) {
             bail!(
-                "{}: no calibration records{}",
-                records_path(&args.data, target).display(),
-                if args.fit_only {
-                    " (run without --fit-only to synthesise them)"
-                } else {
-                    ""
-                }
+                "--targets: expected each target once, got {} twice",
+                t.name()
             );
         }
-        let (coefficients, error) = fit(&records, target)?;
+    }
+    let hdl_ref = if args.fit_only {
+        None
+    } else {
+        let dir = super::cost::hdl_ref(args.hdl_ref.as_deref())?;
+        super::output::check_can_create(&args.data, "--data")?;
+        Some(dir)
+    };
+    let mut plans = Vec::new();
+    for &target in &args.targets {
+        let path = records_path(&args.data, target);
+        let records = load_records(&path)?;
+        let mut todo = Vec::new();
+        if args.fit_only {
+            if records.is_empty() {
+                bail!(
+                    "{}: no calibration records (run without --fit-only to synthesise them)",
+                    path.display()
+                );
+            }
+        } else {
+            if let Some(r) = records
+                .iter()
+                .find(|r| sample(args.seed, r.index).0 != r.config)
+            {
+                bail!(
+                    "{}: record {} was drawn with another seed than --seed {} or another sampler; use another --data directory",
+                    path.display(),
+                    r.index,
+                    args.seed
+                );
+            }
+            let have: std::collections::BTreeSet<u64> = records.iter().map(|r| r.index).collect();
+            let count = args.count.unwrap_or(match target {
+                Target::Ice40 => 240,
+                _ => 120,
+            });
+            todo = (0..count).filter(|i| !have.contains(i)).collect();
+            // The file takes new lines: checked now, not after the first synthesis.
+            if !todo.is_empty() && path.exists() {
+                std::fs::OpenOptions::new()
+                    .append(true)
+                    .open(&path)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+            }
+        }
+        plans.push(Plan {
+            target,
+            path,
+            records,
+            todo,
+        });
+    }
+    if plans.iter().any(|p| !p.todo.is_empty()) {
+        super::cost::check_yosys()?;
+    }
+    Ok((plans, hdl_ref))
+}
+
+/// Runs `specfx calibrate`.
+pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
+    let (plans, hdl_ref) = plan(args)?;
+    let mut fits = Vec::new();
+    for mut plan in plans {
+        let target = plan.target;
+        let mut failed = Vec::new();
+        if let Some(hdl_ref) = &hdl_ref {
+            if !plan.todo.is_empty() {
+                failed = collect(args, &mut plan, hdl_ref)?;
+            }
+            // In index order: the file is the same whatever the finishing order, and holds
+            // records only (an earlier specfx's stored failures and a torn line are dropped).
+            plan.records.sort_by_key(|r| r.index);
+            let text = records_text(&plan.records)?;
+            let on_disk = std::fs::read(&plan.path).ok();
+            if !plan.records.is_empty() && on_disk.as_deref() != Some(text.as_bytes()) {
+                super::output::write_atomic(&plan.path, text.as_bytes())?;
+            }
+        }
+        if let Some((index, first)) = failed.first() {
+            if plan.records.is_empty() {
+                bail!(
+                    "{}: no calibration records to fit: yosys failed on all {} configurations it was given (configuration {index}: {first})",
+                    plan.path.display(),
+                    failed.len()
+                );
+            }
+            log::warn!(
+                "calibrate {}: yosys failed on {} of {} configurations (configuration {index}: {first}); they are left out and tried again by the next run",
+                target.name(),
+                failed.len(),
+                plan.todo.len()
+            );
+        }
+        let (coefficients, error) = fit(&plan.records, target)?;
         fits.push(TargetFit {
             fitted: Calibration {
                 target,
@@ -200,7 +321,7 @@ pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
                 error,
             },
             committed: calibration(target),
-            failed: records.iter().filter(|r| r.failed.is_some()).count(),
+            failed: failed.len(),
         });
     }
     if args.json {
@@ -222,7 +343,10 @@ fn write_fits(w: &mut impl Write, fits: &[TargetFit], width: Option<u16>) -> std
             a.target.name(),
             a.error.records,
             if f.failed > 0 {
-                format!(", {} more that yosys failed on", f.failed)
+                format!(
+                    "; yosys failed on {} more, tried again by the next run",
+                    f.failed
+                )
             } else {
                 String::new()
             },

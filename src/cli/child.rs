@@ -1,18 +1,36 @@
 //! External tools (yosys, nextpnr, gappa, the simulators) run as children that end with the
 //! command: each in its own process group, killed by the interrupt handler on Ctrl-C or
 //! SIGTERM and by the kernel when specfx itself dies (even by SIGKILL); their work
-//! directories are removed then too, or by the next run when specfx was killed.
+//! directories are removed then too, or by the next run when specfx was killed. Each child
+//! gets a private temporary directory (`TMPDIR`, `TMP` and `TEMP`: a C++ compiler's `cc*.s`,
+//! yosys's `yosys-abc-*`) inside the work directory it runs in, or a work directory of its
+//! own, removed when the child ends and with the work directories otherwise.
 
 use std::io;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Mutex;
 
+/// Set by [`end_all`]: specfx is ending on an interrupt, and no caller may go on with a
+/// killed child's result (an error of its own would race the interrupt's exit code 130).
+static ENDING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Once specfx is ending on an interrupt: waits for the interrupt handler's exit.
+fn stop_if_ending() {
+    while ENDING.load(std::sync::atomic::Ordering::SeqCst) {
+        std::thread::park();
+    }
+}
+
 /// Process groups of running children (each child leads its own group).
 static GROUPS: Mutex<Vec<i32>> = Mutex::new(Vec::new());
 
 /// Work directories of this process, removed on interrupt.
 static WORK_DIRS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// The private temporary directory of each running child, by its pid: removed when the child
+/// is waited for.
+static CHILD_TMP: Mutex<Vec<(i32, PathBuf)>> = Mutex::new(Vec::new());
 
 /// The prefix of every work directory: `specfx-<tag>-<pid>-`, so a later run can tell the
 /// ones of dead processes.
@@ -48,15 +66,58 @@ pub fn output(cmd: &mut Command) -> io::Result<Output> {
     wait(spawn(cmd)?)
 }
 
-/// Spawns `cmd` (its stdio as set by the caller) as a child that ends with specfx; finish it
-/// with [`wait`].
+/// Spawns `cmd` (its stdio as set by the caller) as a child that ends with specfx, with a
+/// private temporary directory; finish it with [`wait`].
 pub fn spawn(cmd: &mut Command) -> io::Result<std::process::Child> {
+    stop_if_ending();
     prepare(cmd);
-    let child = cmd.spawn()?;
+    let tmp = private_tmp(cmd)?;
+    for var in ["TMPDIR", "TMP", "TEMP"] {
+        cmd.env(var, &tmp);
+    }
+    let child = match cmd.spawn() {
+        Ok(c) => c,
+        Err(e) => {
+            remove_tmp(&tmp);
+            return Err(e);
+        }
+    };
+    let pid = child.id() as i32;
     if let Ok(mut g) = GROUPS.lock() {
-        g.push(child.id() as i32);
+        g.push(pid);
+    }
+    if let Ok(mut t) = CHILD_TMP.lock() {
+        t.push((pid, tmp));
     }
     Ok(child)
+}
+
+/// A new temporary directory for a child of `cmd` (absolute, as every work directory, so that
+/// the child's own working directory does not move it): inside the work directory the child
+/// runs in when that is one of [`work_dir`]'s (removed with it), else a work directory of its
+/// own (`specfx-tmp-<pid>-XXXXXX`), which the interrupt handler and the next run's clean-up
+/// know as any other.
+fn private_tmp(cmd: &Command) -> io::Result<PathBuf> {
+    let work = cmd.get_current_dir().and_then(|cwd| {
+        let cwd = std::path::absolute(cwd).ok()?;
+        let dirs = WORK_DIRS.lock().ok()?;
+        dirs.iter()
+            .find(|w| std::path::absolute(w).is_ok_and(|w| cwd.starts_with(w)))
+            .cloned()
+    });
+    match work {
+        Some(work) => Ok(tempfile::Builder::new()
+            .prefix("tmp-")
+            .tempdir_in(work)?
+            .keep()),
+        None => Ok(work_dir("tmp")?.keep_registered()),
+    }
+}
+
+/// Removes a child's private temporary directory (and forgets it as a work directory).
+fn remove_tmp(dir: &Path) {
+    let _ = std::fs::remove_dir_all(dir);
+    forget(dir);
 }
 
 /// Waits for a child of [`spawn`] (or [`output`]) and collects its output.
@@ -68,8 +129,16 @@ pub fn wait(child: std::process::Child) -> io::Result<Output> {
         }
     }
     let out = child.wait_with_output();
+    stop_if_ending();
     if let Ok(mut g) = GROUPS.lock() {
         g.retain(|&p| p != pid);
+    }
+    let tmp = CHILD_TMP.lock().ok().and_then(|mut t| {
+        let i = t.iter().position(|(p, _)| *p == pid)?;
+        Some(t.swap_remove(i).1)
+    });
+    if let Some(tmp) = tmp {
+        remove_tmp(&tmp);
     }
     out
 }
@@ -78,7 +147,8 @@ pub fn wait(child: std::process::Child) -> io::Result<Output> {
 /// interrupt, or (when specfx was killed) by the next call. The directories of processes that
 /// no longer run are removed first.
 pub fn work_dir(tag: &str) -> io::Result<WorkDir> {
-    let tmp = std::env::temp_dir();
+    // Absolute: a child runs in it, and may be given paths inside it.
+    let tmp = std::path::absolute(std::env::temp_dir())?;
     remove_stale(&tmp);
     let dir = tempfile::Builder::new()
         .prefix(&format!("{PREFIX}{tag}-{}-", std::process::id()))
@@ -103,6 +173,13 @@ impl WorkDir {
         let dir = self.0.take().expect("a live work directory");
         forget(dir.path());
         dir.keep()
+    }
+
+    /// Hands the directory's removal over: it stays registered, so the interrupt handler (and
+    /// the next run, when specfx was killed) still removes it, but dropping the returned path
+    /// does not.
+    fn keep_registered(mut self) -> PathBuf {
+        self.0.take().expect("a live work directory").keep()
     }
 }
 
@@ -151,12 +228,18 @@ fn remove_stale(tmp: &Path) {
 /// Ends every running child's process group and removes every work directory: called by the
 /// interrupt handler before specfx exits.
 pub fn end_all() {
+    ENDING.store(true, std::sync::atomic::Ordering::SeqCst);
     if let Ok(groups) = GROUPS.lock() {
         for &pgid in groups.iter() {
             // SAFETY: killpg only sends a signal.
             unsafe {
                 libc::killpg(pgid, libc::SIGKILL);
             }
+        }
+    }
+    if let Ok(dirs) = CHILD_TMP.lock() {
+        for (_, d) in dirs.iter() {
+            let _ = std::fs::remove_dir_all(d);
         }
     }
     if let Ok(dirs) = WORK_DIRS.lock() {

@@ -39,11 +39,12 @@ pub struct CostArgs {
     analytic_only: bool,
     /// Also place and route on an iCE40 device with nextpnr (target ice40): Fmax, critical
     /// path, latency and throughput at Fmax (`specfx timing` for the details).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "analytic_only")]
     timing: bool,
-    /// The iCE40 device whose resources the figures are checked against: up5k or hx8k.
-    #[arg(long, default_value = "up5k")]
-    device: specfx::hdl::pnr::Device,
+    /// The iCE40 device whose resources the figures are checked against (target ice40): up5k
+    /// or hx8k [default: up5k].
+    #[arg(long)]
+    device: Option<specfx::hdl::pnr::Device>,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
@@ -88,11 +89,76 @@ pub struct CostReport {
     pub timing: Option<specfx::hdl::pnr::Timing>,
 }
 
-/// The reference Verilog directory.
+/// The reference Verilog directory: `arg` (`--hdl-ref`), else `$SPECFX_HDL_REF` (unless empty),
+/// else the source tree's `hdl_ref/`.
 pub fn hdl_ref_dir(arg: Option<&Path>) -> PathBuf {
-    arg.map(Path::to_path_buf)
-        .or_else(|| std::env::var_os("SPECFX_HDL_REF").map(PathBuf::from))
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("hdl_ref"))
+    hdl_ref_source(arg).0
+}
+
+/// [`hdl_ref_dir`] and how it was chosen, as errors name it (`--hdl-ref DIR`,
+/// `SPECFX_HDL_REF=DIR`, or the built-in directory).
+fn hdl_ref_source(arg: Option<&Path>) -> (PathBuf, String) {
+    let shown = |p: &Path| super::error_text(&p.display().to_string());
+    if let Some(p) = arg {
+        return (p.to_path_buf(), format!("--hdl-ref {}", shown(p)));
+    }
+    match std::env::var_os("SPECFX_HDL_REF").filter(|v| !v.is_empty()) {
+        Some(v) => {
+            let p = PathBuf::from(v);
+            let name = format!("SPECFX_HDL_REF={}", shown(&p));
+            (p, name)
+        }
+        None => {
+            let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("hdl_ref");
+            let name = format!(
+                "the reference Verilog {} (pass --hdl-ref or set SPECFX_HDL_REF)",
+                shown(&p)
+            );
+            (p, name)
+        }
+    }
+}
+
+/// The reference Verilog directory of [`hdl_ref_dir`], checked before any work: a directory
+/// holding `rtl/*.v` and `specfx_dut.v`, what yosys is given.
+pub fn hdl_ref(arg: Option<&Path>) -> Result<PathBuf> {
+    let (dir, name) = hdl_ref_source(arg);
+    let expected = "expected the reference Verilog directory (rtl/*.v and specfx_dut.v)";
+    match std::fs::metadata(&dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            bail!("{name}: {expected}, got no such directory")
+        }
+        Err(e) => bail!("{name}: {expected}, but it cannot be read: {}", e.kind()),
+        Ok(m) if !m.is_dir() => bail!("{name}: {expected}, got a file"),
+        Ok(_) => {}
+    }
+    let has_rtl = std::fs::read_dir(dir.join("rtl")).is_ok_and(|entries| {
+        entries
+            .flatten()
+            .any(|e| e.path().extension().is_some_and(|x| x == "v") && e.path().is_file())
+    });
+    if !has_rtl {
+        bail!("{name}: {expected}, but it has no rtl/*.v");
+    }
+    if !dir.join("specfx_dut.v").is_file() {
+        bail!("{name}: {expected}, but it has no specfx_dut.v");
+    }
+    Ok(dir)
+}
+
+/// Checks before any work that yosys runs; returns `yosys -V`.
+pub fn check_yosys() -> Result<String> {
+    let out =
+        super::child::output(Command::new("yosys").arg("-V")).map_err(|e| match e.kind() {
+            std::io::ErrorKind::NotFound => {
+                anyhow::anyhow!("yosys not found: install it (Debian: apt-get install yosys)")
+            }
+            _ => anyhow::Error::new(e).context("cannot run yosys"),
+        })?;
+    if !out.status.success() {
+        bail!("yosys -V failed: {}", out.status);
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).trim().to_string())
 }
 
 /// The Verilog sources of the DUT: every `rtl/*.v`, sorted, then `specfx_dut.v`.
@@ -140,9 +206,7 @@ fn yosys_in(
     top: &str,
     target: Target,
 ) -> Result<(YosysCost, String, String)> {
-    let version = super::child::output(Command::new("yosys").arg("-V"))
-        .context("yosys not found: install it (Debian: apt-get install yosys)")?;
-    let version = String::from_utf8_lossy(&version.stdout).trim().to_string();
+    let version = check_yosys()?;
     let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
     let script = yosys_script(target, &files, &work.display().to_string(), top);
     std::fs::write(work.join("cost.ys"), &script)?;
@@ -331,22 +395,45 @@ pub fn write_cost(
 
 /// Runs `specfx cost`.
 pub fn run(args: &CostArgs) -> Result<Outcome> {
+    // Everything that can be refused is refused before yosys spends seconds on synthesis:
+    // the options that go together, the configuration, the reference Verilog and the tools.
+    if args.target != Target::Ice40 {
+        if args.timing {
+            bail!(
+                "--timing: place and route is available for --target ice40 only (nextpnr-ice40), got --target {}",
+                args.target.name()
+            );
+        }
+        if let Some(d) = args.device {
+            bail!(
+                "--device {d}: the device check is for --target ice40 only, got --target {}",
+                args.target.name()
+            );
+        }
+    }
+    let device = args.device.unwrap_or(specfx::hdl::pnr::Device::Up5k);
     let dp = super::datapath::load(&args.config, None)?;
-    let dir = hdl_ref_dir(args.hdl_ref.as_deref());
+    let dir = if args.analytic_only {
+        hdl_ref_dir(args.hdl_ref.as_deref())
+    } else {
+        let dir = hdl_ref(args.hdl_ref.as_deref())?;
+        check_yosys()?;
+        if args.timing {
+            super::pnr::check_nextpnr()?;
+        }
+        dir
+    };
     let mut r = cost_report(&dp, args.arch, args.target, &dir, args.analytic_only)?;
     if args.target == Target::Ice40 {
         let (dsps, luts, ffs) = match &r.yosys {
             Some(y) => (y.dsps, y.luts, y.ffs),
             None => (r.analytic.dsps, r.analytic.luts, r.analytic.ffs),
         };
-        r.device = Some(args.device);
-        r.over_limit = specfx::hdl::pnr::device_check(dsps, luts, ffs, args.device);
+        r.device = Some(device);
+        r.over_limit = specfx::hdl::pnr::device_check(dsps, luts, ffs, device);
     }
     if args.timing {
-        if args.target != Target::Ice40 {
-            bail!("--timing: place and route is available for --target ice40 only (nextpnr-ice40)");
-        }
-        r.timing = Some(super::pnr::run_timing(&dp, args.arch, args.device, &dir)?);
+        r.timing = Some(super::pnr::run_timing(&dp, args.arch, device, &dir)?);
     }
     if args.json {
         print_json(&r)?;

@@ -7,7 +7,7 @@ use std::process::Command;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 
-use super::cost::{hdl_ref_dir, rtl_files};
+use super::cost::{hdl_ref, rtl_files};
 use super::output::{print_json, print_with};
 use super::Outcome;
 use specfx::cycle::Arch;
@@ -51,6 +51,11 @@ fn run_tool(tool: &str, args: &[String], dir: &Path) -> Result<std::process::Out
             _ => anyhow::Error::new(e).context(format!("cannot run {tool}")),
         }
     })
+}
+
+/// Checks before any work that nextpnr-ice40 runs.
+pub fn check_nextpnr() -> Result<()> {
+    run_tool("nextpnr-ice40", &["--version".into()], Path::new(".")).map(|_| ())
 }
 
 /// The first line of a tool's complaint that says something.
@@ -215,7 +220,8 @@ pub fn write_timing(
 /// Runs `specfx timing`.
 pub fn run(args: &TimingArgs) -> Result<Outcome> {
     let dp = super::datapath::load(&args.config, None)?;
-    let dir = hdl_ref_dir(args.hdl_ref.as_deref());
+    let dir = hdl_ref(args.hdl_ref.as_deref())?;
+    super::cost::check_yosys()?;
     let t = run_timing(&dp, args.arch, args.device, &dir)?;
     if args.json {
         print_json(&t)?;

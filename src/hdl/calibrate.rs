@@ -14,7 +14,8 @@ use crate::nset::NSet;
 use crate::pipeline::{Config, Datapath, StageSpec, Variant};
 use crate::reference::lobe::Cutoff;
 
-/// One synthesised configuration: what was built and what yosys counted.
+/// One synthesised configuration: what was built and what yosys counted. A configuration
+/// yosys failed on is not a record: it is never stored, and a later run tries it again.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Record {
     /// Index in the seeded sample.
@@ -31,10 +32,6 @@ pub struct Record {
     pub dsps: u64,
     /// yosys flip-flops.
     pub ffs: u64,
-    /// yosys's first error line when it failed on this configuration (then the counts are 0
-    /// and the record is left out of the fit).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub failed: Option<String>,
 }
 
 fn format(signed: bool, int: i32, frac: i32) -> Format {
@@ -231,11 +228,19 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[i]
 }
 
-/// Fits a target's coefficients to its records and measures the fit on the same records.
+/// Fits a target's coefficients to its records and measures the fit on the same records; a
+/// fit over no record is an error.
 pub fn fit(records: &[Record], target: Target) -> Result<(Coefficients, FitError), Error> {
+    if records.is_empty() {
+        return Err(Error::Config {
+            key: format!("calibration of {}", target.name()),
+            problem: "no records to fit: a fit needs at least one configuration yosys synthesised"
+                .to_string(),
+        });
+    }
     let mut rows = Vec::with_capacity(records.len());
     let mut regs = (0.0, 0.0);
-    for r in records.iter().filter(|r| r.failed.is_none()) {
+    for r in records {
         let dp = Datapath::new(r.config.clone()).map_err(|e| Error::Config {
             key: format!("calibration record {}", r.index),
             problem: e.to_string(),
@@ -286,18 +291,41 @@ fn measure(rows: &[(Features, &Record)], c: &Coefficients) -> FitError {
     }
 }
 
-/// Reads a JSON Lines file of records (`path` names it in errors).
+/// What an earlier specfx stored for a configuration yosys failed on: a line with a `failed`
+/// key (not a record: left out, so that the configuration is synthesised again).
+#[derive(Deserialize)]
+struct StoredFailure {
+    #[serde(default)]
+    failed: Option<serde::de::IgnoredAny>,
+}
+
+/// Reads a JSON Lines file of records (`path` names it in errors). Left out: the failures an
+/// earlier specfx stored (a line with a `failed` key), and a last line cut short without its
+/// newline (a write that was interrupted); both are synthesised again by the next run.
 pub fn read_records(text: &str, path: &str) -> Result<Vec<Record>, Error> {
-    text.lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(i, l)| {
-            serde_json::from_str(l).map_err(|e| Error::Config {
-                key: format!("{path}: line {}", i + 1),
-                problem: format!("not a calibration record: {e}"),
-            })
-        })
-        .collect()
+    let lines: Vec<&str> = text.lines().collect();
+    let mut records = Vec::with_capacity(lines.len());
+    for (i, l) in lines.iter().enumerate() {
+        let stored_failure =
+            || serde_json::from_str::<StoredFailure>(l).is_ok_and(|f| f.failed.is_some());
+        if l.trim().is_empty() || stored_failure() {
+            continue;
+        }
+        match serde_json::from_str::<Record>(l) {
+            Ok(r) => records.push(r),
+            Err(e)
+                if i + 1 == lines.len()
+                    && !text.ends_with('\n')
+                    && e.classify() == serde_json::error::Category::Eof => {}
+            Err(e) => {
+                return Err(Error::Config {
+                    key: format!("{path}: line {}", i + 1),
+                    problem: format!("not a calibration record: {e}"),
+                })
+            }
+        }
+    }
+    Ok(records)
 }
 
 #[cfg(test)]
@@ -313,6 +341,38 @@ mod tests {
             assert!(Datapath::new(a).is_ok());
         }
         assert_ne!(sample(7, 1).0, sample(7, 2).0);
+    }
+
+    #[test]
+    fn stored_failures_and_a_torn_last_line_are_not_records() {
+        let (config, arch) = sample(1, 0);
+        let record = Record {
+            index: 0,
+            arch,
+            config,
+            luts: 10,
+            carries: 2,
+            dsps: 1,
+            ffs: 5,
+        };
+        let line = serde_json::to_string(&record).unwrap();
+        let failed = r#"{"index":1,"arch":"pipelined","config":{"name":"x"},"luts":0,"carries":0,"dsps":0,"ffs":0,"failed":"yosys not found"}"#;
+        let torn = &line[..line.len() / 2];
+        let text = format!("{line}\n{failed}\n{torn}");
+        assert_eq!(
+            read_records(&text, "f").unwrap(),
+            std::slice::from_ref(&record)
+        );
+        // A torn line followed by a newline, or anywhere but last, is an error that names it.
+        for bad in [format!("{torn}\n"), format!("{torn}\n{line}\n")] {
+            let e = read_records(&bad, "f").unwrap_err().to_string();
+            assert!(e.starts_with("f: line 1: not a calibration record"), "{e}");
+        }
+        assert!(fit(&[], Target::Ice40)
+            .unwrap_err()
+            .to_string()
+            .contains("no records to fit"));
+        assert_eq!(fit(&[record], Target::Ice40).unwrap().1.records, 1);
     }
 
     #[test]
