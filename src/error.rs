@@ -171,13 +171,15 @@ pub enum FixedError {
         /// The text that was given.
         got: String,
     },
-    /// The total width (int bits + frac bits) is outside `1..=64`.
-    #[error("width (int bits + frac bits) of {notation} must be in 1..=64, got {got}")]
+    /// The total width (int bits + frac bits) is outside `1..=64` (`1..=63` when unsigned).
+    #[error("width (int bits + frac bits) of {notation} must be in 1..={max}, got {got}")]
     Width {
         /// The format as it was given, in the usual notation.
         notation: String,
         /// The total width that was given.
         got: i64,
+        /// The widest format of that signedness: 64 signed, 63 unsigned.
+        max: i64,
     },
     /// An unsigned format is 64 bits wide: its largest raw value would not fit in `i64`.
     #[error("width (int bits + frac bits) of unsigned {notation} must be at most 63 so that raws fit in i64, got {got}")]

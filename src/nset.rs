@@ -94,10 +94,15 @@ impl NSet {
 fn parse_n(s: &str, whole: &str) -> Result<u32, Error> {
     let out_of_range = || Error::OutOfRange {
         what: "an exponent n",
-        expected: format!("a whole number in 1..={N_MAX} (in n set '{whole}')"),
+        expected: format!("a whole number in 1..={N_MAX}, digits only (in n set '{whole}')"),
         got: format!("'{s}'"),
     };
-    let n: u32 = s.trim().parse().map_err(|_| out_of_range())?;
+    // Digits only: `u32::from_str` would also take a leading `+`.
+    let digits = s.trim();
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(out_of_range());
+    }
+    let n: u32 = digits.parse().map_err(|_| out_of_range())?;
     if (1..=N_MAX).contains(&n) {
         Ok(n)
     } else {
@@ -178,7 +183,7 @@ mod tests {
         let e = "16..x".parse::<NSet>().unwrap_err().to_string();
         assert_eq!(
             e,
-            "an exponent n must be a whole number in 1..=65535 (in n set '16..x'), got 'x'"
+            "an exponent n must be a whole number in 1..=65535, digits only (in n set '16..x'), got 'x'"
         );
         assert!("0".parse::<NSet>().is_err());
         assert!("".parse::<NSet>().is_err());
@@ -187,11 +192,21 @@ mod tests {
     }
 
     #[test]
+    fn digits_only_and_spaces_around_whole_operators() {
+        // docs/arithmetic.md, section 4.3: no sign; spaces around an item or an operator.
+        for bad in ["+5", "1..=+3", "16.. =20", "16. .20", "- 5", "5 6", "0x10"] {
+            assert!(bad.parse::<NSet>().is_err(), "{bad}");
+        }
+        let spaced: NSet = " 16 ..= 18 , 20 .. 21 ".parse().unwrap();
+        assert_eq!(spaced.values(), &[16, 17, 18, 20, 21]);
+    }
+
+    #[test]
     fn user_text_in_errors_stays_on_one_line() {
         let e = "16..17\n,x\r".parse::<NSet>().unwrap_err().to_string();
         assert_eq!(
             e,
-            r"an exponent n must be a whole number in 1..=65535 (in n set '16..17\n,x\r'), got 'x'"
+            r"an exponent n must be a whole number in 1..=65535, digits only (in n set '16..17\n,x\r'), got 'x'"
         );
     }
 

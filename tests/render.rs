@@ -365,7 +365,7 @@ mod meshes {
     fn bad_meshes_get_clear_errors() {
         let nan = obj("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").unwrap_err();
         assert!(
-            nan.contains("line 2: expected `v x y z` (three finite numbers"),
+            nan.contains("line 2: expected `v x y z` (three numbers within the 32-bit float range"),
             "{nan}"
         );
         let range = obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap_err();

@@ -481,7 +481,12 @@ const CASES: &[Case] = &[
     Case {
         args: &["hdl", "stimulus", "--vectors", "{dir}", "--out", "{dir}/s"],
         inputs: &[],
-        expect: "manifest.json",
+        expect: "/s: is inside the input --vectors directory",
+    },
+    Case {
+        args: &["hdl", "stimulus", "--vectors", "{dir}/v", "--out", "{dir}/s"],
+        inputs: &[Input::File("v/readme.txt", "not vectors")],
+        expect: "/v: no manifest.json",
     },
     Case {
         args: &["trace", "compare", "{dir}/a.vcd", "{dir}/b.vcd"],
@@ -753,6 +758,76 @@ const CASES: &[Case] = &[
         args: &["man", "--out", "/proc/man"],
         inputs: &[],
         expect: "--out /proc/man: cannot write into /proc",
+    },
+    // Issue 25: messages that named the wrong thing or took the wrong rule.
+    Case {
+        args: &["check", "--config", "{dir}/x.json"],
+        inputs: &[Input::File("x.json", "not json")],
+        expect: "config {dir}/x.json: a JSON file, expected a TOML configuration",
+    },
+    Case {
+        args: &["hdl", "stimulus", "--vectors", "{dir}/nosuch", "--out", "{dir}/st"],
+        inputs: &[],
+        expect: "{dir}/nosuch: no such file or directory, expected a vector directory",
+    },
+    Case {
+        args: &["hdl", "stimulus", "--vectors", "{dir}/loop", "--out", "{dir}/st"],
+        inputs: &[Input::Symlink("loop", "loop")],
+        expect: "{dir}/loop: Too many levels of symbolic links",
+    },
+    Case {
+        args: &["hdl", "params", "--vectors", "{dir}/vectors.csv"],
+        inputs: &[Input::File("vectors.csv", "n,in_c\n16,0\n")],
+        expect: "{dir}/vectors.csv: not a directory, expected a vector directory",
+    },
+    Case {
+        args: &[],
+        inputs: &[],
+        expect: "'specfx' needs a subcommand, expected one of: report, paper, check,",
+    },
+    Case {
+        args: &["hdl"],
+        inputs: &[],
+        expect: "'specfx hdl' needs a subcommand, expected one of: params, rom, stimulus",
+    },
+    Case {
+        args: &["--quiet", "trace"],
+        inputs: &[],
+        expect: "'specfx trace' needs a subcommand, expected one of: compare",
+    },
+    Case {
+        args: &["hdl", "params", "--format", "iverilog", "--top", "a b;"],
+        inputs: &[],
+        expect: "expected a Verilog module name (a letter or '_', then letters, digits, '_' or '$'), got 'a b;'",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[c]\nformat = \"u40.40\"\n")],
+        expect: "width (int bits + frac bits) of u40.40 must be in 1..=63, got 80",
+    },
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File("c.toml", "[c]\nformat = \"u0.0\"\n")],
+        expect: "width (int bits + frac bits) of u0.0 must be in 1..=63, got 0",
+    },
+    // c - 1 of s64.0 reaches -2^63 - 1, which no 64-bit format holds; printed exactly.
+    Case {
+        args: &["check", "--config", "{dir}/c.toml"],
+        inputs: &[Input::File(
+            "c.toml",
+            "[c]\nformat = \"s64.0\"\n[d]\nformat = \"s64.0\"\n",
+        )],
+        expect: "range down to -9223372036854775809), got s64.0",
+    },
+    Case {
+        args: &["check", "--n", "+5"],
+        inputs: &[],
+        expect: "an exponent n must be a whole number in 1..=65535, digits only (in n set '+5'), got '+5'",
+    },
+    Case {
+        args: &["check", "--n", "16.. =20"],
+        inputs: &[],
+        expect: "digits only (in n set '16.. =20'), got ' =20'",
     },
     Case {
         args: &["hdl", "stimulus", "--vectors", "{dir}", "--out", "/proc/st"],
@@ -1139,5 +1214,176 @@ fn a_full_disk_leaves_no_partial_pages_or_stimulus() {
     let o = common::specfx(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(files_in(&stim).len(), 4);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// No command writes into the vector directory it reads, even with --force: `hdl stimulus`'s
+/// --out (the directory itself, a path through `..`, a symbolic link to it) and its --vcd,
+/// and `cosim`'s --vcd directory.
+#[test]
+fn the_input_vector_directory_is_never_written_into() {
+    let dir = fresh_dir("into");
+    let o = specfx_in(
+        &dir,
+        &["vectors", "--n", "16", "--cases", "random:10", "--out", "v"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::os::unix::fs::symlink("v", dir.join("link")).unwrap();
+    let before = common::snapshot(&dir.join("v"));
+    for (flag, out) in [
+        ("--out", "v"),
+        ("--out", "v/x/.."),
+        ("--out", "link"),
+        ("--out", "v/sub"),
+        ("--vcd", "v/model.vcd"),
+        ("--vcd", "link/model.vcd"),
+    ] {
+        let mut args = vec!["hdl", "stimulus", "--vectors", "v", "--force"];
+        if flag == "--vcd" {
+            args.extend(["--out", "st", "--vcd", out]);
+        } else {
+            args.extend(["--out", out]);
+        }
+        let o = specfx_in(&dir, &args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.contains(&format!(
+                "{flag} {out}: is inside the input --vectors directory v"
+            )),
+            "{err}"
+        );
+        assert_eq!(common::snapshot(&dir.join("v")), before, "{args:?}");
+        assert!(!dir.join("st").exists());
+    }
+    // cosim's trace directory, refused before any simulation.
+    for vcd in ["v", "link", "v/traces"] {
+        let args = ["cosim", "--vectors", "v", "--vcd", vcd, "--force"];
+        let o = specfx_in(&dir, &args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.contains(&format!(
+                "--vcd {vcd}: is inside the input --vectors directory v"
+            )),
+            "{err}"
+        );
+        assert_eq!(common::snapshot(&dir.join("v")), before, "{args:?}");
+    }
+    // Beside it, as before.
+    let o = specfx_in(&dir, &["hdl", "stimulus", "--vectors", "v", "--out", "st"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A symbolic link named like a staging directory (`.o.partial-<dead pid>`, `.o.old-<dead
+/// pid>`) pointing to a user's directory, even one holding a marker, is neither taken over,
+/// put back in place of the result, nor emptied.
+#[test]
+fn links_named_like_staging_directories_are_left_alone() {
+    let dir = fresh_dir("links");
+    let users = dir.join("users");
+    std::fs::create_dir(&users).unwrap();
+    std::fs::write(users.join(".specfx-result"), "budget\n").unwrap();
+    std::fs::write(users.join("notes.txt"), "mine").unwrap();
+    for tag in ["partial", "old"] {
+        std::os::unix::fs::symlink("users", dir.join(format!(".o.{tag}-999999999"))).unwrap();
+    }
+    let o = specfx_in(
+        &dir,
+        &["budget", "--no-gappa", "--n", "16..=20", "--out", "o"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let meta = std::fs::symlink_metadata(dir.join("o")).unwrap();
+    assert!(meta.is_dir() && !meta.is_symlink());
+    assert!(dir.join("o/budget.json").is_file());
+    let mut kept: Vec<String> = std::fs::read_dir(&users)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    kept.sort();
+    assert_eq!(kept, [".specfx-result", "notes.txt"]);
+    for tag in ["partial", "old"] {
+        let link = dir.join(format!(".o.{tag}-999999999"));
+        assert!(std::fs::symlink_metadata(link).unwrap().is_symlink());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An existing result that cannot be moved aside (immutable) is refused before the work, with
+/// one line, the earlier result unchanged. Needs root for chattr, as CI runs.
+#[test]
+fn an_immutable_result_is_refused_before_the_work() {
+    let dir = fresh_dir("immutable");
+    let args = ["budget", "--no-gappa", "--n", "16..=20", "--out", "o"];
+    assert!(specfx_in(&dir, &args).status.success());
+    let before = common::snapshot(&dir.join("o"));
+    let chattr = |flag: &str| {
+        Command::new("chattr")
+            .args([flag, dir.join("o").to_str().unwrap()])
+            .status()
+            .is_ok_and(|s| s.success())
+    };
+    if !chattr("+i") {
+        assert!(
+            !euid_is_root(),
+            "chattr +i failed as root: this test needs a filesystem with attributes"
+        );
+        eprintln!("skipped: chattr +i needs root");
+        std::fs::remove_dir_all(&dir).unwrap();
+        return;
+    }
+    let o = specfx_in(&dir, &args);
+    assert!(chattr("-i"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--out o: cannot be replaced (moving it aside failed)"),
+        "{err}"
+    );
+    assert!(staging(&dir).is_empty(), "{:?}", staging(&dir));
+    assert_eq!(common::snapshot(&dir.join("o")), before);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Whether this process runs as root (`id -u` is 0).
+fn euid_is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+}
+
+/// A summary that cannot reach a full stdout after the result directory was committed: one
+/// error line that says the result is complete, and it is.
+#[test]
+fn a_full_stdout_after_the_result_says_the_result_is_complete() {
+    let dir = fresh_dir("fullout");
+    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args([
+            "--quiet",
+            "budget",
+            "--no-gappa",
+            "--n",
+            "16..=20",
+            "--json",
+            "--out",
+            "o",
+        ])
+        .current_dir(&dir)
+        .stdout(std::fs::File::create("/dev/full").unwrap())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("cannot write to stdout") && err.contains("(the result in o is complete)"),
+        "{err}"
+    );
+    assert!(dir.join("o/budget.json").is_file());
     std::fs::remove_dir_all(&dir).unwrap();
 }

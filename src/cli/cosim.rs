@@ -125,6 +125,10 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     if args.lint && !Simulator::Verilator.installed() {
         bail!("--lint: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator)");
     }
+    if let (Some(vcd), Some(v)) = (&args.vcd, &args.vectors) {
+        let vector_dir = super::vectordir::dir_of(v);
+        super::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
+    }
     if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
         super::output::check_can_create(dir, "--vcd")?;
     } else if let Some(dir) = &args.vcd {
@@ -183,10 +187,12 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             dir
         }
     };
-    let dp = super::datapath::load(&vectors.to_string_lossy(), None)?;
+    let opened = super::vectordir::open(&vectors)?;
+    let dp = specfx::pipeline::Datapath::new(opened.config.clone())
+        .context("the manifest's configuration")?;
     // The --vcd directory is made with the model's trace, once the stimulus is known to fit.
     let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
-    let stim = write_stimulus(&vectors, args.run, wd, model_vcd.as_deref())?;
+    let stim = write_stimulus(&opened, args.run, wd, model_vcd.as_deref())?;
     for port in [
         "in_c",
         "in_n",

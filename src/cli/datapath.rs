@@ -17,8 +17,11 @@ pub fn load(arg: &str, n: Option<&NSet>) -> Result<Datapath> {
     let path = Path::new(arg);
     let mut config = match Config::builtin(arg) {
         Some(c) => c,
-        None if path.is_dir() || path.extension().is_some_and(|e| e == "json") => {
+        None if path.is_dir() || path.file_name().is_some_and(|f| f == "manifest.json") => {
             super::vectordir::open(path)?.config
+        }
+        None if path.extension().is_some_and(|e| e == "json") => {
+            bail!("config {arg}: a JSON file, expected a TOML configuration, a built-in name (baseline) or a vector directory (or its manifest.json)")
         }
         None => {
             // A dangling symbolic link exists as a link: read_text names it.
@@ -42,6 +45,13 @@ pub fn load(arg: &str, n: Option<&NSet>) -> Result<Datapath> {
         config.n = n.clone();
     }
     Datapath::new(config).with_context(|| format!("config {arg}"))
+}
+
+/// The datapath of a `--vectors` argument: a verified vector directory (or its
+/// `manifest.json`), nothing else.
+pub fn load_vectors(path: &Path) -> Result<Datapath> {
+    let config = super::vectordir::open(path)?.config;
+    Datapath::new(config).with_context(|| format!("--vectors {}", path.display()))
 }
 
 /// Parses a set of numbers of squarings (`--k`): the n-set notation (`4`, `3..=5`, `1,4,7`)

@@ -53,7 +53,7 @@ struct ParamsArgs {
     #[arg(long, default_value = "define")]
     format: ParamsFormat,
     /// The module whose parameters the iverilog `-P` flags set.
-    #[arg(long, default_value = "specfx_top")]
+    #[arg(long, default_value = "specfx_top", value_parser = verilog_identifier)]
     top: String,
     /// Clear the data registers on reset too (`RESET_DATA = 1`), so out_data is 0 until the
     /// first result.
@@ -169,7 +169,7 @@ fn print_or_write(out: Output, text: &str) -> Result<Outcome> {
 
 fn params(args: &ParamsArgs) -> Result<Outcome> {
     let dp = match &args.vectors {
-        Some(dir) => super::datapath::load(&dir.to_string_lossy(), None)?,
+        Some(dir) => super::datapath::load_vectors(dir)?,
         None => super::datapath::load(&args.config, None)?,
     };
     let text = render_parameters(&dp, args.arch, args.reset_data, args.format, &args.top);
@@ -197,6 +197,24 @@ fn bits_file(bits: &[bool]) -> String {
         .collect()
 }
 
+/// A Verilog identifier (`--top`): a letter or `_`, then letters, digits, `_` or `$`, at most
+/// 1024 characters; anything else would go into the simulator's flags as more than a name.
+fn verilog_identifier(s: &str) -> std::result::Result<String, String> {
+    let mut chars = s.chars();
+    let first_ok = chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
+    let rest_ok = chars.all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '$');
+    if first_ok && rest_ok && s.len() <= 1024 {
+        Ok(s.to_string())
+    } else {
+        Err(format!(
+            "expected a Verilog module name (a letter or '_', then letters, digits, '_' or '$'), got '{}'",
+            s.escape_debug()
+        ))
+    }
+}
+
 /// The longest stimulus `specfx hdl stimulus` writes, in cycles (a line of each of its bit
 /// files per cycle).
 pub const MAX_STIMULUS_CYCLES: u64 = 1 << 26;
@@ -211,12 +229,12 @@ pub struct StimulusInfo {
     pub latency: (u64, u64),
 }
 
-/// Writes the co-simulation stimulus of a vector directory into `out`: `stim_valid.hex`,
-/// `stim_ready.hex`, `expected_cycle.hex` and `stim.json`, from the cycle model run on the
-/// vectors in file order under seeded bubbles and stalls; with `vcd`, also the model's trace
-/// of that run (every cycle until the last output transfers) to that file.
+/// Writes the co-simulation stimulus of an opened vector directory into `out`:
+/// `stim_valid.hex`, `stim_ready.hex`, `expected_cycle.hex` and `stim.json`, from the cycle
+/// model run on the vectors in file order under seeded bubbles and stalls; with `vcd`, also
+/// the model's trace of that run (every cycle until the last output transfers) to that file.
 pub fn write_stimulus(
-    dir: &Path,
+    vectors: &super::vectordir::VectorDir,
     run: RunOpts,
     out: &Path,
     vcd: Option<&Path>,
@@ -227,9 +245,8 @@ pub fn write_stimulus(
         bubble,
         stall,
     } = run;
-    let vectors = super::vectordir::open(dir)?;
-    let dp =
-        specfx::pipeline::Datapath::new(vectors.config).context("the manifest's configuration")?;
+    let dp = specfx::pipeline::Datapath::new(vectors.config.clone())
+        .context("the manifest's configuration")?;
     let ns = dp.config().n.values();
     // open() checked that every n is in the manifest's n set.
     let items: Vec<(usize, i64)> = vectors
@@ -351,9 +368,14 @@ const STIMULUS_FILES: [&str; 4] = [
 ];
 
 fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
-    // The stimulus may go into the vector directory itself, beside (never over) its files;
-    // an earlier stimulus there (its stim.json) is replaced, other files of the same names
-    // only with --force.
+    // The stimulus goes into a directory of its own, never into the vector directory it
+    // reads; an earlier stimulus there (its stim.json) is replaced, other files of the same
+    // names only with --force. The outputs are checked before the vectors are read.
+    let vector_dir = super::vectordir::dir_of(&args.vectors);
+    super::output::refuse_inside_input_dir(&args.out, "--out", &vector_dir, "--vectors")?;
+    if let Some(vcd) = &args.vcd {
+        super::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
+    }
     let inputs = super::output::config_inputs_as("--vectors", &args.vectors.to_string_lossy());
     let earlier = args.out.join("stim.json").is_file();
     super::output::check_files_in(
@@ -375,7 +397,8 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
             args.force,
         )?;
     }
-    let s = write_stimulus(&args.vectors, args.run, &args.out, args.vcd.as_deref())?;
+    let vectors = super::vectordir::open(&args.vectors)?;
+    let s = write_stimulus(&vectors, args.run, &args.out, args.vcd.as_deref())?;
     super::output::outln!(
         "{} vectors over {} cycles ({}, latency {}..{})",
         s.n_vectors,

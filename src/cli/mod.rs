@@ -398,6 +398,33 @@ fn error_text(text: &str) -> String {
         .collect()
 }
 
+/// The error line of a command given without its subcommand: the command the arguments name
+/// (walking down its subcommands by name) and the subcommands it takes.
+fn missing_subcommand(
+    root: &clap::Command,
+    args: impl Iterator<Item = std::ffi::OsString>,
+) -> String {
+    let mut path = vec![root.get_name().to_string()];
+    let mut cmd = root;
+    for arg in args {
+        let arg = arg.to_string_lossy();
+        if let Some(sub) = cmd.find_subcommand(arg.as_ref()) {
+            path.push(sub.get_name().to_string());
+            cmd = sub;
+        }
+    }
+    let subs: Vec<&str> = cmd
+        .get_subcommands()
+        .filter(|c| !c.is_hide_set())
+        .map(|c| c.get_name())
+        .collect();
+    let path = path.join(" ");
+    format!(
+        "'{path}' needs a subcommand, expected one of: {} (see '{path} --help')",
+        subs.join(", ")
+    )
+}
+
 /// Parses the arguments, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
     output::install_interrupt_handler();
@@ -410,13 +437,18 @@ pub fn main() -> ExitCode {
         .and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m))
     {
         Ok(cli) => cli,
-        // Help and version go to stdout with exit code 0, as clap prints them; no command at
-        // all shows the whole help.
-        Err(e)
-            if !e.use_stderr()
-                || e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
-        {
-            e.exit()
+        // Help and version go to stdout with exit code 0, as clap prints them.
+        Err(e) if !e.use_stderr() => e.exit(),
+        // A command without its subcommand is an error like any other: one line naming what
+        // it takes, not a page of help.
+        Err(e) if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            use std::io::Write as _;
+            let _ = writeln!(
+                std::io::stderr(),
+                "specfx: error: {}",
+                missing_subcommand(&command(), std::env::args_os().skip(1))
+            );
+            return ExitCode::from(2);
         }
         Err(e) => {
             // A closed or full stderr is no reason to panic: the exit code still tells.
@@ -477,9 +509,16 @@ pub fn main() -> ExitCode {
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
         Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,
         Err(err) => {
+            // A summary that cannot reach stdout after the result directory was committed:
+            // the files are all there, and the one line says so.
+            let complete = output::last_committed()
+                .filter(|_| output::is_stdout_error(&err))
+                .map_or(String::new(), |dir| {
+                    format!(" (the result in {} is complete)", dir.display())
+                });
             {
                 use std::io::Write as _;
-                let _ = writeln!(std::io::stderr(), "specfx: error: {err:#}");
+                let _ = writeln!(std::io::stderr(), "specfx: error: {err:#}{complete}");
             }
             ExitCode::from(2)
         }

@@ -124,8 +124,28 @@ pub fn stdout() -> Stdout {
     Stdout(io::stdout().lock())
 }
 
+/// What every stdout error message begins with.
+const STDOUT_ERROR: &str = "cannot write to stdout";
+
 fn on_stdout(e: io::Error) -> io::Error {
-    io::Error::new(e.kind(), format!("cannot write to stdout: {e}"))
+    io::Error::new(e.kind(), format!("{STDOUT_ERROR}: {e}"))
+}
+
+/// Whether an error is (caused by) a failed write to stdout.
+pub fn is_stdout_error(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| {
+        e.downcast_ref::<io::Error>()
+            .is_some_and(|io| io.to_string().starts_with(STDOUT_ERROR))
+    })
+}
+
+/// The result directories this process committed, newest last: an error after a commit (a
+/// summary that cannot reach a full stdout) says that the result is nevertheless complete.
+static COMMITTED: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// The result directory this process committed last, if any.
+pub fn last_committed() -> Option<PathBuf> {
+    COMMITTED.lock().ok().and_then(|c| c.last().cloned())
 }
 
 impl Write for Stdout {
@@ -295,6 +315,7 @@ impl OutDir {
                     target.display()
                 );
             }
+            probe_move_aside(target, &parent, &name)?;
         }
         std::fs::create_dir_all(&parent)
             .with_context(|| format!("cannot create {}", parent.display()))?;
@@ -378,6 +399,9 @@ impl OutDir {
             });
         }
         log::debug!("{} complete", self.target.display());
+        if let Ok(mut committed) = COMMITTED.lock() {
+            committed.push(self.target.clone());
+        }
         self.done = true;
         self.unregister();
         if had_old {
@@ -400,6 +424,34 @@ impl Drop for OutDir {
             self.unregister();
         }
     }
+}
+
+/// Checks before any work that the existing result `target` can be moved aside when the new
+/// one is committed: renamed to its `.<name>.old-<pid>` name and straight back. An immutable
+/// directory, a mount point or a read-only mount is refused here, not after the run.
+fn probe_move_aside(target: &Path, parent: &Path, name: &str) -> Result<()> {
+    let aside = parent.join(format!(".{name}.old-{}", std::process::id()));
+    if std::fs::symlink_metadata(&aside).is_ok() {
+        // Not ours to touch; the commit would stop at it too.
+        anyhow::bail!(
+            "{}: exists beside --out {}; remove it or pass another --out",
+            aside.display(),
+            target.display()
+        );
+    }
+    std::fs::rename(target, &aside).with_context(|| {
+        format!(
+            "--out {}: cannot be replaced (moving it aside failed); pass another --out",
+            target.display()
+        )
+    })?;
+    std::fs::rename(&aside, target).with_context(|| {
+        format!(
+            "--out {}: was moved to {} and cannot be moved back",
+            target.display(),
+            aside.display()
+        )
+    })
 }
 
 /// The `.<name>.partial-<pid>` (true) and `.<name>.old-<pid>` (false) directories left by
@@ -460,21 +512,26 @@ fn remove_stale(parent: &Path, name: &str) {
 /// The absolute form of `path` with symbolic links resolved as far as it exists: the path
 /// itself when it exists, else its nearest existing ancestor's with the rest appended.
 fn resolve(path: &Path) -> PathBuf {
+    use std::path::Component;
     let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
-    let mut rest = Vec::new();
-    let mut head = abs.as_path();
-    loop {
-        if let Ok(c) = head.canonicalize() {
-            return rest.iter().rev().fold(c, |p: PathBuf, r| p.join(r));
-        }
-        match (head.parent(), head.file_name()) {
-            (Some(parent), Some(name)) => {
-                rest.push(name.to_os_string());
-                head = parent;
+    let components: Vec<Component> = abs.components().collect();
+    for i in (0..=components.len()).rev() {
+        let head: PathBuf = components[..i].iter().collect();
+        if let Ok(mut resolved) = head.canonicalize() {
+            // What does not exist is no link: the rest applies as written.
+            for c in &components[i..] {
+                match c {
+                    Component::ParentDir => {
+                        resolved.pop();
+                    }
+                    Component::CurDir => {}
+                    other => resolved.push(other),
+                }
             }
-            _ => return abs,
+            return resolved;
         }
     }
+    abs
 }
 
 /// Refuses an output that would replace one of the command's inputs: the same file, or a
@@ -502,6 +559,28 @@ pub fn refuse_over_inputs(out: &Path, flag: &str, inputs: &[(&str, PathBuf)]) ->
                 input.display()
             );
         }
+    }
+    Ok(())
+}
+
+/// Refuses an output (a file, or a directory written into) that is inside the input directory
+/// `input_dir` (a vector directory): no command adds files to what it reads, even with
+/// `--force`. Symbolic links and `..` are resolved first.
+pub fn refuse_inside_input_dir(
+    out: &Path,
+    flag: &str,
+    input_dir: &Path,
+    input_flag: &str,
+) -> Result<()> {
+    if !input_dir.is_dir() {
+        return Ok(());
+    }
+    if resolve(out).starts_with(resolve(input_dir)) {
+        anyhow::bail!(
+            "{flag} {}: is inside the input {input_flag} directory {}, which no command writes into; pass another {flag}",
+            out.display(),
+            input_dir.display()
+        );
     }
     Ok(())
 }
@@ -626,7 +705,7 @@ pub fn config_input(arg: &str) -> Vec<PathBuf> {
         return Vec::new();
     }
     let path = Path::new(arg);
-    let is_vectors = path.is_dir() || path.extension().is_some_and(|e| e == "json");
+    let is_vectors = path.is_dir() || path.file_name().is_some_and(|f| f == "manifest.json");
     if !is_vectors {
         return vec![path.to_path_buf()];
     }

@@ -23,15 +23,16 @@ pub struct VectorDir {
 }
 
 /// The directory a `--config`/`--vectors` argument names: the directory itself, or the
-/// directory of a `manifest.json` path.
+/// directory of a `manifest.json` path; anything else is its own path, which [`open`] refuses
+/// by name.
 pub fn dir_of(path: &Path) -> PathBuf {
-    if path.is_dir() {
-        path.to_path_buf()
-    } else {
+    if !path.is_dir() && path.file_name().is_some_and(|f| f == "manifest.json") {
         match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         }
+    } else {
+        path.to_path_buf()
     }
 }
 
@@ -39,7 +40,28 @@ pub fn dir_of(path: &Path) -> PathBuf {
 /// `manifest.json`) with [`VerifiedManifest`]. Nothing of the directory is used unless all of
 /// it checks out.
 pub fn open(path: &Path) -> Result<VectorDir> {
+    if let Err(e) = std::fs::metadata(path) {
+        let what = if std::fs::symlink_metadata(path).is_ok()
+            && e.kind() == std::io::ErrorKind::NotFound
+        {
+            "a dangling symbolic link".to_string()
+        } else if e.kind() == std::io::ErrorKind::NotFound {
+            "no such file or directory".to_string()
+        } else {
+            e.to_string()
+        };
+        bail!(
+            "{}: {what}, expected a vector directory (written by specfx vectors) or its manifest.json",
+            path.display()
+        );
+    }
     let dir = dir_of(path);
+    if !dir.is_dir() {
+        bail!(
+            "{}: not a directory, expected a vector directory (written by specfx vectors) or its manifest.json",
+            path.display()
+        );
+    }
     let file = dir.join("manifest.json");
     let name = file.display().to_string();
     if !file.exists() {

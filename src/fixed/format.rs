@@ -126,10 +126,12 @@ impl Format {
     fn validated(signed: bool, int_bits: i64, frac_bits: i64) -> Result<Format, FixedError> {
         let notation = || format!("{}{}.{}", sign_letter(signed), int_bits, frac_bits);
         let width = int_bits + frac_bits;
+        let max = if signed { 64 } else { 63 };
         if !(1..=64).contains(&width) {
             return Err(FixedError::Width {
                 notation: notation(),
                 got: width,
+                max,
             });
         }
         if !signed && width == 64 {
@@ -579,7 +581,7 @@ mod tests {
             ),
             (
                 "u3.-3",
-                "width (int bits + frac bits) of u3.-3 must be in 1..=64, got 0",
+                "width (int bits + frac bits) of u3.-3 must be in 1..=63, got 0",
             ),
             (
                 "s-5.2",
@@ -591,7 +593,7 @@ mod tests {
             ),
             (
                 "u40.40",
-                "width (int bits + frac bits) of u40.40 must be in 1..=64, got 80",
+                "width (int bits + frac bits) of u40.40 must be in 1..=63, got 80",
             ),
             (
                 "u1.63",
@@ -621,7 +623,8 @@ mod tests {
             Format::new(true, i32::MAX, i32::MAX),
             Err(FixedError::Width {
                 notation: format!("s{}.{}", i32::MAX, i32::MAX),
-                got: 2 * i64::from(i32::MAX)
+                got: 2 * i64::from(i32::MAX),
+                max: 64
             })
         );
     }

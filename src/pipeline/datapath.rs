@@ -302,23 +302,26 @@ impl Datapath {
         // d = c - 1 must be exact for every clamped input.
         let df = config.d.format;
         let d_shift = df.frac_bits() - cf.frac_bits();
-        let d_min = cf.min_value() - 1.0;
-        if d_shift < 0 || df.min_value() > d_min || df.max_value() < 0.0 || d_shift > 62 {
+        // Printed exactly: through f64, c - 1 of s64.0 would read as a value s64.0 holds.
+        let d_min_text = exact_decimal(
+            i128::from(cf.min_raw()) - i128::from(one_raw),
+            cf.frac_bits() as u32,
+        );
+        // The bound is compared exactly (in i128): through f64, c - 1 of s64.0 would pass.
+        let d_exact = (0..=62).contains(&d_shift)
+            && df.max_value() >= 0.0
+            && (i128::from(cf.min_raw()) - i128::from(one_raw)) << d_shift
+                >= i128::from(df.min_raw());
+        if !d_exact {
             return Err(config_error(
                 "d.format",
                 format!(
-                    "must hold c - 1 exactly for every input of {cf} (at least {} fraction bits, range down to {d_min}), got {df}",
+                    "must hold c - 1 exactly for every input of {cf} (at least {} fraction bits, range down to {d_min_text}), got {df}",
                     cf.frac_bits()
                 ),
             ));
         }
         let d_shift = d_shift as u32;
-        if (i128::from(cf.min_raw()) - i128::from(one_raw)) << d_shift < i128::from(df.min_raw()) {
-            return Err(config_error(
-                "d.format",
-                format!("cannot hold {d_min} exactly, got {df}"),
-            ));
-        }
 
         let mut constants = Vec::with_capacity(config.n.len());
         for &n in config.n.values() {
@@ -1059,4 +1062,23 @@ pub fn paper_threshold(n: u32, c_format: Format, one_raw: i64) -> i64 {
     // x * 2^frac is exact (a power-of-two scaling); its ceiling is the first code >= x.
     let scaled = (x * one_raw as f64).ceil();
     (scaled as i64).clamp(c_format.min_raw(), c_format.max_raw())
+}
+
+/// The exact decimal value of `raw * 2^-frac_bits` (`frac_bits <= 62`): every digit, no
+/// rounding through f64.
+fn exact_decimal(raw: i128, frac_bits: u32) -> String {
+    let sign = if raw < 0 { "-" } else { "" };
+    let abs = raw.unsigned_abs();
+    let mask = (1u128 << frac_bits) - 1;
+    let mut text = format!("{sign}{}", abs >> frac_bits);
+    let mut rest = abs & mask;
+    if rest != 0 {
+        text.push('.');
+        while rest != 0 {
+            rest *= 10;
+            text.push(char::from(b'0' + (rest >> frac_bits) as u8));
+            rest &= mask;
+        }
+    }
+    text
 }

@@ -244,7 +244,7 @@ fn check_obj(text: &str) -> Result<(), String> {
                         .any(|w| !w.parse::<f32>().is_ok_and(f32::is_finite))
                 {
                     return Err(format!(
-                        "line {}: expected `v x y z` (three finite numbers, then optionally w or a colour), got '{}'",
+                        "line {}: expected `v x y z` (three numbers within the 32-bit float range, |x| <= 3.4e38, then optionally w or a colour), got '{}'",
                         i + 1,
                         shown()
                     ));
@@ -356,7 +356,7 @@ fn check_ascii_stl(bytes: &[u8]) -> Result<(), String> {
                 format!("`{}`", STEPS[step])
             };
             return Err(format!(
-                "line {}: expected {expected} (x y z finite numbers), got '{}'",
+                "line {}: expected {expected} (x y z numbers within the 32-bit float range, |x| <= 3.4e38), got '{}'",
                 i + 1,
                 line.trim().escape_debug()
             ));
@@ -530,12 +530,17 @@ mod tests {
             ("f 0 1 2\n", "line 4: vertex index 0 is out of range"),
             (
                 "v 1 2\n",
-                "line 4: expected `v x y z` (three finite numbers",
+                "line 4: expected `v x y z` (three numbers within the 32-bit float range, |x| <= 3.4e38",
             ),
             ("v 1 2 z\n", "line 4: expected `v x y z`"),
             (
                 "v 1 2 1e39\n",
-                "line 4: expected `v x y z` (three finite numbers",
+                "line 4: expected `v x y z` (three numbers within the 32-bit float range, |x| <= 3.4e38",
+            ),
+            // Finite, but beyond f32: the message says the real rule.
+            (
+                "v 1 2 1e300\n",
+                "line 4: expected `v x y z` (three numbers within the 32-bit float range, |x| <= 3.4e38",
             ),
         ] {
             let e = err(format!("{v}{tail}").as_bytes(), MeshFormat::Obj);
@@ -569,7 +574,7 @@ mod tests {
             (
                 "vertex 1 0 0",
                 "vertex 1 nan 0",
-                "line 5: expected `vertex x y z` (x y z finite",
+                "line 5: expected `vertex x y z` (x y z numbers within the 32-bit float range",
             ),
             (
                 "endsolid t\n",
