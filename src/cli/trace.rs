@@ -166,6 +166,19 @@ fn write_comparison(
             list(&c.registers_only_second)
         )?;
     }
+    let unchecked = c.only_second.len() - c.registers_only_second.len();
+    if unchecked > 0 {
+        let other = if c.registers_only_second.is_empty() {
+            ""
+        } else {
+            "other "
+        };
+        writeln!(
+            w,
+            "  the {other}{unchecked} only in {} are wires, or registers in scopes {} has no signal in: internal to the RTL, not a difference",
+            files[1], files[0]
+        )?;
+    }
     if !c.ignored.is_empty() {
         writeln!(
             w,
