@@ -295,7 +295,7 @@ fn no_command_writes_over_one_of_its_inputs() {
                 "--vcd",
                 "v/expected_out.hex",
             ],
-            "--vcd v/expected_out.hex: is the input --vectors",
+            "--vcd v/expected_out.hex: is inside the input --vectors directory v",
         ),
         (
             &[
@@ -379,11 +379,11 @@ fn an_existing_file_is_replaced_only_when_it_is_an_earlier_result_or_with_force(
     assert!(run_in(dir, &json).status.success());
     assert_refused(&run_in(dir, &json), "pass --force", "json twice");
 
-    // A stimulus may go into the vector directory and be written again; a foreign file of a
-    // stimulus name is refused.
+    // A stimulus goes into a directory of its own (never the vector directory) and may be
+    // written again; a foreign file of a stimulus name is refused.
     vectors(dir);
     for _ in 0..2 {
-        let o = run_in(dir, &["hdl", "stimulus", "--vectors", "v", "--out", "v"]);
+        let o = run_in(dir, &["hdl", "stimulus", "--vectors", "v", "--out", "own"]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
     std::fs::create_dir(dir.join("st")).unwrap();
