@@ -27,7 +27,7 @@ fn files(kind: &str, target: &str) -> Vec<PathBuf> {
 
 /// Runs a target's check on every file of its corpus and regressions; returns how many. A
 /// seed is a real input: accepted, unless its name starts with `bad_` (a real mistake, taken
-/// from the bad inputs of `tests/robustness.rs` and the docs), which must be refused.
+/// from the bad inputs of `tests/command_line/robustness.rs` and the docs), which must be refused.
 /// Reproducers may go either way: their check must only pass.
 fn replay(target: &str) -> usize {
     let (_, check) = checks::TARGETS

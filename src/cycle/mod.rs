@@ -7,7 +7,7 @@
 //! operations of [`crate::pipeline::Datapath`] (`op_sub`, `op_mul_t`, `op_add_b`,
 //! `op_square`, `op_mul_out`) as its FSM steps, as in the RTL. The `pipelined` one carries
 //! tokens whose values are the functional model's (`docs/cycle.md`), checked register by
-//! register against a literal pipeline in `tests/cycle_model.rs`.
+//! register against a literal pipeline in `tests/model/cycle_model.rs`.
 //!
 //! Valid/ready rules (both ports; see `docs/cycle.md`):
 //!

@@ -1,5 +1,8 @@
 //! Helpers shared by the integration tests that drive the built `specfx` binary.
 
+/// The independent big-integer oracle of the datapath (`docs/arithmetic.md` alone).
+pub mod oracle;
+
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 

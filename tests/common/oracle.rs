@@ -13,12 +13,7 @@
 //! `width`, `is_signed` and `frac_bits`, and the `Rounding`/`Overflow`/`Event` names). The
 //! per-n constants are taken from `NConstants` as given: they are inputs.
 //!
-//! Use it from an integration test with
-//!
-//! ```ignore
-//! #[path = "common/oracle.rs"]
-//! mod oracle;
-//! ```
+//! Use it from a test module with `use crate::common::oracle;`.
 #![allow(dead_code)]
 
 use num_bigint::BigInt;

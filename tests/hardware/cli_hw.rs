@@ -1,0 +1,178 @@
+//! End-to-end tests of `specfx sim`, `specfx hdl` and `specfx cost` through the built binary.
+
+use crate::common::specfx;
+
+use std::process::Output;
+
+fn json(o: &Output) -> serde_json::Value {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).expect("JSON on stdout")
+}
+
+#[test]
+fn sim_json_reports_latency_throughput_and_no_mismatch() {
+    for (arch, latency) in [("pipelined", 8), ("folded", 7)] {
+        let v = json(&specfx(&[
+            "sim", "--arch", arch, "--cycles", "3000", "--seed", "9", "--json",
+        ]));
+        assert_eq!(v["mismatches"], 0, "{arch}");
+        assert_eq!(v["latency_min"], latency, "{arch}");
+        assert!(v["latency_max"].as_u64().unwrap() >= latency);
+        assert!(v["n_outputs"].as_u64().unwrap() > 0);
+        assert!(v["throughput"].as_f64().unwrap() > 0.0);
+    }
+    // Without bubbles or stalls a pipeline delivers one result per cycle after it fills:
+    // 1000 cycles - 8 of latency = 992 results.
+    let v = json(&specfx(&[
+        "sim", "--cycles", "1000", "--bubble", "0", "--stall", "0", "--json",
+    ]));
+    assert_eq!(v["n_outputs"], 992);
+    assert_eq!(v["latency_max"], 8);
+    // The sweep stream: n = 16 and 20, every code 0..=32768 of each (65,538 inputs) and on
+    // into the second pass; every output checked against the functional model.
+    let v = json(&specfx(&[
+        "sim", "--n", "16,20", "--stream", "sweep", "--cycles", "70000", "--bubble", "0",
+        "--stall", "0", "--json",
+    ]));
+    assert_eq!(v["n_inputs"], 70000);
+    assert_eq!(v["n_outputs"], 70000 - 8);
+    assert_eq!(v["mismatches"], 0);
+    assert_eq!(v["order_errors"], 0);
+}
+
+#[test]
+fn sim_writes_a_vcd() {
+    let path = std::env::temp_dir().join(format!("specfx-{}-trace.vcd", std::process::id()));
+    let o = specfx(&[
+        "sim",
+        "--cycles",
+        "200",
+        "--vcd",
+        path.to_str().unwrap(),
+        "--vcd-cycles",
+        "100",
+    ]);
+    assert!(o.status.success());
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("$enddefinitions"));
+    assert!(text.contains(" out_valid $end"));
+    assert!(text.contains("$scope module u_core $end"));
+    // Reset for four edges (the first at 5 ns), then 100 cycles of 10 ns: cycle 99 ends at
+    // the edge at 1035 ns.
+    assert!(
+        text.contains("#1035\n1!"),
+        "100 cycles of 10 ns after reset"
+    );
+    std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn bad_sim_arguments_are_refused() {
+    for args in [
+        &["sim", "--arch", "systolic"][..],
+        &["sim", "--bubble", "1.5"],
+        &["sim", "--cycles", "0"],
+        &["sim", "--stream", "sorted"],
+        &["cost", "--target", "asic"],
+    ] {
+        let o = specfx(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(o.stdout.is_empty());
+    }
+}
+
+#[test]
+fn hdl_params_describe_the_configuration() {
+    let o = specfx(&["hdl", "params", "--arch", "folded"]);
+    assert!(o.status.success());
+    let text = String::from_utf8(o.stdout).unwrap();
+    for line in [
+        "`define SPECFX_ARCH 1",
+        "`define SPECFX_K 4",
+        "`define SPECFX_T_W 18",
+        "`define SPECFX_T_F 16",
+        "`define SPECFX_T_S 1",
+        "`define SPECFX_T_RND 2",
+        "`define SPECFX_T_OVF 1",
+        "`define SPECFX_OUT_W 24",
+        "`define SPECFX_SLOPE_W 11",
+        "`define SPECFX_SLOPE_F 4",
+    ] {
+        assert!(text.lines().any(|l| l == line), "missing {line}");
+    }
+}
+
+#[test]
+fn cost_runs_yosys_and_the_analytic_model() {
+    let v = json(&specfx(&["cost", "--target", "ice40", "--json"]));
+    for key in ["luts", "dsps", "ffs"] {
+        assert!(v[key].as_u64().unwrap() > 0, "{key}");
+    }
+    assert!(v["yosys_version"].as_str().unwrap().starts_with("Yosys"));
+    assert!(v["yosys_script"].as_str().unwrap().contains("synth_ice40"));
+    // Six multipliers: d x n, four squares, the output product.
+    assert_eq!(
+        v["analytic"]["features"]["multipliers"]
+            .as_array()
+            .unwrap()
+            .len(),
+        6
+    );
+    // The pipeline keeps at least every stage's value in registers: 8 stages, >= 8 * 16 bits.
+    assert!(v["ffs"].as_u64().unwrap() >= 128);
+    let v = json(&specfx(&[
+        "cost",
+        "--analytic-only",
+        "--arch",
+        "folded",
+        "--json",
+    ]));
+    assert!(v["yosys"].is_null());
+    assert_eq!(
+        v["analytic"]["features"]["multipliers"]
+            .as_array()
+            .unwrap()
+            .len(),
+        1
+    );
+    // Figures named with target and unit, and checked against the device.
+    assert_eq!(v["analytic"]["target"], "ice40");
+    assert_eq!(v["analytic"]["logic_unit"], "LUTs");
+    assert_eq!(v["device"], "up5k");
+    assert_eq!(v["over_limit"].as_array().unwrap().len(), 0);
+    // The fast generic mapping: gates and a transistor estimate, through abc -fast.
+    let v = json(&specfx(&["cost", "--target", "generic-fast", "--json"]));
+    assert!(v["yosys_script"]
+        .as_str()
+        .unwrap()
+        .contains("abc -fast -g cmos2"));
+    assert!(v["yosys"]["transistors"].as_u64().unwrap() > 1000);
+}
+
+/// Seven squarings of 24 x 24 bits need four SB_MAC16 each on iCE40 (16 x 16 blocks: two
+/// slices per operand): far more than the UP5K's eight DSP blocks, which `cost` flags.
+#[test]
+fn cost_flags_what_exceeds_the_device() {
+    let dir = std::env::temp_dir().join(format!("specfx-hw-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = dir.join("wide.toml");
+    std::fs::write(
+        &cfg,
+        "k = 7\n[b]\nformat = \"u1.23\"\n[square]\nformat = \"u1.23\"\n",
+    )
+    .unwrap();
+    let v = json(&specfx(&[
+        "cost",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--analytic-only",
+        "--json",
+    ]));
+    let dsps = v["analytic"]["dsps"].as_u64().unwrap();
+    assert!(dsps >= 7 * 4, "{dsps}");
+    let flags = v["over_limit"].as_array().unwrap();
+    assert!(
+        flags.iter().any(|f| f.as_str().unwrap().contains("DSP")),
+        "{flags:?}"
+    );
+}

@@ -1,0 +1,246 @@
+//! The cocotb testbench (`hdl_ref/cocotb/run.py`, `test_specfx.py`) under Icarus Verilog: every
+//! vector of several configurations passes, bit for bit and cycle for cycle, and a broken RTL
+//! fails. Needs cocotb in `target/cocotb-venv` (`./scripts/test` makes it and sets
+//! `SPECFX_COCOTB_PYTHON`) and Icarus Verilog.
+
+use crate::common::{config_path, specfx};
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The Python that has the pinned cocotb: `$SPECFX_COCOTB_PYTHON`, else the virtual
+/// environment `./scripts/test` makes.
+fn cocotb_python() -> PathBuf {
+    let python = std::env::var_os("SPECFX_COCOTB_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target/cocotb-venv/bin/python"));
+    assert!(
+        python.is_file(),
+        "{}: no Python with cocotb; ./scripts/test makes it (or: python3 -m venv \
+         target/cocotb-venv && target/cocotb-venv/bin/pip install -r \
+         hdl_ref/cocotb/requirements.txt), or set SPECFX_COCOTB_PYTHON",
+        python.display()
+    );
+    python
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let p = std::env::temp_dir().join(format!("specfx-cocotb-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&p);
+    p
+}
+
+/// Writes vectors into a fresh directory; returns it and the manifest's `n_vectors`.
+fn vectors(name: &str, args: &[&str]) -> (PathBuf, u64) {
+    let dir = temp_dir(name);
+    let mut all = vec!["vectors", "--seed", "3", "--out", dir.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let o = specfx(&all);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    (dir, manifest["n_vectors"].as_u64().unwrap())
+}
+
+/// Runs `hdl_ref/cocotb/run.py --vectors DIR` with more arguments.
+fn run_py(vectors: &Path, args: &[&str]) -> Output {
+    Command::new(cocotb_python())
+        .arg(root().join("hdl_ref/cocotb/run.py"))
+        .arg("--vectors")
+        .arg(vectors)
+        .arg("--specfx")
+        .arg(env!("CARGO_BIN_EXE_specfx"))
+        .args(args)
+        .output()
+        .expect("the cocotb Python runs")
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// The N of run.py's `cocotb: N vectors passed (...)` line.
+fn vectors_passed(o: &Output) -> Option<u64> {
+    String::from_utf8_lossy(&o.stdout).lines().find_map(|l| {
+        l.strip_prefix("cocotb: ")?
+            .split_once(" vectors passed (")?
+            .0
+            .parse()
+            .ok()
+    })
+}
+
+/// Every vector of a configuration passes under the given architecture and stimulus.
+fn check(name: &str, vector_args: &[&str], run_args: &[&str]) {
+    let (dir, n) = vectors(name, vector_args);
+    assert!(
+        (100..=1000).contains(&n),
+        "{name}: {n} vectors, want a few hundred"
+    );
+    let o = run_py(&dir, run_args);
+    assert!(o.status.success(), "{name}: run.py failed:\n{}", text(&o));
+    assert_eq!(vectors_passed(&o), Some(n), "{name}:\n{}", text(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn baseline_pipelined_passes_every_vector() {
+    check(
+        "baseline",
+        &["--n", "16,64,1000", "--cases", "corner,random:200"],
+        &["--arch", "pipelined", "--seed", "11", "--bubble", "0.25"],
+    );
+}
+
+#[test]
+fn baseline_folded_passes_every_vector() {
+    check(
+        "baseline_folded",
+        &["--n", "16,64,1000", "--cases", "corner,random:150"],
+        &["--arch", "folded", "--seed", "12", "--stall", "0.4"],
+    );
+}
+
+#[test]
+fn minimax_folded_passes_every_vector() {
+    check(
+        "minimax_folded",
+        &[
+            "--config",
+            &config_path("minimax_folded.toml"),
+            "--cases",
+            "corner,random:150",
+        ],
+        &[
+            "--arch", "folded", "--seed", "13", "--bubble", "0.3", "--stall", "0.4",
+        ],
+    );
+}
+
+/// Latencies of 2, the paper cutoff and a signed output.
+#[test]
+fn conv_sym_k5_pipelined_passes_every_vector() {
+    check(
+        "conv_sym_k5",
+        &[
+            "--config",
+            &config_path("conv_sym_k5.toml"),
+            "--cases",
+            "corner,random:200",
+        ],
+        &[
+            "--arch",
+            "pipelined",
+            "--seed",
+            "14",
+            "--bubble",
+            "0.3",
+            "--stall",
+            "0.3",
+        ],
+    );
+}
+
+/// RESET_DATA = 1 (out_data checked to be 0 after reset), with 60-bit coefficients and 64-bit
+/// signed output words, some negative, in both architectures.
+#[test]
+fn reset_data_and_64_bit_signed_words_pass_every_vector() {
+    let config = config_path("wide_signed_out64.toml");
+    let (dir, n) = vectors(
+        "wide",
+        &["--config", &config, "--cases", "corner,random:200"],
+    );
+    let manifest = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+    assert!(manifest.contains("\"format\": \"s40.24\""), "{manifest}");
+    let negative = std::fs::read_to_string(dir.join("expected_out.hex"))
+        .unwrap()
+        .lines()
+        .filter(|l| l.len() == 16 && l.as_bytes()[0] >= b'8')
+        .count();
+    assert!(negative > 10, "only {negative} negative outputs");
+    for (arch, seed) in [("pipelined", "15"), ("folded", "16")] {
+        let o = run_py(
+            &dir,
+            &[
+                "--arch",
+                arch,
+                "--seed",
+                seed,
+                "--stall",
+                "0.3",
+                "--reset-data",
+            ],
+        );
+        assert!(o.status.success(), "{arch}: run.py failed:\n{}", text(&o));
+        assert_eq!(vectors_passed(&o), Some(n), "{arch}:\n{}", text(&o));
+        assert!(String::from_utf8_lossy(&o.stdout).contains("RESET_DATA = 1"));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A copy of `hdl_ref/rtl` with one line of `specfx_pipelined.v` replaced.
+fn broken_rtl(name: &str, from: &str, to: &str) -> PathBuf {
+    let dir = temp_dir(name);
+    std::fs::create_dir_all(dir.join("rtl")).unwrap();
+    for entry in std::fs::read_dir(root().join("hdl_ref/rtl")).unwrap() {
+        let path = entry.unwrap().path();
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        if path.ends_with("specfx_pipelined.v") {
+            assert_eq!(text.matches(from).count(), 1, "{from:?} is not one line");
+            text = text.replace(from, to);
+        }
+        std::fs::write(dir.join("rtl").join(path.file_name().unwrap()), text).unwrap();
+    }
+    dir
+}
+
+fn check_broken(name: &str, from: &str, to: &str, problem: &str) {
+    let (vec_dir, n) = vectors(name, &["--n", "16,64,1000", "--cases", "corner,random:100"]);
+    let rtl = broken_rtl(&format!("{name}-rtl"), from, to);
+    let args = ["--hdl-ref", rtl.to_str().unwrap(), "--seed", "17"];
+    let o = run_py(&vec_dir, &args);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{name} must fail:\n{}", text(&o));
+    assert_eq!(vectors_passed(&o), None);
+    assert!(
+        out.lines().any(|l| l.starts_with(problem)),
+        "{name}: no {problem:?} line:\n{out}"
+    );
+    let verdict = out.lines().last().unwrap();
+    assert!(
+        verdict.starts_with("cocotb: FAIL: ") && verdict.contains(&format!(" of {n} vectors")),
+        "{verdict}"
+    );
+    std::fs::remove_dir_all(&vec_dir).unwrap();
+    std::fs::remove_dir_all(&rtl).unwrap();
+}
+
+/// The output product reads the coefficient one stage back (the neighbouring vector's).
+#[test]
+fn a_neighbouring_coefficient_fails() {
+    check_broken(
+        "neighbour_coef",
+        ".coef(coefs[K*COEF_W +: COEF_W])",
+        ".coef(coefs[(K-1)*COEF_W +: COEF_W])",
+        "mismatch i=",
+    );
+}
+
+/// The output register moves while the output is stalled (rule 5 of docs/cycle.md).
+#[test]
+fn an_output_that_moves_while_stalled_fails() {
+    check_broken(
+        "moves_while_stalled",
+        ".en(advance), .d(out_k), .q(out_data)",
+        ".en(1'b1), .d(out_k), .q(out_data)",
+        "protocol: out_valid/out_data changed while stalled",
+    );
+}

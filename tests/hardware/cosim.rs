@@ -1,0 +1,220 @@
+//! Co-simulation of the reference Verilog against the golden vectors and the Rust cycle model,
+//! in Icarus Verilog and Verilator (both must be installed: `./scripts/test` installs them).
+
+use crate::common::{config_path, specfx};
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let p = std::env::temp_dir().join(format!("specfx-cosim-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&p);
+    p
+}
+
+fn cosim(vectors: &Path, sim: &str, arch: &str, seed: &str) -> Output {
+    Command::new(Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/cosim"))
+        .args([
+            "--vectors",
+            vectors.to_str().unwrap(),
+            "--sim",
+            sim,
+            "--arch",
+            arch,
+        ])
+        .args(["--seed", seed, "--bubble", "0.25", "--stall", "0.25"])
+        .env("SPECFX", env!("CARGO_BIN_EXE_specfx"))
+        .output()
+        .expect("scripts/cosim runs")
+}
+
+/// The `N passed, N failed` line of a run.
+fn summary(o: &Output) -> (u64, u64) {
+    let text = String::from_utf8_lossy(&o.stdout);
+    let line = text
+        .lines()
+        .rev()
+        .find(|l| l.contains(" passed, ") && l.trim_end().ends_with(" failed"))
+        .unwrap_or_else(|| {
+            panic!(
+                "no summary line in:\n{text}\n{}",
+                String::from_utf8_lossy(&o.stderr)
+            )
+        });
+    let nums: Vec<u64> = line
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().unwrap())
+        .collect();
+    (nums[0], nums[1])
+}
+
+fn vectors(config: &str, name: &str, cases: &str) -> (PathBuf, u64) {
+    let dir = temp_dir(name);
+    let o = specfx(&[
+        "vectors",
+        "--config",
+        config,
+        "--cases",
+        cases,
+        "--seed",
+        "3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    (dir, manifest["n_vectors"].as_u64().unwrap())
+}
+
+fn check_all(config: &str, name: &str, arch: &str, cases: &str) {
+    let (dir, n) = vectors(config, name, cases);
+    for sim in ["icarus", "verilator"] {
+        let o = cosim(&dir, sim, arch, "11");
+        let (passed, failed) = summary(&o);
+        assert_eq!(
+            (passed, failed),
+            (n, 0),
+            "{name} on {sim} ({arch}):\n{}\n{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(o.status.success());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn baseline_pipelined_matches_bit_and_cycle() {
+    check_all("baseline", "baseline", "pipelined", "corner,random:400");
+}
+
+#[test]
+fn narrow_trn_wrap_matches_bit_and_cycle() {
+    check_all(
+        &config_path("narrow_trn_wrap.toml"),
+        "narrow",
+        "pipelined",
+        "corner,random:300",
+    );
+}
+
+#[test]
+fn conv_sym_k5_matches_bit_and_cycle() {
+    check_all(
+        &config_path("conv_sym_k5.toml"),
+        "k5",
+        "pipelined",
+        "corner,random:300",
+    );
+}
+
+/// Every n a power of two: the pipelined RTL's t product is a shifter (`SLOPE_POW2`), checked
+/// on every exponent (corner cases hold each n) and in both simulators; folded keeps its
+/// shared multiplier.
+#[test]
+fn power_of_two_slopes_shift_and_match_bit_and_cycle() {
+    let config = config_path("pow2_shift.toml");
+    let header = specfx(&["hdl", "params", "--config", &config]);
+    assert!(String::from_utf8_lossy(&header.stdout).contains("`define SPECFX_SLOPE_POW2 1\n"));
+    check_all(&config, "pow2", "pipelined", "corner,random:400");
+    check_all(&config, "pow2_folded", "folded", "corner,random:100");
+}
+
+#[test]
+fn folded_matches_bit_and_cycle() {
+    check_all("baseline", "baseline_folded", "folded", "random:300");
+    check_all(
+        &config_path("minimax_folded.toml"),
+        "minimax_folded",
+        "folded",
+        "corner,random:200",
+    );
+}
+
+/// A corrupted expected value never reaches the simulator: the vector directory is verified
+/// against its manifest first (the testbench's own sensitivity to a wrong output is
+/// tests/hardware/mutation.rs's business).
+#[test]
+fn a_corrupted_expected_value_is_refused_before_simulation() {
+    let (dir, _) = vectors("baseline", "corrupt", "random:50");
+    let path = dir.join("expected_out.hex");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let v = u64::from_str_radix(&lines[17], 16).unwrap() ^ 1;
+    lines[17] = format!("{v:06x}");
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    let o = cosim(&dir, "icarus", "pipelined", "5");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("expected_out.hex: sha256")
+            && stderr.contains("differs from the manifest's"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `specfx cosim` with no argument co-simulates the baseline on vectors it writes itself.
+#[test]
+fn cosim_defaults_lead_to_an_answer() {
+    let o = specfx(&["cosim"]);
+    let (passed, failed) = summary(&o);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The default cases: every n of the baseline's 16..1024 has corner cases, plus 1000 random.
+    assert!(passed > 1009 + 1000 && failed == 0, "{passed} passed");
+}
+
+/// RESET_DATA = 1 (data registers cleared on reset) matches in both simulators and both
+/// architectures, with the top linted under its parameters first; the testbench then also
+/// checks out_data = 0 right after reset.
+#[test]
+fn reset_data_variant_matches_and_is_lint_clean() {
+    let (dir, n) = vectors(
+        &config_path("minimax_folded.toml"),
+        "reset",
+        "corner,random:100",
+    );
+    for (sim, arch) in [("icarus", "pipelined"), ("verilator", "folded")] {
+        let o = specfx(&[
+            "cosim",
+            "--vectors",
+            dir.to_str().unwrap(),
+            "--sim",
+            sim,
+            "--arch",
+            arch,
+            "--reset-data",
+            "--lint",
+        ]);
+        assert_eq!(summary(&o), (n, 0), "{sim} {arch}");
+        assert!(o.status.success());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A simulator that is not installed is named with the package that has it: one line, exit 2.
+#[test]
+fn a_missing_simulator_is_named_with_its_package() {
+    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args(["cosim", "--sim", "icarus"])
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("iverilog and vvp not found on PATH")
+            && err.contains("apt-get install -y iverilog"),
+        "{err}"
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .arg("cosim")
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no Verilog simulator"));
+}
