@@ -98,8 +98,20 @@ pub fn map_n<T: Send>(dp: &Datapath, work: impl Fn(&NConstants) -> T + Sync) -> 
 pub struct Codes {
     /// Raw input codes, in the order the stream visits them.
     pub codes: Vec<i64>,
-    /// `ln c` of each code clamped to 1.0.
+    /// `ln c` of each code clamped to 1.0; minus infinity for `c <= 0`, so that
+    /// `exp(n ln c)` is 0 there for every n >= 1 (the lobe is max(0, c)^n).
     pub ln_c: Vec<f64>,
+}
+
+/// `ln c` of an input `c`, minus infinity for `c <= 0`: `exp(n ln_c(c))` is cos^n of the
+/// clamped cosine, 0 at and below 0 for every n >= 1 (a signed input's negative codes, where
+/// `ln` alone would give NaN).
+pub fn ln_c(c: f64) -> f64 {
+    if c > 0.0 {
+        c.ln()
+    } else {
+        f64::NEG_INFINITY
+    }
 }
 
 impl Codes {
@@ -108,7 +120,7 @@ impl Codes {
         let (one, lsb) = (dp.one_code(), dp.config().c.format.lsb());
         let ln_c = codes
             .iter()
-            .map(|&k| (k.min(one) as f64 * lsb).ln())
+            .map(|&k| ln_c(k.min(one) as f64 * lsb))
             .collect();
         Codes { codes, ln_c }
     }

@@ -155,3 +155,26 @@ fn a_sweep_point_is_the_same_with_one_and_two_threads() {
         assert_eq!(one, two);
     }
 }
+
+/// cos^n of a code follows one rule everywhere: 0 at and below c = 0 (the lobe is
+/// max(0, c)^n), so a signed input's negative codes give 0, not NaN, to every analysis
+/// streaming the engine's `ln c` (the budget's targets among them); above 0, `c^n` by `powi`.
+#[test]
+fn cos_n_of_a_signed_inputs_codes_is_zero_at_and_below_zero() {
+    let toml = "name = \"signed_c\"\n[c]\nformat = \"s2.15\"\n[d]\nformat = \"s3.15\"\n";
+    let dp = Datapath::new(Config::from_toml(toml).unwrap()).unwrap();
+    let codes = specfx::engine::Codes::up_to_one(&dp);
+    assert_eq!(codes.codes[0], -65536, "the stream starts at c = -2");
+    let lsb = 2f64.powi(-15);
+    for n in [1, 2, 16, 1024] {
+        for (&k, &ln) in codes.codes.iter().zip(&codes.ln_c).step_by(97) {
+            let got = (f64::from(n) * ln).exp();
+            let c = k as f64 * lsb;
+            let want = if c <= 0.0 { 0.0 } else { c.powi(n as i32) };
+            assert!(
+                (got - want).abs() <= 1e-12 * want.max(1e-300),
+                "n = {n}, c = {c}: {got} against {want}"
+            );
+        }
+    }
+}
