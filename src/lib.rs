@@ -17,6 +17,7 @@
 //! ```
 
 pub mod analysis;
+pub mod csv_dialect;
 pub mod cycle;
 pub mod engine;
 pub mod error;

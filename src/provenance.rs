@@ -12,7 +12,6 @@
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
-use crate::analysis::sweep::Space;
 use crate::nset::NSet;
 use crate::pipeline::Config;
 
@@ -109,11 +108,10 @@ impl Inputs {
         self
     }
 
-    /// Records a design space (`[space]`: its base configuration, axes and target).
-    pub fn space(mut self, space: &Space) -> Inputs {
-        let mut s = space.clone();
-        s.base = canonical_config(&space.base);
-        self.root.insert("space".into(), to_value("a space", &s));
+    /// Records a serialisable value under `key` (a design space's `[space]`, recorded by
+    /// `analysis::sweep::Space::recorded`: this module knows no result's types).
+    pub fn value(mut self, key: &str, value: &impl Serialize) -> Inputs {
+        self.root.insert(key.into(), to_value(key, value));
         self
     }
 

@@ -28,7 +28,7 @@ use crate::reference::method::Method;
 use crate::reference::minimax;
 
 /// The default tolerance: one LSB of an 8-bit display, 2^-8.
-pub const DEFAULT_TOL: f64 = 1.0 / 256.0;
+pub const DEFAULT_TOL: f64 = super::LSB8;
 
 /// Rows of the heat maps: theta from 0 to 90 degrees in steps of one degree.
 pub const HEAT_ROWS: usize = 90;

@@ -150,6 +150,14 @@ k = [3, 4, 5]
 "#;
 
 impl Space {
+    /// Records the space in a result's inputs: `[space]`, its base configuration in
+    /// canonical form ([`crate::provenance::canonical_config`]), its axes and target.
+    pub fn recorded(&self, inputs: crate::provenance::Inputs) -> crate::provenance::Inputs {
+        let mut s = self.clone();
+        s.base = crate::provenance::canonical_config(&self.base);
+        inputs.value("space", &s)
+    }
+
     /// The built-in space ([`DEFAULT_SPACE`]).
     ///
     /// # Examples

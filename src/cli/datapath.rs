@@ -6,6 +6,7 @@ use anyhow::{bail, Context, Result};
 
 use specfx::nset::NSet;
 use specfx::pipeline::{Config, Datapath};
+use specfx::reference::lobe::K_RANGE;
 
 /// Reads a configuration: a built-in name (`baseline`; a file of that name is read as
 /// `./baseline`), a TOML file, or a vector directory (or its `manifest.json`), whose manifest
@@ -60,7 +61,7 @@ pub fn parse_k_set(s: &str) -> std::result::Result<NSet, String> {
     let bad =
         || format!("expected numbers of squarings k in 1..=7 (e.g. 4, 3..=5 or 1,4,7), got '{s}'");
     let set: NSet = s.parse().map_err(|_| bad())?;
-    if set.values().iter().all(|k| (1..=7).contains(k)) {
+    if set.values().iter().all(|k| K_RANGE.contains(k)) {
         Ok(set)
     } else {
         Err(bad())

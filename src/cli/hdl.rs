@@ -16,6 +16,33 @@ use specfx::cycle::Arch;
 use specfx::hdl::rom::rom_verilog;
 use specfx::hdl::{render_parameters, ParamsFormat};
 
+/// `--format` of `specfx hdl params`: the library's [`ParamsFormat`], with its help.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum FormatArg {
+    /// `specfx_params.vh`: `` `define SPECFX_<NAME> <value> `` lines for `specfx_dut.v`.
+    Define,
+    /// A JSON object `{"NAME": value, ...}` (cocotb, VUnit, FuseSoC scripts).
+    Json,
+    /// Icarus Verilog flags, one per line: `-P<top>.<NAME>=<value>`.
+    Iverilog,
+    /// Verilator flags, one per line: `-G<NAME>=<value>` (for the top module).
+    Verilator,
+    /// A Verilog instantiation of `specfx_top` with every parameter set.
+    Instance,
+}
+
+impl From<FormatArg> for ParamsFormat {
+    fn from(f: FormatArg) -> ParamsFormat {
+        match f {
+            FormatArg::Define => ParamsFormat::Define,
+            FormatArg::Json => ParamsFormat::Json,
+            FormatArg::Iverilog => ParamsFormat::Iverilog,
+            FormatArg::Verilator => ParamsFormat::Verilator,
+            FormatArg::Instance => ParamsFormat::Instance,
+        }
+    }
+}
+
 /// Arguments of `specfx hdl`.
 #[derive(Debug, Args)]
 pub struct HdlArgs {
@@ -51,7 +78,7 @@ struct ParamsArgs {
     /// `specfx_dut.v`), json, iverilog (`-P` flags), verilator (`-G` flags) or instance (a
     /// Verilog instantiation).
     #[arg(long, default_value = "define")]
-    format: ParamsFormat,
+    format: FormatArg,
     /// The module whose parameters the iverilog `-P` flags set.
     #[arg(long, default_value = "specfx_top", value_parser = verilog_identifier)]
     top: String,
@@ -172,12 +199,18 @@ fn params(args: &ParamsArgs) -> Result<Outcome> {
         Some(dir) => super::datapath::load_vectors(dir)?,
         None => super::datapath::load(&args.config, None)?,
     };
-    let text = render_parameters(&dp, args.arch, args.reset_data, args.format, &args.top);
+    let text = render_parameters(
+        &dp,
+        args.arch,
+        args.reset_data,
+        args.format.into(),
+        &args.top,
+    );
     let inputs = match &args.vectors {
         Some(dir) => super::output::config_inputs_as("--vectors", &dir.to_string_lossy()),
         None => super::output::config_inputs_as("--config", &args.config),
     };
-    let own_header = match args.format {
+    let own_header = match ParamsFormat::from(args.format) {
         ParamsFormat::Define => Some("// specfx parameters: "),
         ParamsFormat::Instance => Some("// specfx_top for configuration "),
         _ => None,

@@ -74,7 +74,12 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         args.force,
     )?;
     let base = dp.config().clone();
-    if let Some(&k) = args.k.values().iter().find(|&&k| !(1..=7).contains(&k)) {
+    if let Some(&k) = args
+        .k
+        .values()
+        .iter()
+        .find(|&&k| !specfx::reference::lobe::K_RANGE.contains(&k))
+    {
         bail!("--k: expected numbers of squarings in 1..=7, got {k}");
     }
     let yosys = match args.objective.as_str() {

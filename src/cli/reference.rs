@@ -142,14 +142,13 @@ pub fn run_minimax(args: &MinimaxArgs) -> Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
-/// The first line of a minimax table (`write_minimax_table`).
-const TABLE_HEADER: &str = "k,n,a,b,max_abs_err,plain_max_abs_err\n";
-
 fn write_table(path: &std::path::Path, n_max: u32, force: bool) -> Result<Outcome> {
     if !(1..=specfx::nset::N_MAX).contains(&n_max) {
         bail!("--n-max: expected 1..={}, got {n_max}", specfx::nset::N_MAX);
     }
-    super::output::check_file_output(path, "--write", &[], Some(TABLE_HEADER), force)?;
+    // An earlier table (its first line the table's header) is replaced without --force.
+    let header = format!("{}\n", specfx::reference::minimax::TABLE_HEADER);
+    super::output::check_file_output(path, "--write", &[], Some(&header), force)?;
     let jobs: Vec<(u32, u32)> = K_RANGE
         .flat_map(|k| (1..=n_max).map(move |n| (k, n)))
         .collect();

@@ -187,7 +187,7 @@ fn write_index(
     writeln!(w, "<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em}}.table{{overflow-x:auto}}td,th{{padding:2px 8px;text-align:right;white-space:nowrap}}td:first-child,th:first-child{{text-align:left}}img{{max-width:100%;height:auto}}</style></head><body>")?;
     writeln!(w, "<h1>specfx report</h1>")?;
     // The verdict first: the numbers a designer acts on.
-    let lsb8 = 1.0 / 256.0;
+    let lsb8 = specfx::analysis::LSB8;
     let total = checked.shape_total_max_abs;
     let pipelined = costs
         .iter()

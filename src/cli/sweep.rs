@@ -69,8 +69,8 @@ struct SweepInfo {
 /// the same space written differently is the same sweep, and a shard of another space or of
 /// another sharding is not.
 fn sweep_sha256(space: &Space, shard_count: u64) -> String {
-    let inputs = Inputs::new("sweep")
-        .space(space)
+    let inputs = space
+        .recorded(Inputs::new("sweep"))
         .option("shard_count", shard_count.to_string());
     sha256_hex(inputs.canonical().as_bytes())
 }
@@ -368,8 +368,9 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
     log.sync_all().with_context(cannot_write)?;
     let mut points: Vec<PointResult> = done.into_values().collect();
     specfx::analysis::sweep::mark_pareto(&mut points);
-    let mut inputs = Inputs::new("sweep")
-        .space(&info.space)
+    let mut inputs = info
+        .space
+        .recorded(Inputs::new("sweep"))
         .option("shard", info.shard());
     if args.yosys.is_some() {
         synthesise_front(&info.space, &mut points, target, dir)?;
@@ -642,8 +643,9 @@ fn merge(out: &Path, shards: &[PathBuf], force: bool) -> Result<Outcome> {
         ],
     )?;
     let mut points: Vec<PointResult> = points.into_values().collect();
-    let inputs = Inputs::new("sweep")
-        .space(&merged.space)
+    let inputs = merged
+        .space
+        .recorded(Inputs::new("sweep"))
         .option("shard", merged.shard());
     write_results(
         staged.path(),

@@ -20,7 +20,6 @@
 //! constants from [`Datapath::constants`].
 
 use crate::cycle::{Arch, Op, RegisterView, Token, Word};
-use crate::golden::constant_formats;
 use crate::pipeline::Datapath;
 
 /// The width of the testbench's `in_n` (`tb_specfx.v`'s `N_W`).
@@ -74,7 +73,7 @@ impl Widths {
     /// ```
     pub fn of(dp: &Datapath) -> Widths {
         let cfg = dp.config();
-        let (slope, offset) = constant_formats(cfg);
+        let (slope, offset) = cfg.constant_formats();
         Widths {
             c: cfg.c.format.width(),
             n: TESTBENCH_N_W,

@@ -15,10 +15,10 @@ use std::io::{self, Write};
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 
+use crate::csv_dialect::CsvWriter;
 use crate::fixed::{Format, Rounding};
 use crate::pipeline::fast::EventCounts;
-use crate::pipeline::{Config, Datapath, NConstants, ProbeColumns, Variant};
-use crate::report::csv::CsvWriter;
+use crate::pipeline::{Config, Datapath, NConstants, ProbeColumns};
 
 pub use cases::{CaseSelection, Directed, Order, Selection};
 
@@ -75,23 +75,6 @@ pub fn n_format(config: &Config) -> Format {
     Format::unsigned(bits, 0).expect("1..=17 bits")
 }
 
-/// The formats of the per-n constant ports: (slope, offset). Plain datapaths take n with k
-/// fraction bits (the value n/m) and the constant 1; minimax ones take A(n) and A(n) + B(n)
-/// in their configured formats.
-pub fn constant_formats(config: &Config) -> (Format, Format) {
-    match config.variant {
-        Variant::Plain => {
-            let bits = (32 - config.n.max().leading_zeros()) as i32;
-            let k = config.k as i32;
-            (
-                Format::unsigned(bits - k, k).expect("1..=17 bits"),
-                Format::unsigned(1, 0).expect("one bit"),
-            )
-        }
-        Variant::Minimax => (config.minimax.a_format, config.minimax.offset_format),
-    }
-}
-
 /// The ports of a datapath's vector files, in the order they are written.
 ///
 /// Inputs first: `in_c`, `in_n`, then the per-n constants a datapath reads from its ROM
@@ -100,7 +83,7 @@ pub fn constant_formats(config: &Config) -> (Format, Format) {
 /// `expected_out`.
 pub fn ports(dp: &Datapath) -> Vec<Port> {
     let cfg = dp.config();
-    let (slope_format, offset_format) = constant_formats(cfg);
+    let (slope_format, offset_format) = cfg.constant_formats();
     let mut v = vec![
         Port::new("in_c", cfg.c.format, Source::C, "input cosine c (raw code)"),
         Port::new("in_n", n_format(cfg), Source::N, "specular exponent n"),

@@ -61,7 +61,7 @@ pub fn sample(seed: u64, index: u64) -> (Config, Arch) {
         } else {
             Variant::Minimax
         };
-        cfg.k = rng.gen_range(1..=7);
+        cfg.k = rng.gen_range(crate::reference::lobe::K_RANGE);
         cfg.cutoff = Cutoff::ALL[rng.gen_range(0..Cutoff::ALL.len())];
         cfg.n = match rng.gen_range(0..3) {
             0 => {

@@ -8,7 +8,6 @@ use serde::Serialize;
 
 use crate::cycle::Arch;
 use crate::fixed::{Overflow, Rounding};
-use crate::golden::constant_formats;
 use crate::pipeline::Datapath;
 use crate::reference::lobe::Cutoff;
 
@@ -250,7 +249,7 @@ impl Features {
 /// Counts a datapath's features on a target (see [`analytic_cost`]).
 pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
     let cfg = dp.config();
-    let (slope, offset) = constant_formats(cfg);
+    let (slope, offset) = cfg.constant_formats();
     let w = |f: crate::fixed::Format| f.width();
     // Every slope a power of two (pipelined): t's product is a shift of d by one of the
     // slope's bit positions, a multiplexer per product bit and select bit, not a multiplier.

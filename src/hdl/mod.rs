@@ -13,7 +13,6 @@ use std::fmt::Write as _;
 
 use crate::cycle::Arch;
 use crate::fixed::{Format, Overflow, Rounding};
-use crate::golden::constant_formats;
 use crate::pipeline::{Datapath, StageSpec};
 use crate::reference::lobe::Cutoff;
 
@@ -70,7 +69,7 @@ pub const MAX_SQUARES: usize = 7;
 /// ```
 pub fn top_parameters(dp: &Datapath, arch: Arch, reset_data: bool) -> Vec<(String, i64)> {
     let cfg = dp.config();
-    let (slope, offset) = constant_formats(cfg);
+    let (slope, offset) = cfg.constant_formats();
     let mut p: Vec<(String, i64)> = Vec::new();
     let mut def = |name: &str, value: i64| p.push((name.to_string(), value));
     let format = |def: &mut dyn FnMut(&str, i64), x: &str, f: Format| {
@@ -179,8 +178,9 @@ pub fn slope_is_pow2(cfg: &crate::pipeline::Config) -> bool {
         && cfg.n.values().iter().all(|n| n.is_power_of_two())
 }
 
-/// How `specfx hdl params` renders a configuration's parameters.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+/// How `specfx hdl params` renders a configuration's parameters (the command line's
+/// `--format` values, with their help, are in `cli/hdl.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ParamsFormat {
     /// `specfx_params.vh`: `` `define SPECFX_<NAME> <value> `` lines for `specfx_dut.v`.
     Define,

@@ -42,7 +42,6 @@ use serde::Serialize;
 
 use crate::cycle::Arch;
 use crate::error::Error;
-use crate::golden::constant_formats;
 use crate::pipeline::Datapath;
 
 /// The name of the harness's top module.
@@ -214,7 +213,7 @@ impl HarnessBits {
 /// ```
 pub fn harness_bits(dp: &Datapath) -> HarnessBits {
     let cfg = dp.config();
-    let (slope, offset) = constant_formats(cfg);
+    let (slope, offset) = cfg.constant_formats();
     let w = |f: crate::fixed::Format| u64::from(f.width());
     HarnessBits {
         inputs: 3 + 2 * w(cfg.c.format) + w(slope) + w(offset) + w(cfg.coef.format),

@@ -10,7 +10,6 @@
 use serde::Serialize;
 
 use crate::fixed::Format;
-use crate::golden::constant_formats;
 use crate::hdl::cost::Target;
 use crate::pipeline::{Datapath, Variant};
 use crate::reference::lobe::Cutoff;
@@ -75,7 +74,7 @@ pub fn constant_rom(dp: &Datapath, target: Target) -> ConstantRom {
     } else {
         index_bits(entries)
     };
-    let (slope, offset) = constant_formats(cfg);
+    let (slope, offset) = cfg.constant_formats();
     let mut fields = Vec::new();
     let minimax = cfg.variant == Variant::Minimax;
     if minimax || !addressed_by_n {
@@ -134,7 +133,7 @@ fn hex(raw: i64, f: Format) -> String {
 pub fn rom_verilog(dp: &Datapath) -> String {
     let cfg = dp.config();
     let rom = constant_rom(dp, Target::Generic);
-    let (slope_f, offset_f) = constant_formats(cfg);
+    let (slope_f, offset_f) = cfg.constant_formats();
     let stored = |name: &str| rom.fields.iter().any(|f| f.name == name);
     let ports = [
         ("slope", slope_f),

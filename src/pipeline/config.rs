@@ -199,6 +199,24 @@ pub fn name_from(text: &str) -> String {
 }
 
 impl Config {
+    /// The formats of the per-n constants the datapath reads from its ROM: (slope, offset).
+    /// Plain datapaths take n with k fraction bits (the value n/m) and the constant 1;
+    /// minimax ones take A(n) and A(n) + B(n) in their configured formats. The vector ports,
+    /// the ROM, the RTL's parameters and the cost model all use these.
+    pub fn constant_formats(&self) -> (Format, Format) {
+        match self.variant {
+            Variant::Plain => {
+                let bits = (32 - self.n.max().leading_zeros()) as i32;
+                let k = self.k as i32;
+                (
+                    Format::unsigned(bits - k, k).expect("1..=17 bits"),
+                    Format::unsigned(1, 0).expect("one bit"),
+                )
+            }
+            Variant::Minimax => (self.minimax.a_format, self.minimax.offset_format),
+        }
+    }
+
     /// The built-in `baseline` configuration (see `docs/arithmetic.md`).
     ///
     /// # Examples

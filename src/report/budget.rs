@@ -3,6 +3,7 @@
 
 use crate::analysis::budget::{BudgetReport, Histogram, PerN};
 use crate::analysis::check::Input;
+use crate::analysis::LSB8;
 use crate::report::chart::{Chart, Dash, RefLine, Series};
 use crate::report::doc::Block;
 
@@ -17,9 +18,6 @@ fn ulp(x: f64) -> String {
 fn at(i: &Input) -> String {
     format!("n = {}, c = {:.6} (code {})", i.n, i.c, i.c_raw)
 }
-
-/// One lsb8: a step of an 8-bit display at the lobe's peak (2^-8, as in `1 lsb8` budgets).
-const LSB8: f64 = 1.0 / 256.0;
 
 /// A histogram as bars, one per non-empty bin (an absent bar is an empty bin).
 fn histogram_series(h: &Histogram, label: &str, i: usize) -> Series {

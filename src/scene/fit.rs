@@ -423,7 +423,7 @@ pub fn floors(
     start_frac: i32,
 ) -> Vec<Floor> {
     let mut v = Vec::new();
-    for k in 1..=7 {
+    for k in crate::reference::lobe::K_RANGE {
         for variant in [Variant::Plain, Variant::Minimax] {
             let dp = start_of(base, Algorithm { k, variant }, start_frac).and_then(Datapath::new);
             let floor = match dp {

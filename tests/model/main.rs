@@ -13,6 +13,7 @@ mod cycle_model;
 mod datapath_props;
 mod engine;
 mod furnace;
+mod layers;
 mod minimax;
 mod oracle;
 mod paper;
