@@ -8,12 +8,12 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::analysis::furnace::{Curve, FormSummary, FurnacePath, FurnaceReport};
+use crate::csv_dialect::CsvWriter;
 use crate::error::Error;
 use crate::report::chart::{
     draw_chart, draw_sample, encode_png, register_font, render_error, Chart, Dash, Marker, RefLine,
     Series, OKABE_ITO,
 };
-use crate::report::csv::CsvWriter;
 use crate::report::doc::Block;
 use crate::report::table::{Align, TextTable};
 

@@ -6,9 +6,9 @@ use std::io::{self, Write};
 
 use plotters::prelude::*;
 
+use crate::csv_dialect::CsvWriter;
 use crate::error::Error;
 use crate::report::chart::{encode_png, encode_png_depth, register_font, render_error};
-use crate::report::csv::CsvWriter;
 use crate::report::table::{Align, TextTable};
 use crate::scene::render::{ImageError, InputsOfN, Rendered, INPUT_BINS};
 

@@ -11,8 +11,8 @@ use plotters::prelude::*;
 use crate::analysis::stability::{
     Kind, PathMap, StabilityReport, HEAT_ROWS, OVERSHOOT_J_MAX, SPECIAL_N,
 };
+use crate::csv_dialect::CsvWriter;
 use crate::report::chart::{lsb8, register_font, style, Chart, Dash, Series};
-use crate::report::csv::CsvWriter;
 use crate::report::doc::Block;
 use plotters::element::DashedPathElement;
 

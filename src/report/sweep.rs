@@ -6,9 +6,9 @@ use std::io::{self, Write};
 
 use crate::analysis::sweep::PointResult;
 use crate::analysis::LSB8;
+use crate::csv_dialect::CsvWriter;
 use crate::hdl::cost::Target;
 use crate::report::chart::{front_2d, Chart, Dash, Marker, RefLine, Series};
-use crate::report::csv::CsvWriter;
 
 /// The CSV of a sweep: one row per point, in index order; the cost columns are named with the
 /// target and unit (`ice40_luts,ice40_dsps,ice40_ffs`, `generic_gates,..`). Empty cells where

@@ -6,9 +6,9 @@ use std::io::{self, Write};
 
 use crate::analysis::tradeoff::MethodFigures;
 use crate::analysis::LSB8;
+use crate::csv_dialect::CsvWriter;
 use crate::hdl::cost::{CostFigures, Target};
 use crate::report::chart::{front_2d, Chart, Dash, Marker, RefLine, Series};
-use crate::report::csv::CsvWriter;
 use crate::report::table::{Align, TextTable};
 
 /// A method's analytic cost on a target, if it has one.
