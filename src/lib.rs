@@ -31,5 +31,6 @@ pub mod provenance;
 pub mod reference;
 pub mod report;
 pub mod scene;
+pub mod tools;
 
 pub use error::Error;

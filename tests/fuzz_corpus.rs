@@ -183,3 +183,8 @@ fn mesh_stl_corpus() {
 fn trace_corpus() {
     assert!(replay("trace") > 0);
 }
+
+#[test]
+fn testbench_log_corpus() {
+    assert!(replay("testbench_log") > 0);
+}

@@ -12,6 +12,7 @@ use specfx::analysis::sweep::{Space, MAX_POINTS};
 use specfx::cycle::compare::compare;
 use specfx::fixed::{Format, Overflow, Rounding};
 use specfx::golden::verify::{VerifiedManifest, CSV_FILE};
+use specfx::hdl::testbench::parse_log;
 use specfx::nset::{NSet, N_MAX};
 use specfx::pipeline::{Config, Datapath};
 use specfx::scene::fit::ImageBudget;
@@ -34,6 +35,7 @@ pub const TARGETS: &[(&str, Check)] = &[
     ("mesh_obj", mesh_obj),
     ("mesh_stl", mesh_stl),
     ("trace", trace),
+    ("testbench_log", testbench_log),
 ];
 
 /// A refused input: its error is one line; not accepted.
@@ -409,5 +411,32 @@ pub fn trace(data: &[u8]) -> bool {
             );
             true
         }
+    }
+}
+
+/// A simulator's log of the reference testbench (`specfx cosim`): `hdl::testbench::parse_log`.
+/// A log without a summary is refused with one line; an accepted log's problems are exactly
+/// its lines that begin with a problem's word, and a summary line appended to any log is the
+/// one read.
+pub fn testbench_log(data: &[u8]) -> bool {
+    let log = String::from_utf8_lossy(data);
+    let problems = log
+        .lines()
+        .filter(|l| {
+            ["mismatch", "protocol", "unexpected", "timeout"]
+                .iter()
+                .any(|p| l.starts_with(p))
+        })
+        .count();
+    let appended = format!("{log}\n7 passed, 3 failed\n");
+    let tally = parse_log(&appended).expect("a log ending with its summary");
+    assert_eq!((tally.passed, tally.failed), (7, 3), "{log:?}");
+    assert_eq!(tally.problems.len(), problems, "{log:?}");
+    match parse_log(&log) {
+        Ok(t) => {
+            assert_eq!(t.problems.len(), problems, "{log:?}");
+            true
+        }
+        Err(e) => refused(&log, &e),
     }
 }

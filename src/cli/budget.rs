@@ -2,9 +2,8 @@
 //! with gappa's formal bounds when gappa is installed.
 
 use std::fs;
-use std::io::{ErrorKind, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
@@ -73,32 +72,6 @@ pub fn spread(ns: &[u32]) -> Vec<u32> {
     picked
 }
 
-/// Runs gappa on one script; `Ok(None)` when gappa is not installed.
-fn run_gappa(script: &str) -> Result<Option<String>> {
-    let child = super::child::spawn(
-        Command::new("gappa")
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped()),
-    );
-    let mut child = match child {
-        Ok(c) => c,
-        Err(e) if e.kind() == ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(anyhow!("cannot run gappa: {e}")),
-    };
-    child
-        .stdin
-        .take()
-        .expect("piped stdin")
-        .write_all(script.as_bytes())
-        .context("cannot write to gappa")?;
-    let out = super::child::wait(child).context("gappa did not finish")?;
-    // gappa prints its results on stderr.
-    let mut text = String::from_utf8_lossy(&out.stderr).into_owned();
-    text.push_str(&String::from_utf8_lossy(&out.stdout));
-    Ok(Some(text))
-}
-
 /// Proves bounds with gappa for the chosen exponents and adds them to the report.
 fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Result<()> {
     let jobs: Vec<(u32, Result<gappa::Job, specfx::Error>)> = ns
@@ -114,7 +87,7 @@ fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Re
                 Err(why) => return Ok(Some((*n, f64::NAN, why.to_string()))),
             };
             let output = if job.upper_from.is_some() {
-                match run_gappa(&job.script)? {
+                match specfx::tools::gappa::run(&job.script)? {
                     Some(text) => text,
                     None => return Ok(None),
                 }

@@ -13,7 +13,6 @@ use clap::Args;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::cost::run_yosys;
 use super::output::{print_json, print_with};
 use super::Outcome;
 use specfx::hdl::calibrate::{calibration, fit, read_records, sample, Calibration, Record};
@@ -158,15 +157,15 @@ fn collect(args: &CalibrateArgs, plan: &mut Plan, hdl_ref: &Path) -> Result<Vec<
         .map(|&index| {
             let (config, arch) = sample(args.seed, index);
             let dp = Datapath::new(config.clone())?;
-            let r = match run_yosys(&dp, arch, target, hdl_ref) {
-                Ok((y, _, _)) => Record {
+            let r = match specfx::tools::yosys::synthesise(&dp, arch, target, hdl_ref) {
+                Ok(s) => Record {
                     index,
                     arch,
                     config,
-                    luts: y.luts,
-                    carries: y.carries,
-                    dsps: y.dsps,
-                    ffs: y.ffs,
+                    luts: s.cost.luts,
+                    carries: s.cost.carries,
+                    dsps: s.cost.dsps,
+                    ffs: s.cost.ffs,
                 },
                 Err(e) => {
                     let first = format!("{e:#}").lines().next().unwrap_or("").to_string();
@@ -223,7 +222,7 @@ fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
     let hdl_ref = if args.fit_only {
         None
     } else {
-        let dir = super::cost::hdl_ref(args.hdl_ref.as_deref())?;
+        let dir = super::hdl_ref::hdl_ref(args.hdl_ref.as_deref())?;
         super::output::check_can_create(&args.data, "--data")?;
         Some(dir)
     };
@@ -273,7 +272,7 @@ fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
         });
     }
     if plans.iter().any(|p| !p.todo.is_empty()) {
-        super::cost::check_yosys()?;
+        specfx::tools::yosys::check()?;
     }
     Ok((plans, hdl_ref))
 }

@@ -7,7 +7,6 @@
 //! cocotb, VUnit or FuseSoC flow instantiates.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
@@ -15,8 +14,10 @@ use clap::{Args, ValueEnum};
 use super::hdl::{write_stimulus, RunOpts};
 use super::Outcome;
 use specfx::golden::{CaseSelection, Order};
+use specfx::hdl::testbench::parse_log;
 use specfx::hdl::{render_parameters, ParamsFormat};
 use specfx::nset::NSet;
+use specfx::tools;
 
 /// A Verilog simulator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -27,33 +28,13 @@ pub enum Simulator {
     Verilator,
 }
 
-impl Simulator {
-    fn name(self) -> &'static str {
-        match self {
-            Simulator::Icarus => "icarus",
-            Simulator::Verilator => "verilator",
+impl From<Simulator> for tools::simulator::Simulator {
+    fn from(s: Simulator) -> Self {
+        match s {
+            Simulator::Icarus => tools::simulator::Simulator::Icarus,
+            Simulator::Verilator => tools::simulator::Simulator::Verilator,
         }
     }
-
-    /// The programs it needs and the Debian package that has them.
-    fn programs(self) -> (&'static [&'static str], &'static str) {
-        match self {
-            Simulator::Icarus => (&["iverilog", "vvp"], "iverilog"),
-            Simulator::Verilator => (&["verilator"], "verilator"),
-        }
-    }
-
-    fn installed(self) -> bool {
-        self.programs().0.iter().all(|p| find_program(p).is_some())
-    }
-}
-
-/// The program's path on `PATH`, if it is there.
-pub fn find_program(name: &str) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|dir| dir.join(name))
-        .find(|p| p.is_file())
 }
 
 /// Arguments of `specfx cosim`.
@@ -108,21 +89,10 @@ pub struct CosimArgs {
     keep: bool,
 }
 
-/// The testbench's verdict.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Verdict {
-    /// Vectors whose output and cycle matched.
-    pub passed: u64,
-    /// Vectors that did not, plus protocol failures.
-    pub failed: u64,
-    /// The testbench's problem lines (mismatch, protocol, unexpected, timeout).
-    pub problems: Vec<String>,
-}
-
 /// Runs `specfx cosim`. Exit code 1 when a vector failed or nothing was checked.
 pub fn run(args: &CosimArgs) -> Result<Outcome> {
-    let sim = choose_simulator(args.sim)?;
-    if args.lint && !Simulator::Verilator.installed() {
+    let sim = choose_simulator(args.sim.map(Into::into))?;
+    if args.lint && !tools::simulator::Simulator::Verilator.installed() {
         bail!("--lint: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator)");
     }
     if let (Some(vcd), Some(v)) = (&args.vcd, &args.vectors) {
@@ -149,7 +119,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         super::output::check_file_output(&rtl, "--vcd", &inputs, None, args.force || earlier)?;
     }
     // Absolute: the simulator runs in the work directory.
-    let hdl = super::cost::hdl_ref_dir(args.hdl_ref.as_deref());
+    let hdl = super::hdl_ref::hdl_ref_dir(args.hdl_ref.as_deref());
     let hdl = std::path::absolute(&hdl)
         .with_context(|| format!("--hdl-ref {}: cannot resolve it", hdl.display()))?;
     let rtl = rtl_sources(&hdl)?;
@@ -157,7 +127,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     if !tb.is_file() {
         bail!("{}: the testbench is missing", tb.display());
     }
-    let work = super::child::work_dir("cosim").context("cannot create a work directory")?;
+    let work = tools::child::work_dir("cosim").context("cannot create a work directory")?;
     let wd = work.path();
 
     // The vectors: given, or written for --config.
@@ -223,18 +193,13 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
 
     if args.lint {
         log::info!("cosim: verilator --lint-only -Wall (specfx_top + rtl)");
-        let mut cmd = Command::new("verilator");
-        cmd.args(["--lint-only", "-Wall", "--top-module", "specfx_top"])
-            .args(
-                params
-                    .iter()
-                    .filter(|(k, _)| k != "NVEC" && k != "NCYC")
-                    .map(|(k, v)| format!("-G{k}={v}")),
-            )
-            .args(&rtl);
-        let o = super::child::output(&mut cmd).context("cannot run verilator")?;
-        if !o.status.success() || !o.stderr.is_empty() {
-            log::error!("{}", String::from_utf8_lossy(&o.stderr).trim_end());
+        let top: Vec<(String, i64)> = params
+            .iter()
+            .filter(|(k, _)| k != "NVEC" && k != "NCYC")
+            .cloned()
+            .collect();
+        if let Some(complaints) = tools::simulator::lint(&rtl, &top)? {
+            log::error!("{complaints}");
             log::error!("cosim: lint failed");
             return Ok(Outcome::CheckFailed);
         }
@@ -256,7 +221,10 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             ""
         }
     );
-    let log = simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
+    if sim == tools::simulator::Simulator::Verilator {
+        log::info!("cosim: building with verilator (a minute or less)");
+    }
+    let log = tools::simulator::simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
     let verdict = parse_log(&log);
     // The RTL's trace: a testbench that ran to its summary must have written it; one that
     // died may have written none, and then there is nothing to compare.
@@ -332,7 +300,10 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     }
 }
 
-fn choose_simulator(asked: Option<Simulator>) -> Result<Simulator> {
+fn choose_simulator(
+    asked: Option<tools::simulator::Simulator>,
+) -> Result<tools::simulator::Simulator> {
+    use tools::simulator::Simulator;
     let hint = |s: Simulator| {
         let (programs, package) = s.programs();
         format!(
@@ -343,7 +314,7 @@ fn choose_simulator(asked: Option<Simulator>) -> Result<Simulator> {
     match asked {
         Some(s) if s.installed() => Ok(s),
         Some(s) => bail!("--sim {}: {}", s.name(), hint(s)),
-        None => [Simulator::Icarus, Simulator::Verilator]
+        None => Simulator::ALL
             .into_iter()
             .find(|s| s.installed())
             .ok_or_else(|| {
@@ -358,114 +329,11 @@ fn choose_simulator(asked: Option<Simulator>) -> Result<Simulator> {
 
 /// Every `rtl/*.v` of a reference Verilog directory, sorted.
 fn rtl_sources(hdl: &Path) -> Result<Vec<PathBuf>> {
-    let mut files = super::cost::rtl_files(hdl)?;
+    let mut files = tools::rtl_files(hdl)?;
     // rtl_files ends with specfx_dut.v, the `define top; the co-simulation uses specfx_top.
     files.retain(|f| f.parent().is_some_and(|p| p.ends_with("rtl")));
     if !files.iter().any(|f| f.ends_with("specfx_top.v")) {
         bail!("{}: no rtl/specfx_top.v", hdl.display());
     }
     Ok(files)
-}
-
-/// Compiles and runs the testbench in `wd`; returns the simulator's output.
-fn simulate(
-    sim: Simulator,
-    wd: &Path,
-    tb: &Path,
-    rtl: &[PathBuf],
-    params: &[(String, i64)],
-    vcd: bool,
-) -> Result<String> {
-    let run = |cmd: &mut Command, what: &str| -> Result<std::process::Output> {
-        let o = super::child::output(cmd.current_dir(wd))
-            .with_context(|| format!("cannot run {what}"))?;
-        Ok(o)
-    };
-    match sim {
-        Simulator::Icarus => {
-            let mut cmd = Command::new("iverilog");
-            cmd.args(["-g2005", "-s", "tb_specfx", "-o", "tb.vvp"])
-                .args(params.iter().map(|(k, v)| format!("-Ptb_specfx.{k}={v}")));
-            if vcd {
-                cmd.arg("-DSPECFX_VCD");
-            }
-            let o = run(cmd.arg(tb).args(rtl), "iverilog")?;
-            if !o.status.success() {
-                bail!(
-                    "iverilog failed: {}",
-                    String::from_utf8_lossy(&o.stderr).trim()
-                );
-            }
-            let o = run(Command::new("vvp").args(["-n", "tb.vvp"]), "vvp")?;
-            Ok(String::from_utf8_lossy(&o.stdout).into_owned()
-                + &String::from_utf8_lossy(&o.stderr))
-        }
-        Simulator::Verilator => {
-            log::info!("cosim: building with verilator (a minute or less)");
-            let mut cmd = Command::new("verilator");
-            cmd.args([
-                "--binary",
-                "-j",
-                "0",
-                "-Wno-fatal",
-                "-Wno-lint",
-                "-Wno-style",
-                "--top-module",
-                "tb_specfx",
-                "-Mdir",
-                "obj",
-            ])
-            .args(params.iter().map(|(k, v)| format!("-G{k}={v}")));
-            if vcd {
-                cmd.args(["--trace", "-DSPECFX_VCD"]);
-            }
-            let o = run(cmd.arg(tb).args(rtl), "verilator")?;
-            if !o.status.success() {
-                let err = String::from_utf8_lossy(&o.stderr);
-                let first = err
-                    .lines()
-                    .find(|l| l.contains("%Error"))
-                    .unwrap_or("see its output");
-                bail!("verilator failed: {}", first.trim());
-            }
-            let o = run(&mut Command::new(wd.join("obj/Vtb_specfx")), "the model")?;
-            Ok(String::from_utf8_lossy(&o.stdout).into_owned()
-                + &String::from_utf8_lossy(&o.stderr))
-        }
-    }
-}
-
-/// The testbench's problem lines and its `N passed, N failed` summary.
-///
-/// # Errors
-/// When the summary line is missing (the simulation died or never finished).
-pub fn parse_log(log: &str) -> Result<Verdict> {
-    let problems: Vec<String> = log
-        .lines()
-        .filter(|l| {
-            ["mismatch", "protocol", "unexpected", "timeout"]
-                .iter()
-                .any(|p| l.starts_with(p))
-        })
-        .map(str::to_string)
-        .collect();
-    let summary = log.lines().rev().find_map(|l| {
-        let (p, f) = l.trim().split_once(" passed, ")?;
-        let f = f.strip_suffix(" failed")?;
-        Some((p.parse::<u64>().ok()?, f.parse::<u64>().ok()?))
-    });
-    match summary {
-        Some((passed, failed)) => Ok(Verdict {
-            passed,
-            failed,
-            problems,
-        }),
-        None => {
-            let tail: Vec<&str> = log.lines().rev().take(5).collect();
-            bail!(
-                "the simulation printed no `N passed, N failed` line; its last lines: {}",
-                tail.into_iter().rev().collect::<Vec<_>>().join(" | ")
-            )
-        }
-    }
 }

@@ -116,9 +116,9 @@ fn side_cost(dp: &Datapath, target: Target, yosys: bool) -> Result<SideCost> {
     let a = analytic_cost(dp, Arch::Pipelined, target);
     let rom = constant_rom(dp, target);
     let (y, ry) = if yosys {
-        let hdl = super::cost::hdl_ref_dir(None);
-        let (y, _, _) = super::cost::run_yosys(dp, Arch::Pipelined, target, &hdl)?;
-        let (ry, _, _) = super::cost::run_yosys_rom(dp, target)?;
+        let hdl = super::hdl_ref::hdl_ref_dir(None);
+        let y = specfx::tools::yosys::synthesise(dp, Arch::Pipelined, target, &hdl)?.cost;
+        let ry = specfx::tools::yosys::synthesise_rom(dp, target)?.cost;
         (Some(y), Some(ry))
     } else {
         (None, None)

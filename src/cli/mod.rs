@@ -6,13 +6,13 @@
 pub mod budget;
 mod calibrate;
 mod check;
-mod child;
 mod cosim;
 pub mod cost;
 mod datapath;
 pub mod fit;
 pub mod furnace;
 mod hdl;
+mod hdl_ref;
 mod input;
 mod logging;
 mod optimize;

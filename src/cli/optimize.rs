@@ -87,18 +87,13 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         "yosys" => true,
         other => bail!("--objective: expected analytic or yosys, got '{other}'"),
     };
-    let hdl = super::cost::hdl_ref_dir(None);
+    let hdl = super::hdl_ref::hdl_ref_dir(None);
     let arch = args.arch;
     let target = args.target;
     let unit = format!("{} on {}", target.logic_unit(), target.name());
     let cost = |dp: &Datapath| -> Result<f64, specfx::Error> {
         if yosys {
-            super::cost::run_yosys(dp, arch, target, &hdl)
-                .map(|(c, _, _)| c.luts as f64)
-                .map_err(|e| specfx::Error::Tool {
-                    tool: "yosys",
-                    message: format!("{e:#}"),
-                })
+            specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| s.cost.luts as f64)
         } else {
             Ok(analytic_cost(dp, arch, target).luts as f64)
         }
@@ -142,17 +137,14 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                  arch: Arch,
                  target: Target|
      -> Result<specfx::hdl::cost::CostFigures, specfx::Error> {
-        super::cost::run_yosys(dp, arch, target, &hdl)
-            .map(|(c, _, _)| specfx::hdl::cost::CostFigures {
+        specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| {
+            specfx::hdl::cost::CostFigures {
                 target,
-                luts: c.luts,
-                dsps: c.dsps,
-                ffs: c.ffs,
-            })
-            .map_err(|e| specfx::Error::Tool {
-                tool: "yosys",
-                message: format!("{e:#}"),
-            })
+                luts: s.cost.luts,
+                dsps: s.cost.dsps,
+                ffs: s.cost.ffs,
+            }
+        })
     };
     let r = optimize_all(
         &base,

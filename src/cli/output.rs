@@ -208,7 +208,7 @@ pub static RESUME_HINT: std::sync::Mutex<Option<String>> = std::sync::Mutex::new
 /// previous results stay as they were) and exits with code 130.
 pub fn install_interrupt_handler() {
     let _ = ctrlc::set_handler(|| {
-        super::child::end_all();
+        specfx::tools::child::end_all();
         if let Ok(dirs) = STAGING.lock() {
             for d in dirs.iter() {
                 let _ = std::fs::remove_dir_all(d);

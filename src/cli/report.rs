@@ -33,18 +33,6 @@ pub struct ReportArgs {
     restart: bool,
 }
 
-/// The first line of `tool flag`'s output when the tool runs, else None.
-fn tool_version(tool: &str, flag: &str) -> Option<String> {
-    super::child::output(std::process::Command::new(tool).arg(flag))
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| {
-            let text = String::from_utf8_lossy(&o.stdout).into_owned()
-                + &String::from_utf8_lossy(&o.stderr);
-            text.lines().next().unwrap_or("").trim().to_string()
-        })
-}
-
 /// Renders into a buffer and writes it atomically to `dir/name`; returns the path.
 fn emit(
     dir: &Path,
@@ -90,7 +78,7 @@ struct TimingRow {
 }
 
 impl CostRow {
-    fn new(c: &super::cost::CostReport) -> CostRow {
+    fn new(c: &specfx::hdl::cost::CostReport) -> CostRow {
         CostRow {
             arch: c.arch,
             luts: c.luts.unwrap_or(0),
@@ -385,9 +373,9 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     let (out_dir, resumed) =
         super::output::OutDir::begin_resumable(&args.out, "report", args.force, &[], args.restart)?;
     let dir = out_dir.path();
-    let yosys_version = tool_version("yosys", "-V");
-    let nextpnr_version = tool_version("nextpnr-ice40", "--version");
-    let hdl = super::cost::hdl_ref_dir(None);
+    let yosys_version = specfx::tools::version("yosys", "-V");
+    let nextpnr_version = specfx::tools::version("nextpnr-ice40", "--version");
+    let hdl = super::hdl_ref::hdl_ref_dir(None);
     let key = super::resume::run_key(&format!(
         "yosys {yosys_version:?}\nnextpnr-ice40 {nextpnr_version:?}\nhdl_ref {}",
         hdl.display()
@@ -491,7 +479,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         costs = resume.step("costs", &["cost_baseline.txt"], || {
             let mut reports = Vec::new();
             for arch in specfx::cycle::Arch::ALL {
-                let mut c = super::cost::cost_report(
+                let mut c = specfx::tools::yosys::cost_report(
                     &dp,
                     arch,
                     specfx::hdl::cost::Target::Ice40,
@@ -509,7 +497,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
                     steps.part(&format!(
                         "placing and routing baseline ({arch}) on an iCE40 UP5K with nextpnr"
                     ));
-                    c.timing = Some(super::pnr::run_timing(
+                    c.timing = Some(specfx::tools::nextpnr::place_and_route(
                         &dp,
                         arch,
                         specfx::hdl::pnr::Device::Up5k,
@@ -520,7 +508,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             }
             emit(dir, "cost_baseline.txt", |b| {
                 for c in &reports {
-                    super::cost::write_cost(b, c, None)?;
+                    specfx::report::cost::write_cost(b, c, None)?;
                 }
                 Ok(())
             })?;

@@ -412,7 +412,7 @@ fn synthesise_front(
         .filter_map(|l| serde_json::from_str::<Synth>(l).ok())
         .map(|s| (s.index, s))
         .collect();
-    let hdl = super::cost::hdl_ref_dir(None);
+    let hdl = super::hdl_ref::hdl_ref_dir(None);
     for p in points.iter_mut().filter(|p| p.pareto) {
         if let std::collections::btree_map::Entry::Vacant(slot) = known.entry(p.index) {
             let (cfg, arch) = space.point(p.index).map_err(anyhow::Error::msg)?;
@@ -421,7 +421,7 @@ fn synthesise_front(
                 "sweep: synthesising Pareto point {} with yosys ({target})",
                 p.index
             );
-            let (cost, _, _) = super::cost::run_yosys(&dp, arch, target, &hdl)?;
+            let cost = specfx::tools::yosys::synthesise(&dp, arch, target, &hdl)?.cost;
             let s = Synth {
                 index: p.index,
                 luts: cost.luts,

@@ -90,9 +90,14 @@ pub fn tradeoff(
                 "tradeoff: synthesising {} with yosys ({target})",
                 dp.config().name
             );
-            let hdl = super::cost::hdl_ref_dir(None);
-            let (cost, _, _) =
-                super::cost::run_yosys(&dp, specfx::cycle::Arch::Pipelined, target, &hdl)?;
+            let hdl = super::hdl_ref::hdl_ref_dir(None);
+            let cost = specfx::tools::yosys::synthesise(
+                &dp,
+                specfx::cycle::Arch::Pipelined,
+                target,
+                &hdl,
+            )?
+            .cost;
             f.yosys = Some(YosysFigures {
                 target: target.to_string(),
                 luts: cost.luts,

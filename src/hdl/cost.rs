@@ -1,5 +1,6 @@
-//! Hardware cost: a fast analytic model from the formats, and the yosys script and statistics
-//! parser behind `specfx cost` (which runs yosys; nothing here starts a process).
+//! Hardware cost: a fast analytic model from the formats, the yosys script and statistics
+//! parser behind `specfx cost` (`tools::yosys` runs yosys; nothing here starts a process),
+//! and the cost report that puts them side by side.
 
 use crate::error::Error;
 use std::collections::BTreeMap;
@@ -614,5 +615,92 @@ mod tests {
         let c = parse_stat_json(text, Some(cmos)).unwrap();
         assert_eq!(c.transistors, Some(78370));
         assert!(parse_stat_json("{}", None).is_err());
+    }
+}
+
+/// What one yosys synthesis gives: its figures, its version and the exact script it ran.
+#[derive(Debug, Clone)]
+pub struct Synthesis {
+    /// yosys's figures.
+    pub cost: YosysCost,
+    /// `yosys -V`.
+    pub version: String,
+    /// The script yosys ran.
+    pub script: String,
+}
+
+/// Everything `specfx cost` reports.
+#[derive(Debug, Serialize)]
+pub struct CostReport {
+    /// Configuration name.
+    pub config: String,
+    /// Architecture.
+    pub arch: Arch,
+    /// Synthesis target.
+    pub target: Target,
+    /// The analytic model's figures.
+    pub analytic: AnalyticCost,
+    /// yosys's figures, when it ran.
+    pub yosys: Option<YosysCost>,
+    /// yosys LUTs (or gates, for generic).
+    pub luts: Option<u64>,
+    /// yosys DSP blocks.
+    pub dsps: Option<u64>,
+    /// yosys flip-flops.
+    pub ffs: Option<u64>,
+    /// The per-n constant ROM in front of the datapath (not in the figures above).
+    pub rom: crate::hdl::rom::ConstantRom,
+    /// yosys's figures for the ROM alone (`specfx_rom`), when it ran.
+    pub rom_yosys: Option<YosysCost>,
+    /// `yosys -V`.
+    pub yosys_version: Option<String>,
+    /// The exact script yosys ran.
+    pub yosys_script: Option<String>,
+    /// yosys LUTs / analytic LUTs.
+    pub lut_ratio: Option<f64>,
+    /// yosys flip-flops / analytic flip-flops.
+    pub ff_ratio: Option<f64>,
+    /// The device the figures are checked against (iCE40 targets only).
+    pub device: Option<crate::hdl::pnr::Device>,
+    /// Resources beyond the device, from yosys's figures when it ran, else the analytic ones.
+    pub over_limit: Vec<String>,
+    /// Place-and-route timing (`--timing`).
+    pub timing: Option<crate::hdl::pnr::Timing>,
+}
+
+impl CostReport {
+    /// The report of `dp` on `target`: the analytic model's figures, beside yosys's synthesis
+    /// of the datapath and the figures of its constant ROM when given; no device, no timing.
+    pub fn new(
+        dp: &Datapath,
+        arch: Arch,
+        target: Target,
+        synthesis: Option<(Synthesis, YosysCost)>,
+    ) -> CostReport {
+        let analytic = analytic_cost(dp, arch, target);
+        let (yosys, version, script, rom_yosys) = match synthesis {
+            None => (None, None, None, None),
+            Some((s, rom)) => (Some(s.cost), Some(s.version), Some(s.script), Some(rom)),
+        };
+        let ratio = |a: u64, b: u64| (b > 0).then(|| a as f64 / b as f64);
+        CostReport {
+            config: dp.config().name.clone(),
+            arch,
+            target,
+            luts: yosys.as_ref().map(|y| y.luts),
+            dsps: yosys.as_ref().map(|y| y.dsps),
+            ffs: yosys.as_ref().map(|y| y.ffs),
+            lut_ratio: yosys.as_ref().and_then(|y| ratio(y.luts, analytic.luts)),
+            ff_ratio: yosys.as_ref().and_then(|y| ratio(y.ffs, analytic.ffs)),
+            analytic,
+            yosys,
+            rom: crate::hdl::rom::constant_rom(dp, target),
+            rom_yosys,
+            yosys_version: version,
+            yosys_script: script,
+            device: None,
+            over_limit: Vec::new(),
+            timing: None,
+        }
     }
 }

@@ -8,6 +8,7 @@ pub mod calibrate;
 pub mod cost;
 pub mod pnr;
 pub mod rom;
+pub mod testbench;
 
 use std::fmt::Write as _;
 

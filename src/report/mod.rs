@@ -3,6 +3,7 @@
 pub mod budget;
 pub mod chart;
 pub mod check;
+pub mod cost;
 pub mod csv;
 pub mod doc;
 pub mod furnace;

@@ -159,3 +159,37 @@ fn the_import_reader_sees_code_only() {
         [(2, "report".to_string()), (5, "fixed".to_string())]
     );
 }
+
+/// External programs have one home: no file of `src/` outside `src/tools/` names
+/// `std::process::Command` (the library receives a tool as a closure; the CLI calls
+/// `specfx::tools`).
+#[test]
+fn only_tools_starts_a_process() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let tools = src.join("tools");
+    let mut found = Vec::new();
+    for path in sources(&src) {
+        if path.starts_with(&tools) {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        for (i, line) in text.lines().enumerate() {
+            let code = line.trim_start();
+            if code.starts_with("//") {
+                continue;
+            }
+            let process = code.contains("process::") && code.contains("Command");
+            if process || (code.contains("Command::new(") && !code.contains("clap::")) {
+                found.push(format!(
+                    "src/{}:{}",
+                    path.strip_prefix(&src).unwrap().display(),
+                    i + 1
+                ));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "processes started outside src/tools/: {found:?}"
+    );
+}

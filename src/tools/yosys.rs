@@ -1,0 +1,110 @@
+//! yosys: the synthesis of the reference Verilog (and of the constant ROM) whose statistics
+//! are the cost figures of `cost`, `report`, `fit`, sweeps, calibration and the optimiser.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use super::{child, error, io_error, work_dir, write};
+use crate::cycle::Arch;
+use crate::error::Error;
+use crate::hdl::cost::{parse_stat_json, yosys_script, CostReport, Synthesis, Target};
+use crate::hdl::params_header;
+use crate::hdl::rom::rom_verilog;
+use crate::pipeline::Datapath;
+
+/// Checks before any work that yosys runs; returns `yosys -V`.
+pub fn check() -> Result<String, Error> {
+    let out = child::output(Command::new("yosys").arg("-V")).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => error(
+            "yosys",
+            "yosys not found: install it (Debian: apt-get install yosys)".into(),
+        ),
+        _ => io_error("yosys", "cannot run yosys", e),
+    })?;
+    if !out.status.success() {
+        return Err(error("yosys", format!("yosys -V failed: {}", out.status)));
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+/// Synthesises the datapath: the reference Verilog in `hdl_ref` with the configuration's
+/// parameter header, on `target`.
+pub fn synthesise(
+    dp: &Datapath,
+    arch: Arch,
+    target: Target,
+    hdl_ref: &Path,
+) -> Result<Synthesis, Error> {
+    let work = work_dir("yosys", "yosys")?;
+    write(
+        "yosys",
+        &work.path().join("specfx_params.vh"),
+        &params_header(dp, arch),
+    )?;
+    let files = super::rtl_files(hdl_ref)?;
+    run_in(work.path(), &files, "specfx_dut", target).map_err(|e| {
+        error(
+            "yosys",
+            format!("yosys failed on the reference Verilog: {e}"),
+        )
+    })
+}
+
+/// Synthesises the configuration's constant ROM (`specfx_rom`, generated) on `target`.
+pub fn synthesise_rom(dp: &Datapath, target: Target) -> Result<Synthesis, Error> {
+    let work = work_dir("yosys", "yosys")?;
+    let file = work.path().join("specfx_rom.v");
+    write("yosys", &file, &rom_verilog(dp))?;
+    run_in(work.path(), &[file], "specfx_rom", target)
+        .map_err(|e| error("yosys", format!("yosys failed on the constant ROM: {e}")))
+}
+
+/// Runs yosys in `work` on `files` with `top`.
+fn run_in(work: &Path, files: &[PathBuf], top: &str, target: Target) -> Result<Synthesis, Error> {
+    let version = check()?;
+    let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+    let script = yosys_script(target, &files, &work.display().to_string(), top);
+    write("yosys", &work.join("cost.ys"), &script)?;
+    let out = child::output(
+        Command::new("yosys")
+            .args(["-q", "-s", "cost.ys"])
+            .current_dir(work),
+    )
+    .map_err(|e| io_error("yosys", "cannot run yosys", e))?;
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        let first = err
+            .lines()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("no message");
+        return Err(error("yosys", first.to_string()));
+    }
+    let stat = std::fs::read_to_string(work.join("stat.json"))
+        .map_err(|e| io_error("yosys", "yosys wrote no statistics", e))?;
+    let cmos = std::fs::read_to_string(work.join("stat_cmos.txt")).ok();
+    let cost = parse_stat_json(&stat, cmos.as_deref())?;
+    Ok(Synthesis {
+        cost,
+        version,
+        script,
+    })
+}
+
+/// The cost report of `specfx cost`: the analytic model's figures, beside yosys's for the
+/// datapath and its constant ROM unless `analytic_only`.
+pub fn cost_report(
+    dp: &Datapath,
+    arch: Arch,
+    target: Target,
+    hdl_ref: &Path,
+    analytic_only: bool,
+) -> Result<CostReport, Error> {
+    let synthesis = if analytic_only {
+        None
+    } else {
+        let datapath = synthesise(dp, arch, target, hdl_ref)?;
+        let rom = synthesise_rom(dp, target)?;
+        Some((datapath, rom.cost))
+    };
+    Ok(CostReport::new(dp, arch, target, synthesis))
+}
