@@ -192,6 +192,15 @@ impl Provenance {
         )
     }
 
+    /// The two files of a result's provenance, `(name, bytes)`: `inputs.toml` (the
+    /// canonical inputs) and `provenance.json`.
+    pub fn files(&self) -> [(String, Vec<u8>); 2] {
+        [
+            (INPUTS_FILE.to_string(), self.canonical.clone().into_bytes()),
+            (PROVENANCE_FILE.to_string(), self.json().into_bytes()),
+        ]
+    }
+
     /// `provenance.json`'s text (pretty JSON and a newline).
     pub fn json(&self) -> String {
         let mut s = serde_json::to_string_pretty(self).expect("provenance serialises");

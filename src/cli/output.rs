@@ -18,7 +18,7 @@ pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
 /// `.<name>.<random>.tmp`, removed on failure) and a rename, so an interrupted run never
 /// leaves a half-written file under the final name. A directory at `path` is refused.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    persist(path, stage(path, bytes)?)
+    persist(path, path, stage(path, path, bytes)?)
 }
 
 /// Writes several files all or none: every file to its temporary name first, then each
@@ -26,6 +26,31 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 /// needed; when one file cannot be written, none is, and the directories created for them are
 /// removed again.
 pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
+    write_all(files, &|p: &Path| p.to_path_buf())
+}
+
+/// A result rendered in memory, `(name, bytes)` with names relative to `dir` (`a/b.png`),
+/// written into `dir` by one call, all or none ([`write_all_atomic`]).
+pub fn write_all_in(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<()> {
+    write_all_shown(dir, dir, files)
+}
+
+/// [`write_all_in`] into `dir`, its messages naming the files in `shown` (the final directory
+/// of a staged one).
+pub fn write_all_shown(dir: &Path, shown: &Path, files: &[(String, Vec<u8>)]) -> Result<()> {
+    let files: Vec<(PathBuf, Vec<u8>)> = files
+        .iter()
+        .map(|(name, bytes)| (dir.join(name), bytes.clone()))
+        .collect();
+    let show = |p: &Path| {
+        p.strip_prefix(dir)
+            .map_or(p.to_path_buf(), |r| shown.join(r))
+    };
+    write_all(&files, &show)
+}
+
+/// [`write_all_atomic`], its messages naming each path as `show` gives it.
+fn write_all(files: &[(PathBuf, Vec<u8>)], show: &dyn Fn(&Path) -> PathBuf) -> Result<()> {
     let mut missing: Vec<PathBuf> = Vec::new();
     for (path, _) in files {
         for d in parent_of(path).ancestors() {
@@ -41,12 +66,13 @@ pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
         .iter()
         .try_for_each(|(path, _)| {
             let dir = parent_of(path);
-            fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+            fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create {}", show(dir).display()))
         })
         .and_then(|()| {
             files
                 .iter()
-                .map(|(path, bytes)| stage(path, bytes).map(|tmp| (path, tmp)))
+                .map(|(path, bytes)| stage(path, &show(path), bytes).map(|tmp| (path, tmp)))
                 .collect::<Result<Vec<_>>>()
         });
     let staged = match staged {
@@ -61,20 +87,21 @@ pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
         }
     };
     for (path, tmp) in staged {
-        persist(path, tmp)?;
+        persist(path, &show(path), tmp)?;
     }
     Ok(())
 }
 
-/// `bytes` in a temporary file beside `path` (see [`write_atomic`]), not yet renamed.
-fn stage(path: &Path, bytes: &[u8]) -> Result<tempfile::NamedTempFile> {
-    log::debug!("writing {} ({} bytes)", path.display(), bytes.len());
+/// `bytes` in a temporary file beside `path` (see [`write_atomic`]), not yet renamed;
+/// messages name it `shown`.
+fn stage(path: &Path, shown: &Path, bytes: &[u8]) -> Result<tempfile::NamedTempFile> {
+    log::debug!("writing {} ({} bytes)", shown.display(), bytes.len());
     let dir = parent_of(path);
     let file_name = path
         .file_name()
-        .with_context(|| format!("{}: not a file path", path.display()))?;
+        .with_context(|| format!("{}: not a file path", shown.display()))?;
     if path.is_dir() {
-        anyhow::bail!("{}: is a directory, expected a file path", path.display());
+        anyhow::bail!("{}: is a directory, expected a file path", shown.display());
     }
     let prefix = format!(".{}.", file_name.to_string_lossy());
     let mut builder = tempfile::Builder::new();
@@ -86,19 +113,19 @@ fn stage(path: &Path, bytes: &[u8]) -> Result<tempfile::NamedTempFile> {
     }
     let mut tmp = builder
         .tempfile_in(dir)
-        .with_context(|| format!("cannot write into {}", dir.display()))?;
+        .with_context(|| format!("cannot write into {}", parent_of(shown).display()))?;
     tmp.write_all(bytes)
         .and_then(|()| tmp.flush())
-        .with_context(|| format!("cannot write {}", path.display()))?;
+        .with_context(|| format!("cannot write {}", shown.display()))?;
     Ok(tmp)
 }
 
-/// Renames a staged file into place.
-fn persist(path: &Path, tmp: tempfile::NamedTempFile) -> Result<()> {
+/// Renames a staged file into place; messages name it `shown`.
+fn persist(path: &Path, shown: &Path, tmp: tempfile::NamedTempFile) -> Result<()> {
     tmp.persist(path)
         .map(|_| ())
         .map_err(|e| e.error)
-        .with_context(|| format!("cannot write {}", path.display()))
+        .with_context(|| format!("cannot write {}", shown.display()))
 }
 
 /// Writes a figure as `dir/stem.svg` and `dir/stem.png`, each atomically.

@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use serde::{Deserialize, Serialize};
 
 use super::output::write_atomic;
 use super::Outcome;
@@ -13,6 +12,9 @@ use specfx::analysis::methods::{max_errors, report_methods};
 use specfx::analysis::paper::reproduce;
 use specfx::provenance::{INPUTS_FILE, PROVENANCE_FILE};
 use specfx::report::csv::{write_coefficients, write_method_errors};
+use specfx::report::index::{
+    write_index, CostRow, FigureRow, FitSummary, Results, StabilitySummary,
+};
 use specfx::report::paper::write_paper_table;
 use specfx::report::table::{Align, TextTable};
 
@@ -44,275 +46,6 @@ fn emit(
     let path = dir.join(name);
     write_atomic(&path, &buf)?;
     Ok(path)
-}
-
-/// What the index page and the summary need of one architecture's synthesis (kept when a
-/// report is interrupted, see [`super::resume`]).
-#[derive(Serialize, Deserialize)]
-struct CostRow {
-    arch: specfx::cycle::Arch,
-    /// yosys LUTs, DSPs, flip-flops and carry cells.
-    luts: u64,
-    dsps: u64,
-    ffs: u64,
-    carries: u64,
-    /// The analytic model's LUTs, latency and initiation interval.
-    analytic_luts: u64,
-    latency: u64,
-    initiation_interval: u64,
-    /// yosys LUTs of the constant ROM.
-    rom_luts: u64,
-    /// Place and route (nextpnr), when it ran.
-    timing: Option<TimingRow>,
-    /// Resources beyond the UP5K.
-    over_limit: Vec<String>,
-}
-
-/// What the index page needs of a place and route.
-#[derive(Serialize, Deserialize)]
-struct TimingRow {
-    fmax_mhz: Option<f64>,
-    fmax_is_upper_bound: bool,
-    latency_ns: Option<f64>,
-    throughput_samples_per_s: Option<f64>,
-}
-
-impl CostRow {
-    fn new(c: &specfx::hdl::cost::CostReport) -> CostRow {
-        CostRow {
-            arch: c.arch,
-            luts: c.luts.unwrap_or(0),
-            dsps: c.dsps.unwrap_or(0),
-            ffs: c.ffs.unwrap_or(0),
-            carries: c.yosys.as_ref().map_or(0, |y| y.carries),
-            analytic_luts: c.analytic.luts,
-            latency: c.analytic.latency,
-            initiation_interval: c.analytic.initiation_interval,
-            rom_luts: c.rom_yosys.as_ref().map_or(0, |r| r.luts),
-            timing: c.timing.as_ref().map(|t| TimingRow {
-                fmax_mhz: t.fmax_mhz,
-                fmax_is_upper_bound: t.fmax_is_upper_bound,
-                latency_ns: t.latency_ns,
-                throughput_samples_per_s: t.throughput_samples_per_s,
-            }),
-            over_limit: c.over_limit.clone(),
-        }
-    }
-}
-
-/// What the index page needs of one method of the trade-off.
-#[derive(Serialize, Deserialize)]
-struct FigureRow {
-    method: String,
-    max_abs_err: f64,
-    mean_abs_err: f64,
-}
-
-/// What the index page and the summary need of the stability maps.
-#[derive(Serialize, Deserialize)]
-struct StabilitySummary {
-    /// Every path, and whether it stays within the tolerance everywhere.
-    paths: Vec<(String, bool)>,
-    /// The exponents of the grid, as printed.
-    n: String,
-    /// The tolerance, as printed.
-    tol: String,
-}
-
-/// What the index page and the summary need of the fit to the built-in scene.
-#[derive(Serialize, Deserialize)]
-struct FitSummary {
-    target: specfx::hdl::cost::Target,
-    inputs: u64,
-    generic_cost: super::fit::SideCost,
-    fitted_cost: super::fit::SideCost,
-}
-
-/// What the index page summarises.
-struct Results<'a> {
-    paper: &'a specfx::analysis::paper::PaperReproduction,
-    checked: &'a specfx::analysis::check::CheckReport,
-    budget: &'a specfx::analysis::budget::BudgetReport,
-    figures: &'a [FigureRow],
-    stability: &'a StabilitySummary,
-    render: &'a [specfx::report::scene::MaterialRow],
-    fit: &'a FitSummary,
-    furnace: &'a specfx::analysis::furnace::FurnaceReport,
-    costs: &'a [CostRow],
-    sims: &'a [specfx::cycle::sim::SimStats],
-    provenance: &'a specfx::provenance::Provenance,
-}
-
-/// A self-contained index page linking (and showing) everything the report wrote.
-fn write_index(
-    w: &mut Vec<u8>,
-    dir: &Path,
-    files: &[PathBuf],
-    results: &Results<'_>,
-) -> std::io::Result<()> {
-    let Results {
-        paper,
-        checked,
-        budget,
-        figures,
-        stability,
-        render,
-        fit,
-        furnace,
-        costs,
-        sims,
-        provenance,
-    } = *results;
-    let rel = |p: &PathBuf| {
-        p.strip_prefix(dir)
-            .unwrap_or(p)
-            .components()
-            .map(|c| c.as_os_str().to_string_lossy().into_owned())
-            .collect::<Vec<_>>()
-            .join("/")
-    };
-    writeln!(w, "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>specfx report</title>")?;
-    writeln!(w, "<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em}}.table{{overflow-x:auto}}td,th{{padding:2px 8px;text-align:right;white-space:nowrap}}td:first-child,th:first-child{{text-align:left}}img{{max-width:100%;height:auto}}</style></head><body>")?;
-    writeln!(w, "<h1>specfx report</h1>")?;
-    // The verdict first: the numbers a designer acts on.
-    let lsb8 = specfx::analysis::LSB8;
-    let total = checked.shape_total_max_abs;
-    let pipelined = costs
-        .iter()
-        .find(|c| c.arch == specfx::cycle::Arch::Pipelined);
-    writeln!(w, "<p style=\"border:1px solid #888;padding:0.6em\"><b>Verdict.</b> The baseline datapath (plain cs16, every input code, n = 16..1024) is {:.2} lsb8 from cos^n at worst (lsb8 = 2^-8 of the lobe's peak, one step of an 8-bit display): it {} a 1 lsb8 budget. Its own quantization adds only {:.3} lsb8; the rest ({:.2} lsb8) is the cs16 approximation, which no bits remove (<code>specfx optimize</code> with its default budget of 1 lsb8 finds a k = 5 minimax datapath instead). Output monotonic: {}. {}On the built-in scene, a datapath fitted to its four exponents renders every material no worse and costs {} analytic {} LUTs with its constant ROM against {}.</p>",
-        total / lsb8,
-        if total <= lsb8 { "meets" } else { "does not meet" },
-        checked.shape_quant_max_abs / lsb8,
-        checked.shape_approx_max_abs / lsb8,
-        if checked.monotonic { "yes" } else { "NO" },
-        pipelined.map_or(String::new(), |c| format!(
-            "Synthesis (yosys, iCE40, pipelined): {} LUTs, {} DSPs, {} flip-flops, latency {} cycles, one result per cycle. ",
-            c.luts, c.dsps, c.ffs, c.latency
-        )),
-        fit.fitted_cost.analytic_total_luts,
-        fit.target,
-        fit.generic_cost.analytic_total_luts
-    )?;
-    let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
-        + usize::from(paper.delta.reproduced_max)
-        + usize::from(paper.delta.reproduced_min);
-    writeln!(w, "<h2>The paper</h2><p>{n_ok} of {} printed claims reproduce to 2 significant digits: <a href=\"paper.txt\">paper.txt</a>, <a href=\"paper.json\">paper.json</a>.</p>", paper.forms.len() + 2)?;
-    writeln!(w, "<h2>The baseline datapath</h2><p>{} evaluations, every input code and n = 16..1024: lobe error against cos^n {:.3e} (quantization {:.3e}, approximation {:.3e}), output max {:.2} ulp, monotonic: {}. <a href=\"check_baseline.txt\">check_baseline.txt</a>, <a href=\"check_baseline.json\">check_baseline.json</a>.</p>",
-        checked.n_evaluations, checked.shape_total_max_abs, checked.shape_quant_max_abs, checked.shape_approx_max_abs, checked.out_max_ulp, if checked.monotonic { "yes" } else { "no" })?;
-    let a = &budget.attribution;
-    let top = a
-        .incremental
-        .iter()
-        .max_by(|x, y| x.max_abs.total_cmp(&y.max_abs))
-        .map_or(String::new(), |s| s.source.clone());
-    let formal = budget
-        .formal
-        .iter()
-        .map(|f| f.bound_ulp / f.exhaustive_ulp.max(1e-300))
-        .fold(0.0, f64::max);
-    writeln!(w, "<h2>Error budget of the baseline</h2><p>Output quantization error {:.3e} ({:.0} output LSBs); the largest part comes from stage <code>{top}</code>. {} <a href=\"budget_baseline/budget.html\">budget_baseline/budget.html</a> (also .md, .json).</p><img src=\"budget_baseline/error_vs_n.png\" alt=\"error per exponent\">",
-        a.total.max_abs, a.total.max_ulp,
-        if budget.formal.is_empty() { budget.formal_note.clone().unwrap_or_default() } else { format!("gappa proves bounds for {} exponents, at most {formal:.2} times the exhaustive maximum.", budget.formal.len()) })?;
-    if !costs.is_empty() {
-        writeln!(w, "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the calibrated analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><div class=\"table\"><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>ROM LUTs (yosys)</th></tr>")?;
-        for c in costs {
-            writeln!(
-                w,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                c.arch, c.luts, c.analytic_luts, c.dsps, c.ffs, c.rom_luts,
-            )?;
-        }
-        writeln!(w, "</table></div><div class=\"table\"><table><tr><th>architecture</th><th>latency (cycles)</th><th>initiation interval</th><th>Fmax on UP5K (nextpnr)</th><th>latency (ns)</th><th>throughput (Msamples/s)</th></tr>")?;
-        for c in costs {
-            let t = c.timing.as_ref();
-            writeln!(
-                w,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                c.arch,
-                c.latency,
-                c.initiation_interval,
-                t.and_then(|t| t.fmax_mhz.map(|f| format!(
-                    "{}{f:.1} MHz",
-                    if t.fmax_is_upper_bound { "&le; " } else { "" }
-                )))
-                .unwrap_or_else(|| "-".into()),
-                t.and_then(|t| t.latency_ns)
-                    .map_or("-".into(), |l| format!("{l:.0}")),
-                t.and_then(|t| t.throughput_samples_per_s)
-                    .map_or("-".into(), |x| format!("{:.1}", x / 1e6)),
-            )?;
-        }
-        writeln!(w, "</table></div>")?;
-        if costs.iter().any(|c| c.timing.is_some()) {
-            writeln!(w, "<p>Fmax is register to register inside a serial harness, placed and routed by nextpnr on an iCE40 UP5K; it is an upper bound because nextpnr does not time the delay through the SB_MAC16 DSP blocks (<code>specfx timing</code>, <code>hdl_ref/README.md</code>). The analytic figures are the calibrated model's (<code>docs/cost.md</code>).</p>")?;
-        }
-        for flag in costs.iter().flat_map(|c| &c.over_limit) {
-            writeln!(w, "<p><b>Exceeds the UP5K:</b> {flag}</p>")?;
-        }
-    }
-    writeln!(w, "<h2>The cycle model</h2><p>20,000 cycles of each microarchitecture under seeded bubbles and stalls, every output checked against the functional model (<a href=\"sim_baseline.json\">sim_baseline.json</a>; a VCD of the first 300 cycles: <a href=\"sim_baseline_pipelined.vcd\">sim_baseline_pipelined.vcd</a>).</p><div class=\"table\"><table><tr><th>architecture</th><th>outputs</th><th>results per cycle</th><th>latency (nominal)</th><th>latency seen</th><th>mismatches</th></tr>")?;
-    for st in sims {
-        writeln!(
-            w,
-            "<tr><td>{}</td><td>{}</td><td>{:.3}</td><td>{}</td><td>{}..{}</td><td>{}</td></tr>",
-            st.arch,
-            st.n_outputs,
-            st.throughput,
-            st.latency_nominal,
-            st.latency_min,
-            st.latency_max,
-            st.mismatches
-        )?;
-    }
-    writeln!(w, "</table></div>")?;
-    writeln!(w, "<h2>Error against hardware cost</h2><p>Each fixed-point datapath of the trade-off (plain k = 4 at 8, 12 and 16 fraction bits; minimax k = 3..6) by its lobe error in lsb8 against the calibrated analytic cost on each target (<a href=\"tradeoff/tradeoff.csv\">tradeoff.csv</a>; the model and its calibration error: <code>docs/cost.md</code>).</p><img src=\"tradeoff/error_vs_luts_ice40.png\" alt=\"error against iCE40 LUTs\"><img src=\"tradeoff/error_vs_dsps_ice40.png\" alt=\"error against iCE40 DSPs\"><img src=\"tradeoff/error_vs_luts_xilinx.png\" alt=\"error against Xilinx LUTs\"><img src=\"tradeoff/error_vs_latency.png\" alt=\"error against latency\">")?;
-    writeln!(w, "<h2>Speed against accuracy</h2><p>Software speed is measured in this run on this machine (one core), so the chart and <a href=\"tradeoff/measured_speed.csv\">measured_speed.csv</a> differ from run to run; every other file of the report is the same on every run.</p><img src=\"tradeoff/measured_speed_accuracy.png\" alt=\"speed against accuracy (measured)\"><img src=\"tradeoff/error_vs_n.png\" alt=\"error against n\">")?;
-    writeln!(
-        w,
-        "<div class=\"table\"><table><tr><th>method</th><th>max |err|</th><th>mean |err|</th></tr>"
-    )?;
-    for f in figures {
-        writeln!(
-            w,
-            "<tr><td>{}</td><td>{:.3e}</td><td>{:.3e}</td></tr>",
-            f.method, f.max_abs_err, f.mean_abs_err
-        )?;
-    }
-    writeln!(w, "</table></div>")?;
-    let passing: Vec<&str> = stability
-        .paths
-        .iter()
-        .filter(|(_, passes)| *passes)
-        .map(|(path, _)| path.as_str())
-        .collect();
-    writeln!(w, "<h2>Where the methods fail</h2><p>{} paths mapped over n = {} and theta in [0, 90] degrees against a tolerance of {}; {} stay within it everywhere ({}). Failure regions, special inputs (NaN, infinities, cosines just outside [0, 1]) and one heat map per path: <a href=\"stability/stability.html\">stability/stability.html</a> (also .md, .json, regions.csv).</p><img src=\"stability/overview.png\" alt=\"where each path passes or fails\">",
-        stability.paths.len(), stability.n, stability.tol, passing.len(), passing.join(", "))?;
-    if let Some(all) = render.iter().find(|r| r.material == "all") {
-        writeln!(w, "<h2>The datapath in an image</h2><p>The built-in scene (cells, a vessel, a bone-like ring; n = 16 to 1024) rendered with the baseline datapath's specular lobe: at most {} display LSBs from f64 cos^n ({:.2}% of covered pixels differ, FLIP mean {:.4}), at most {} from the f64 model of its own algorithm (the quantization alone). Per material: <a href=\"render/render.md\">render/render.md</a>.</p><img src=\"render/datapath.png\" alt=\"the scene through the datapath\"><img src=\"render/diff_vs_cos_n.png\" alt=\"difference from cos^n in display LSBs\">",
-            all.total.max_lsb, 100.0 * all.total.differing, all.total.flip_mean, all.quant.max_lsb)?;
-    }
-    let (g, f) = (&fit.generic_cost, &fit.fitted_cost);
-    let yosys = match (g.yosys_total_luts, f.yosys_total_luts) {
-        (Some(a), Some(b)) => format!(", yosys {b} LUTs against {a}"),
-        _ => String::new(),
-    };
-    writeln!(w, "<h2>No more than the scene needs</h2><p><code>specfx fit</code> on the built-in scene, with the default budget (every material no worse than the generic baseline renders it, against f64 cos^n): the fitted datapath serves only the scene's exponents ({} entries in its constant ROM, against {}) and costs {} analytic {} LUTs with its ROM against {} for the generic n = 16..1024 datapath{}; proved on all {} inputs the scene produces. Configuration <a href=\"fit/fitted.toml\">fit/fitted.toml</a>, report <a href=\"fit/fit.md\">fit/fit.md</a>.</p><img src=\"fit/fitted.png\" alt=\"the scene through the fitted datapath\"><img src=\"fit/diff_fitted_vs_generic.png\" alt=\"fitted against generic, display LSBs\">",
-        f.rom_entries, g.rom_entries, f.analytic_total_luts, fit.target, g.analytic_total_luts, yosys, fit.inputs)?;
-    let flagged: usize = furnace.summary().iter().map(|s| s.n_flagged_values).sum();
-    writeln!(w, "<h2>Energy conservation</h2><p>The white furnace: the reflectance of each of the six normalised forms against incident angle, for f64 cos^n, the f64 lobe with the paper's and with the exact coefficient, and the bit-accurate datapath; {flagged} values above 1 are flagged (see <a href=\"furnace/furnace.md\">furnace/furnace.md</a>: the paper's coefficients overshoot slightly, the microfacet forms gain energy near grazing without a masking term).</p><img src=\"furnace/furnace_phong.png\" alt=\"white furnace, Phong\">")?;
-    writeln!(w, "<h2>Every file</h2><ul>")?;
-    for f in files {
-        let r = rel(f);
-        writeln!(w, "<li><a href=\"{r}\">{r}</a></li>")?;
-    }
-    writeln!(w, "</ul>")?;
-    writeln!(
-        w,
-        "<p>specfx {} · <code>specfx {}</code> · inputs sha256 <code>{}</code> (<a href=\"{INPUTS_FILE}\">{INPUTS_FILE}</a>, <a href=\"{PROVENANCE_FILE}\">{PROVENANCE_FILE}</a>; each part's directory holds its own)</p>",
-        provenance.specfx_version, provenance.command, provenance.inputs_sha256
-    )?;
-    writeln!(w, "</body></html>")
 }
 
 /// The report's steps: a line each on stderr, a bar over them on a terminal (a line every
@@ -614,7 +347,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             fitted_cost: fit.fitted_cost,
         })
     })?;
-    for f in super::fit::FIT_FILES {
+    for f in specfx::report::fit::FIT_FILES {
         written.push(fit_dir.join(f));
     }
 
@@ -659,7 +392,18 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             sims: &sims,
             provenance: &provenance,
         };
-        write_index(b, dir, &written, &results)?;
+        let files: Vec<String> = written
+            .iter()
+            .map(|p| {
+                p.strip_prefix(dir)
+                    .unwrap_or(p)
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                    .collect::<Vec<_>>()
+                    .join("/")
+            })
+            .collect();
+        write_index(b, &files, &results)?;
         // Numbers in the page's text never break at their minus sign (U+2212 instead of -).
         let page = String::from_utf8(std::mem::take(b)).map_err(std::io::Error::other)?;
         let (head, body) = page.split_at(page.find("<body>").unwrap_or(0));

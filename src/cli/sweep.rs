@@ -236,42 +236,13 @@ fn read_log(dir: &Path, info: &SweepInfo, how: LogUse) -> Result<BTreeMap<u64, P
         map.insert(p.index, p);
     }
     if how == LogUse::Resume && good.len() != text.len() {
-        write_files(dir, dir, &[("points.jsonl".to_string(), good.into_bytes())])?;
+        super::output::write_all_shown(
+            dir,
+            dir,
+            &[("points.jsonl".to_string(), good.into_bytes())],
+        )?;
     }
     Ok(map)
-}
-
-/// Writes files into `dir` all or nothing: each under a temporary name first, then all
-/// renamed; on an error the temporary files are removed and the earlier files stay as they
-/// were. Errors name the files as in `shown` (the final directory of a staged one).
-fn write_files(dir: &Path, shown: &Path, files: &[(String, Vec<u8>)]) -> Result<()> {
-    let tmp = |name: &str| dir.join(format!(".{name}.partial-{}", std::process::id()));
-    let mut made = Vec::new();
-    let result = (|| -> Result<()> {
-        for (name, bytes) in files {
-            let t = tmp(name);
-            let _ = fs::remove_file(&t);
-            made.push(t.clone());
-            log::debug!(
-                "writing {} ({} bytes)",
-                shown.join(name).display(),
-                bytes.len()
-            );
-            fs::write(&t, bytes)
-                .with_context(|| format!("cannot write {}", shown.join(name).display()))?;
-        }
-        for (name, _) in files {
-            fs::rename(tmp(name), dir.join(name))
-                .with_context(|| format!("cannot write {}", shown.join(name).display()))?;
-        }
-        Ok(())
-    })();
-    if result.is_err() {
-        for t in made {
-            let _ = fs::remove_file(t);
-        }
-    }
-    result
 }
 
 /// Runs `specfx sweep ...`.
@@ -327,7 +298,7 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
             );
         }
         let staged = OutDir::begin(dir, "sweep", false, &[])?;
-        write_files(
+        super::output::write_all_shown(
             staged.path(),
             dir,
             &[("space.json".to_string(), info.json()?)],
@@ -463,7 +434,7 @@ fn write_results(
     let chart = specfx::report::sweep::chart(points, target);
     let svg = specfx::report::chart::render_svg(&chart).map_err(anyhow::Error::msg)?;
     let png = specfx::report::chart::render_png(&chart).map_err(anyhow::Error::msg)?;
-    write_files(
+    super::output::write_all_shown(
         dir,
         shown,
         &[
@@ -634,7 +605,7 @@ fn merge(out: &Path, shards: &[PathBuf], force: bool) -> Result<Outcome> {
         lines.push_str(&serde_json::to_string(p)?);
         lines.push('\n');
     }
-    write_files(
+    super::output::write_all_shown(
         staged.path(),
         out,
         &[

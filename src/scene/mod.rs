@@ -6,6 +6,7 @@
 //! is read, with an error naming its key (`object[2].radius`), so rendering cannot fail.
 
 pub mod fit;
+pub mod fitting;
 pub mod mesh;
 pub mod render;
 
