@@ -397,3 +397,114 @@ pub fn bound(job: &Job, gappa_output: &str) -> Result<f64, Error> {
     }
     Ok(lo.abs().max(hi.abs()).max(job.lower_bound))
 }
+
+/// Up to 8 exponents of a set, spread evenly on a log scale, always with its ends: those
+/// `budget` proves bounds for by default.
+pub fn spread(ns: &[u32]) -> Vec<u32> {
+    if ns.len() <= 8 {
+        return ns.to_vec();
+    }
+    let (lo, hi) = (f64::from(ns[0]), f64::from(ns[ns.len() - 1]));
+    let mut picked: Vec<u32> = (0..8)
+        .map(|j| {
+            let target = lo * (hi / lo).powf(f64::from(j) / 7.0);
+            *ns.iter()
+                .min_by(|a, b| {
+                    (f64::from(**a) - target)
+                        .abs()
+                        .total_cmp(&(f64::from(**b) - target).abs())
+                })
+                .expect("a non-empty set")
+        })
+        .collect();
+    picked.dedup();
+    picked
+}
+
+/// Runs gappa on a script: what it printed, or `None` when gappa is not installed.
+pub type RunGappa<'a> = &'a (dyn Fn(&str) -> Result<Option<String>, Error> + Sync);
+
+/// Proves bounds with gappa (`run`) for the exponents `ns` of the datapath, in parallel
+/// (`tick` after each), and adds them to the report beside its exhaustive figures: a bound
+/// per exponent and how it was proved, or a note saying why there is none (gappa missing, or
+/// the exponents no bound could be proved for and why).
+pub fn add_formal_bounds(
+    dp: &Datapath,
+    report: &mut crate::analysis::budget::BudgetReport,
+    ns: &[u32],
+    run: RunGappa<'_>,
+    tick: &(dyn Fn() + Sync),
+) -> Result<(), Error> {
+    use rayon::prelude::*;
+    let jobs: Vec<(u32, Result<Job, Error>)> = ns
+        .iter()
+        .filter_map(|&n| dp.constants_for(n).map(|nc| (n, job(dp, nc))))
+        .collect();
+    // Per exponent: its bound (NaN when none was proved) and how, or why not; `None` when
+    // gappa is not installed.
+    type Proved = Option<(u32, f64, String)>;
+    let results: Vec<Result<Proved, Error>> = jobs
+        .par_iter()
+        .map(|(n, job)| {
+            let job = match job {
+                Ok(j) => j,
+                Err(why) => return Ok(Some((*n, f64::NAN, why.to_string()))),
+            };
+            let output = if job.upper_from.is_some() {
+                match run(&job.script)? {
+                    Some(text) => text,
+                    None => return Ok(None),
+                }
+            } else {
+                String::new()
+            };
+            Ok(Some(match bound(job, &output) {
+                Ok(b) => {
+                    let how = match job.upper_from {
+                        Some(0) => "gappa on every code".to_string(),
+                        Some(k) => format!(
+                            "gappa from code {k}; below it, where a model cuts the base, monotonicity bounds the error by {:.3e}",
+                            job.lower_bound
+                        ),
+                        None => "every code is cut: monotonicity alone".to_string(),
+                    };
+                    (*n, b, how)
+                }
+                Err(why) => (*n, f64::NAN, why.to_string()),
+            }))
+        })
+        .inspect(|_| tick())
+        .collect();
+    let out_lsb = report.out_lsb;
+    let mut failures = Vec::new();
+    for r in results {
+        let Some((n, bound, how)) = r? else {
+            report.formal_note = Some(
+                "gappa is not installed (Debian package `gappa`): no formal bound, only the exhaustive figures."
+                    .into(),
+            );
+            report.formal.clear();
+            return Ok(());
+        };
+        if bound.is_nan() {
+            failures.push(format!("n = {n}: {how}"));
+            continue;
+        }
+        let exhaustive = report
+            .per_n
+            .iter()
+            .find(|p| p.n == n)
+            .map_or(f64::NAN, |p| p.out_quant_max_ulp);
+        report.formal.push(crate::analysis::budget::FormalBound {
+            n,
+            bound,
+            bound_ulp: bound / out_lsb,
+            exhaustive_ulp: exhaustive,
+            how,
+        });
+    }
+    if !failures.is_empty() {
+        report.formal_note = Some(format!("No bound proved for {}", failures.join("; ")));
+    }
+    Ok(())
+}

@@ -398,12 +398,16 @@ impl Budget {
         }
     }
 
-    /// The cost ceilings alone: whether they hold, and their largest ratio (no check needed);
-    /// yosys ceilings are measured with `synth` (one synthesis per target), and are an error
-    /// without it.
-    pub fn cost_verdict(&self, dp: &Datapath, synth: Option<Synthesise>) -> Result<Verdict, Error> {
+    /// Each cost ceiling of the budget with its value for `dp`, in the budget's order: the
+    /// analytic cost, or yosys's count measured with `synth` (one synthesis per target; an
+    /// error without it).
+    pub fn cost_values(
+        &self,
+        dp: &Datapath,
+        synth: Option<Synthesise>,
+    ) -> Result<Vec<(Bound, f64)>, Error> {
         let mut synthesised: Vec<(Target, crate::hdl::cost::CostFigures)> = Vec::new();
-        let mut costs: Vec<(&Bound, f64)> = Vec::new();
+        let mut costs: Vec<(Bound, f64)> = Vec::new();
         for b in self.bounds.iter().filter(|b| b.metric.is_cost()) {
             let v = match b.metric {
                 Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t) => {
@@ -428,8 +432,17 @@ impl Budget {
                 }
                 m => cost_value(dp, self.arch, m),
             };
-            costs.push((b, v));
+            costs.push((*b, v));
         }
+        Ok(costs)
+    }
+
+    /// The cost ceilings alone: whether they hold, and their largest ratio (no check needed);
+    /// yosys ceilings are measured with `synth` (one synthesis per target), and are an error
+    /// without it.
+    pub fn cost_verdict(&self, dp: &Datapath, synth: Option<Synthesise>) -> Result<Verdict, Error> {
+        let costs = self.cost_values(dp, synth)?;
+        let costs: Vec<(&Bound, f64)> = costs.iter().map(|(b, v)| (b, *v)).collect();
         Ok(Verdict {
             feasible: costs.iter().all(|&(b, v)| Self::holds(b, v)),
             excess: costs

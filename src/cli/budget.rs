@@ -7,18 +7,16 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
-use rayon::prelude::*;
 
-use super::output::{print_json, write_atomic, write_chart, write_provenance};
+use super::output::{print_json, write_all_in};
 use super::Outcome;
-use specfx::analysis::budget::{analyse, BudgetReport, FormalBound};
+use specfx::analysis::budget::{analyse, BudgetReport};
 use specfx::analysis::gappa;
 use specfx::analysis::optimize::Budget;
 use specfx::nset::NSet;
 use specfx::pipeline::Datapath;
 use specfx::provenance::{Inputs, Provenance};
-use specfx::report::budget::{charts, document};
-use specfx::report::doc::{write_html, write_markdown, Block};
+use specfx::report::budget::budget_files;
 use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx budget`.
@@ -50,102 +48,6 @@ pub struct BudgetArgs {
     json: bool,
 }
 
-/// Up to 8 exponents of a set, spread evenly on a log scale, always with its ends.
-pub fn spread(ns: &[u32]) -> Vec<u32> {
-    if ns.len() <= 8 {
-        return ns.to_vec();
-    }
-    let (lo, hi) = (f64::from(ns[0]), f64::from(ns[ns.len() - 1]));
-    let mut picked: Vec<u32> = (0..8)
-        .map(|j| {
-            let target = lo * (hi / lo).powf(f64::from(j) / 7.0);
-            *ns.iter()
-                .min_by(|a, b| {
-                    (f64::from(**a) - target)
-                        .abs()
-                        .total_cmp(&(f64::from(**b) - target).abs())
-                })
-                .expect("a non-empty set")
-        })
-        .collect();
-    picked.dedup();
-    picked
-}
-
-/// Proves bounds with gappa for the chosen exponents and adds them to the report.
-fn add_formal_bounds(dp: &Datapath, report: &mut BudgetReport, ns: &[u32]) -> Result<()> {
-    let jobs: Vec<(u32, Result<gappa::Job, specfx::Error>)> = ns
-        .iter()
-        .filter_map(|&n| dp.constants_for(n).map(|nc| (n, gappa::job(dp, nc))))
-        .collect();
-    let bar = super::progress::Progress::new("gappa", "exponents", jobs.len() as u64);
-    let results: Vec<Result<Option<(u32, f64, String)>>> = jobs
-        .par_iter()
-        .map(|(n, job)| {
-            let job = match job {
-                Ok(j) => j,
-                Err(why) => return Ok(Some((*n, f64::NAN, why.to_string()))),
-            };
-            let output = if job.upper_from.is_some() {
-                match specfx::tools::gappa::run(&job.script)? {
-                    Some(text) => text,
-                    None => return Ok(None),
-                }
-            } else {
-                String::new()
-            };
-            Ok(Some(match gappa::bound(job, &output) {
-                Ok(b) => {
-                    let how = match job.upper_from {
-                        Some(0) => "gappa on every code".to_string(),
-                        Some(k) => format!(
-                            "gappa from code {k}; below it, where a model cuts the base, monotonicity bounds the error by {:.3e}",
-                            job.lower_bound
-                        ),
-                        None => "every code is cut: monotonicity alone".to_string(),
-                    };
-                    (*n, b, how)
-                }
-                Err(why) => (*n, f64::NAN, why.to_string()),
-            }))
-        })
-        .inspect(|_| bar.inc(1))
-        .collect();
-    bar.finish();
-    let out_lsb = report.out_lsb;
-    let mut failures = Vec::new();
-    for r in results {
-        let Some((n, bound, how)) = r? else {
-            report.formal_note = Some(
-                "gappa is not installed (Debian package `gappa`): no formal bound, only the exhaustive figures."
-                    .into(),
-            );
-            report.formal.clear();
-            return Ok(());
-        };
-        if bound.is_nan() {
-            failures.push(format!("n = {n}: {how}"));
-            continue;
-        }
-        let exhaustive = report
-            .per_n
-            .iter()
-            .find(|p| p.n == n)
-            .map_or(f64::NAN, |p| p.out_quant_max_ulp);
-        report.formal.push(FormalBound {
-            n,
-            bound,
-            bound_ulp: bound / out_lsb,
-            exhaustive_ulp: exhaustive,
-            how,
-        });
-    }
-    if !failures.is_empty() {
-        report.formal_note = Some(format!("No bound proved for {}", failures.join("; ")));
-    }
-    Ok(())
-}
-
 /// Analyses a datapath and writes the budget report into `dir`: `budget.md`, `budget.html`,
 /// `budget.json` and the charts (SVG and PNG).
 pub fn budget(
@@ -164,37 +66,20 @@ pub fn budget(
     match gappa_n {
         Some(ns) => {
             log::info!("budget: proving bounds with gappa for n = {ns:?}");
-            add_formal_bounds(dp, &mut report, ns)?;
+            let bar = super::progress::Progress::new("gappa", "exponents", ns.len() as u64);
+            gappa::add_formal_bounds(
+                dp,
+                &mut report,
+                ns,
+                &specfx::tools::gappa::run,
+                &|| bar.inc(1),
+            )?;
+            bar.finish();
         }
         None => report.formal_note = Some("gappa was not run (--no-gappa).".into()),
     }
-    let mut svgs = Vec::new();
-    for (stem, chart) in charts(&report) {
-        let svg = write_chart(dir, &stem, &chart)?;
-        svgs.push((stem, svg));
-    }
     let provenance = Provenance::new(&inputs(dp, budget, gappa_n));
-    let mut doc = document(&report);
-    doc.push(Block::Paragraph(provenance.line()));
-    let mut md = Vec::new();
-    write_markdown(&mut md, &doc)?;
-    let mut html = Vec::new();
-    write_html(
-        &mut html,
-        &format!("Error budget: {}", report.config),
-        &doc,
-        |stem| {
-            svgs.iter()
-                .find(|(s, _)| s == stem)
-                .map(|(_, svg)| svg.clone())
-        },
-    )?;
-    let mut json = serde_json::to_vec_pretty(&report)?;
-    json.push(b'\n');
-    write_atomic(&dir.join("budget.md"), &md)?;
-    write_atomic(&dir.join("budget.html"), &html)?;
-    write_atomic(&dir.join("budget.json"), &json)?;
-    write_provenance(dir, &provenance)?;
+    write_all_in(dir, &budget_files(&report, &provenance)?)?;
     Ok(report)
 }
 
@@ -236,7 +121,7 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
             }
             Some(wanted)
         }
-        None => Some(spread(&ns)),
+        None => Some(gappa::spread(&ns)),
     };
     let out_dir = super::output::OutDir::begin(
         &args.out,

@@ -90,8 +90,8 @@ pub fn write_furnace(
     bar.finish();
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     for (i, f) in report.forms.iter().enumerate() {
-        let svg = chart_svg(&report, i).map_err(anyhow::Error::msg)?;
-        let png = chart_png(&report, i).map_err(anyhow::Error::msg)?;
+        let svg = chart_svg(&report, i)?;
+        let png = chart_png(&report, i)?;
         write_figure(out, &chart_stem(f.form), &svg, &png)?;
     }
     let provenance = Provenance::new(

@@ -154,8 +154,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         &cost,
         Some(&synth),
         &done,
-    )
-    .map_err(anyhow::Error::msg)?;
+    )?;
     bar.finish();
     super::output::outln!(
         "optimize: budget '{}', {} exhaustive checks",
@@ -228,7 +227,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         }
         if let Some(c) = &r.closest {
             let dp = Datapath::new(c.config.clone())?;
-            let chk = check(&dp).map_err(anyhow::Error::msg)?;
+            let chk = check(&dp)?;
             super::output::outln!(
                 "closest: k = {}, {}: shape_total {:.3e}, shape_quant {:.3e}, out {:.2} ulp, {:.2}% correct ({:.2}x the budget)",
                 c.config.k,
@@ -239,24 +238,9 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                 100.0 * chk.stages[dp.stage_out()].correctly_rounded,
                 c.excess
             )?;
-            for b in r.budget.bounds.iter().filter(|b| b.metric.is_cost()) {
-                let value = match b.metric {
-                    Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t) => {
-                        let f = synth(&dp, arch, t)?;
-                        let count = match b.metric {
-                            Metric::YosysLuts(_) => f.luts,
-                            Metric::YosysDsps(_) => f.dsps,
-                            _ => f.ffs,
-                        };
-                        count as f64
-                    }
-                    m => specfx::analysis::optimize::metric_value(
-                        &chk.output_figures(),
-                        &dp,
-                        arch,
-                        m,
-                    ),
-                };
+            let mut budget = r.budget.clone();
+            budget.arch = arch;
+            for (b, value) in budget.cost_values(&dp, Some(&synth))? {
                 let kind = if b.metric.is_yosys() { "" } else { "analytic " };
                 super::output::outln!("  its {kind}{}: {value} (limit {})", b.metric, b.limit)?;
             }
@@ -267,7 +251,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     let mut config = best.config.clone();
     config.name = "optimized".into();
     let dp = Datapath::new(config.clone())?;
-    let proof = check(&dp).map_err(anyhow::Error::msg)?;
+    let proof = check(&dp)?;
     if !r.budget.met_by(&proof.output_figures(), &dp)
         || !r.budget.cost_verdict(&dp, Some(&synth))?.feasible
     {

@@ -136,8 +136,8 @@ pub fn write_figure(dir: &Path, stem: &str, svg: &str, png: &[u8]) -> Result<()>
 
 /// Renders a chart to SVG and PNG, writes both with [`write_figure`] and returns the SVG.
 pub fn write_chart(dir: &Path, stem: &str, chart: &specfx::report::chart::Chart) -> Result<String> {
-    let svg = specfx::report::chart::render_svg(chart).map_err(anyhow::Error::msg)?;
-    let png = specfx::report::chart::render_png(chart).map_err(anyhow::Error::msg)?;
+    let svg = specfx::report::chart::render_svg(chart)?;
+    let png = specfx::report::chart::render_png(chart)?;
     write_figure(dir, stem, &svg, &png)?;
     Ok(svg)
 }

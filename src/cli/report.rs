@@ -154,7 +154,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
 
     steps.start("checking baseline exhaustively: every input code, n = 16..=1024");
     let dp = specfx::pipeline::Datapath::new(specfx::pipeline::Config::baseline())?;
-    let checked = specfx::analysis::check::check(&dp).map_err(anyhow::Error::msg)?;
+    let checked = specfx::analysis::check::check(&dp)?;
     written.push(emit(dir, "check_baseline.txt", |b| {
         specfx::report::check::write_check_table(b, &checked, None)
     })?);
@@ -258,7 +258,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     steps.start("error budget of baseline (attribution per stage, gappa bounds if installed)");
     let budget_dir = dir.join("budget_baseline");
     let ns: Vec<u32> = dp.constants().iter().map(|c| c.n).collect();
-    let budget = super::budget::budget(&dp, None, Some(&super::budget::spread(&ns)), &budget_dir)?;
+    let budget = super::budget::budget(&dp, None, Some(&specfx::analysis::gappa::spread(&ns)), &budget_dir)?;
     written.push(budget_dir.join("budget.html"));
     written.push(budget_dir.join("budget.md"));
     written.push(budget_dir.join("budget.json"));

@@ -146,16 +146,16 @@ pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<Stability
         write_figure(
             dir,
             &heatmap_stem(&m.path),
-            &heatmap_svg(m, tol).map_err(anyhow::Error::msg)?,
-            &heatmap_png(m, tol).map_err(anyhow::Error::msg)?,
+            &heatmap_svg(m, tol)?,
+            &heatmap_png(m, tol)?,
         )?;
     }
-    let overview = overview_svg(&report.maps, tol).map_err(anyhow::Error::msg)?;
+    let overview = overview_svg(&report.maps, tol)?;
     write_figure(
         dir,
         "overview",
         &overview,
-        &overview_png(&report.maps, tol).map_err(anyhow::Error::msg)?,
+        &overview_png(&report.maps, tol)?,
     )?;
     let overshoot = write_chart(dir, "overshoot", &overshoot_chart(&report))?;
     let mut buf = Vec::new();

@@ -386,7 +386,7 @@ fn synthesise_front(
     let hdl = super::hdl_ref::hdl_ref_dir(None);
     for p in points.iter_mut().filter(|p| p.pareto) {
         if let std::collections::btree_map::Entry::Vacant(slot) = known.entry(p.index) {
-            let (cfg, arch) = space.point(p.index).map_err(anyhow::Error::msg)?;
+            let (cfg, arch) = space.point(p.index)?;
             let dp = specfx::pipeline::Datapath::new(cfg)?;
             log::info!(
                 "sweep: synthesising Pareto point {} with yosys ({target})",
@@ -432,8 +432,8 @@ fn write_results(
     let mut json = serde_json::to_vec_pretty(&points)?;
     json.push(b'\n');
     let chart = specfx::report::sweep::chart(points, target);
-    let svg = specfx::report::chart::render_svg(&chart).map_err(anyhow::Error::msg)?;
-    let png = specfx::report::chart::render_png(&chart).map_err(anyhow::Error::msg)?;
+    let svg = specfx::report::chart::render_svg(&chart)?;
+    let png = specfx::report::chart::render_png(&chart)?;
     super::output::write_all_shown(
         dir,
         shown,

@@ -479,3 +479,43 @@ pub fn document(r: &BudgetReport) -> Vec<Block> {
     }
     doc
 }
+
+/// Every file of a budget report's directory, rendered in memory as `(name, bytes)`: the
+/// charts (SVG and PNG), `budget.md` and `budget.html` (the document, ending with the
+/// provenance's line; the HTML embeds the SVG charts), `budget.json`, and the provenance's
+/// two files.
+pub fn budget_files(
+    r: &BudgetReport,
+    provenance: &crate::provenance::Provenance,
+) -> Result<Vec<(String, Vec<u8>)>, crate::error::Error> {
+    use crate::report::chart::{render_png, render_svg};
+    use crate::report::doc::{write_html, write_markdown};
+    let mut files = Vec::new();
+    let mut svgs = Vec::new();
+    for (stem, chart) in charts(r) {
+        let svg = render_svg(&chart)?;
+        files.push((format!("{stem}.svg"), svg.clone().into_bytes()));
+        files.push((format!("{stem}.png"), render_png(&chart)?));
+        svgs.push((stem, svg));
+    }
+    let mut doc = document(r);
+    doc.push(Block::Paragraph(provenance.line()));
+    let mut md = Vec::new();
+    write_markdown(&mut md, &doc).expect("writing into memory cannot fail");
+    let mut html = Vec::new();
+    write_html(&mut html, &format!("Error budget: {}", r.config), &doc, |stem| {
+        svgs.iter()
+            .find(|(s, _)| s == stem)
+            .map(|(_, svg)| svg.clone())
+    })
+    .expect("writing into memory cannot fail");
+    let mut json = serde_json::to_vec_pretty(r).map_err(|e| crate::error::Error::Render {
+        message: format!("budget.json: {e}"),
+    })?;
+    json.push(b'\n');
+    files.push(("budget.md".into(), md));
+    files.push(("budget.html".into(), html));
+    files.push(("budget.json".into(), json));
+    files.extend(provenance.files());
+    Ok(files)
+}

@@ -9,6 +9,7 @@ use std::process::{Command, Output};
 
 use crate::error::Error;
 
+pub mod cache;
 pub mod child;
 pub mod gappa;
 pub mod nextpnr;

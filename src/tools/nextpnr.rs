@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{error, first_error, io_error, run, work_dir, write};
+use super::{cache, error, first_error, io_error, run, work_dir, write};
 use crate::cycle::Arch;
 use crate::error::Error;
 use crate::hdl::cost::parse_stat_json;
@@ -31,7 +31,7 @@ pub fn place_and_route(
     let work = work_dir("nextpnr-ice40", "pnr")?;
     let dir = work.path();
     // A missing nextpnr is reported before yosys spends seconds on synthesis.
-    run("nextpnr-ice40", &["--version".into()], dir)?;
+    let nextpnr_version = run("nextpnr-ice40", &["--version".into()], dir)?;
     write(
         "nextpnr-ice40",
         &dir.join("specfx_params.vh"),
@@ -55,6 +55,39 @@ pub fn place_and_route(
         &dir.join("pnr.ys"),
         &pnr_yosys_script(device, &files, "."),
     )?;
+    // The synthesis cache: the same inputs to the same tools give the same answer.
+    let args = nextpnr_args(device);
+    let key = {
+        let yosys_version = super::yosys::check()?;
+        let mut parts: Vec<Vec<u8>> = vec![
+            b"nextpnr place and route 1".to_vec(),
+            yosys_version.into_bytes(),
+            nextpnr_version.stdout,
+            nextpnr_version.stderr,
+            args.join("\0").into_bytes(),
+        ];
+        for f in &files {
+            parts.push(f.as_bytes().to_vec());
+            parts.push(cache::file_bytes(&dir.join(f)));
+        }
+        for f in ["pnr.ys", "specfx_params.vh"] {
+            parts.push(cache::file_bytes(&dir.join(f)));
+        }
+        cache::key(&parts.iter().map(Vec::as_slice).collect::<Vec<_>>())
+    };
+    if let Some(cached) = cache::get("nextpnr", &key, &["stat.json", "report.json"]) {
+        let text = |b: &Option<Vec<u8>>| b.clone().and_then(|b| String::from_utf8(b).ok());
+        let stat = text(&cached[0]).and_then(|t| parse_stat_json(&t, None).ok());
+        let report = text(&cached[1]).and_then(|t| parse_report(&t).ok());
+        if let (Some(stat), Some(report)) = (stat, report) {
+            let cells = SynthCells {
+                luts: stat.luts,
+                ffs: stat.ffs,
+                dsps: stat.dsps,
+            };
+            return Ok(Timing::new(dp, arch, device, Some(&report), cells));
+        }
+    }
     let yosys = run("yosys", &["-q".into(), "-s".into(), "pnr.ys".into()], dir)?;
     if !yosys.status.success() {
         return Err(error(
@@ -67,17 +100,27 @@ pub fn place_and_route(
     }
     let stat = std::fs::read_to_string(dir.join("stat.json"))
         .map_err(|e| io_error("yosys", "yosys wrote no statistics", e))?;
-    let stat = parse_stat_json(&stat, None)?;
+    let stat_text = stat;
+    let stat = parse_stat_json(&stat_text, None)?;
     let cells = SynthCells {
         luts: stat.luts,
         ffs: stat.ffs,
         dsps: stat.dsps,
     };
-    let nextpnr = run("nextpnr-ice40", &nextpnr_args(device), dir)?;
+    let nextpnr = run("nextpnr-ice40", &args, dir)?;
     let report = if nextpnr.status.success() {
         let text = std::fs::read_to_string(dir.join("report.json"))
             .map_err(|e| io_error("nextpnr-ice40", "nextpnr-ice40 wrote no report", e))?;
-        Some(parse_report(&text)?)
+        let report = parse_report(&text)?;
+        cache::put(
+            "nextpnr",
+            &key,
+            &[
+                ("stat.json", stat_text.as_bytes()),
+                ("report.json", text.as_bytes()),
+            ],
+        );
+        Some(report)
     } else {
         let log = std::fs::read_to_string(dir.join("nextpnr.log")).unwrap_or_default();
         let timing = Timing::new(dp, arch, device, None, cells);

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use super::{child, error, io_error, work_dir, write};
+use super::{cache, child, error, io_error, work_dir, write};
 use crate::cycle::Arch;
 use crate::error::Error;
 use crate::hdl::cost::{parse_stat_json, yosys_script, CostReport, Synthesis, Target};
@@ -59,12 +59,26 @@ pub fn synthesise_rom(dp: &Datapath, target: Target) -> Result<Synthesis, Error>
         .map_err(|e| error("yosys", format!("yosys failed on the constant ROM: {e}")))
 }
 
-/// Runs yosys in `work` on `files` with `top`.
+/// Runs yosys in `work` on `files` with `top`, or takes its answer from the synthesis cache
+/// ([`super::cache`]) when it already synthesised exactly these inputs.
 fn run_in(work: &Path, files: &[PathBuf], top: &str, target: Target) -> Result<Synthesis, Error> {
     let version = check()?;
-    let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
-    let script = yosys_script(target, &files, &work.display().to_string(), top);
+    let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+    let script = yosys_script(target, &names, &work.display().to_string(), top);
     write("yosys", &work.join("cost.ys"), &script)?;
+    let key = cache_key(work, files, &version, &script);
+    if let Some(cached) = cache::get("yosys", &key, &["stat.json", "stat_cmos.txt"]) {
+        let text = |b: &Option<Vec<u8>>| b.clone().and_then(|b| String::from_utf8(b).ok());
+        if let Some(cost) = text(&cached[0])
+            .and_then(|stat| parse_stat_json(&stat, text(&cached[1]).as_deref()).ok())
+        {
+            return Ok(Synthesis {
+                cost,
+                version,
+                script,
+            });
+        }
+    }
     let out = child::output(
         Command::new("yosys")
             .args(["-q", "-s", "cost.ys"])
@@ -83,11 +97,54 @@ fn run_in(work: &Path, files: &[PathBuf], top: &str, target: Target) -> Result<S
         .map_err(|e| io_error("yosys", "yosys wrote no statistics", e))?;
     let cmos = std::fs::read_to_string(work.join("stat_cmos.txt")).ok();
     let cost = parse_stat_json(&stat, cmos.as_deref())?;
+    let mut kept: Vec<(&str, &[u8])> = vec![("stat.json", stat.as_bytes())];
+    if let Some(c) = &cmos {
+        kept.push(("stat_cmos.txt", c.as_bytes()));
+    }
+    cache::put("yosys", &key, &kept);
     Ok(Synthesis {
         cost,
         version,
         script,
     })
+}
+
+/// The synthesis cache's key of a run of yosys in `work`: its version, its script and every
+/// file it reads (the sources, and the work directory's files such as the parameter header),
+/// the work directory's own name left out.
+fn cache_key(work: &Path, files: &[PathBuf], version: &str, script: &str) -> String {
+    let shown = work.display().to_string();
+    let mut parts: Vec<Vec<u8>> = vec![
+        b"yosys synthesis 1".to_vec(),
+        version.as_bytes().to_vec(),
+        script.replace(&shown, "<work>").into_bytes(),
+    ];
+    for f in files {
+        parts.push(
+            f.display()
+                .to_string()
+                .replace(&shown, "<work>")
+                .into_bytes(),
+        );
+        parts.push(cache::file_bytes(f));
+    }
+    let mut own: Vec<PathBuf> = std::fs::read_dir(work)
+        .map(|d| d.flatten().map(|e| e.path()).collect())
+        .unwrap_or_default();
+    own.sort();
+    for f in own
+        .iter()
+        .filter(|f| f.is_file() && !f.ends_with("cost.ys"))
+    {
+        parts.push(
+            f.file_name()
+                .unwrap_or_default()
+                .as_encoded_bytes()
+                .to_vec(),
+        );
+        parts.push(cache::file_bytes(f));
+    }
+    cache::key(&parts.iter().map(Vec::as_slice).collect::<Vec<_>>())
 }
 
 /// The cost report of `specfx cost`: the analytic model's figures, beside yosys's for the

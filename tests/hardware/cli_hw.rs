@@ -176,3 +176,61 @@ fn cost_flags_what_exceeds_the_device() {
         "{flags:?}"
     );
 }
+
+/// The synthesis cache keeps what yosys and nextpnr answered for exactly these inputs. Shown
+/// from outside: once its entries are edited, a repeated `cost --timing` reports the edited
+/// figures (they came from the cache, not from the tools), while another configuration and
+/// `SPECFX_CACHE=off` give the tools' own figures again.
+#[test]
+fn a_repeated_synthesis_comes_from_the_cache_and_only_for_the_same_inputs() {
+    let root = tempfile::tempdir().unwrap();
+    let cache = root.path().join("cache");
+    let narrow = root.path().join("narrow.toml");
+    std::fs::write(&narrow, "[out]\nformat = \"u1.7\"\n").unwrap();
+    let cost = |config: &str, cache: &str| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_specfx"))
+            .args(["cost", "--timing", "--json", "--config", config])
+            .env("SPECFX_CACHE", cache)
+            .output()
+            .unwrap();
+        json(&o)
+    };
+    let figures = |v: &serde_json::Value| {
+        (
+            v["luts"].as_u64().unwrap(),
+            v["rom_yosys"]["luts"].as_u64().unwrap(),
+            v["timing"]["synthesis"]["luts"].as_u64().unwrap(),
+        )
+    };
+    let first = figures(&cost("baseline", cache.to_str().unwrap()));
+    // One entry per synthesis: the datapath and its ROM (yosys), the place and route.
+    let entries = |tool: &str| -> Vec<std::path::PathBuf> {
+        let mut v: Vec<_> = std::fs::read_dir(cache.join(tool))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(entries("yosys").len(), 2, "{:?}", entries("yosys"));
+    assert_eq!(entries("nextpnr").len(), 1, "{:?}", entries("nextpnr"));
+    // Every cached LUT count becomes 7777: what a run takes from the cache shows.
+    for e in entries("yosys").into_iter().chain(entries("nextpnr")) {
+        let stat = e.join("stat.json");
+        let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&stat).unwrap()).unwrap();
+        let mut v = v;
+        v["design"]["num_cells_by_type"]["SB_LUT4"] = 7777.into();
+        std::fs::write(&stat, serde_json::to_vec(&v).unwrap()).unwrap();
+    }
+    assert_eq!(
+        figures(&cost("baseline", cache.to_str().unwrap())),
+        (7777, 7777, 7777)
+    );
+    // Without the cache: the tools' own figures, the same as the first run's.
+    assert_eq!(figures(&cost("baseline", "off")), first);
+    // Another configuration is other inputs: synthesised, and its figures are not 7777.
+    let other = figures(&cost(narrow.to_str().unwrap(), cache.to_str().unwrap()));
+    assert!(other.0 != 7777 && other.2 != 7777, "{other:?}");
+    assert!(entries("yosys").len() >= 3, "{:?}", entries("yosys"));
+    assert_eq!(entries("nextpnr").len(), 2);
+}
