@@ -134,6 +134,12 @@ pub enum Error {
         /// What is wrong, e.g. `line 12: ...` or `no signal tb_specfx.clk`.
         problem: String,
     },
+    /// A co-simulation stimulus that cannot be made: too long, or not drained.
+    #[error("{problem}")]
+    Stimulus {
+        /// What is wrong and what to change.
+        problem: String,
+    },
     /// The minimax table has no entry for this (n, k).
     #[error("no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..=7")]
     NoMinimaxEntry {

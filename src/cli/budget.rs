@@ -67,13 +67,9 @@ pub fn budget(
         Some(ns) => {
             log::info!("budget: proving bounds with gappa for n = {ns:?}");
             let bar = super::progress::Progress::new("gappa", "exponents", ns.len() as u64);
-            gappa::add_formal_bounds(
-                dp,
-                &mut report,
-                ns,
-                &specfx::tools::gappa::run,
-                &|| bar.inc(1),
-            )?;
+            gappa::add_formal_bounds(dp, &mut report, ns, &specfx::tools::gappa::run, &|| {
+                bar.inc(1)
+            })?;
             bar.finish();
         }
         None => report.formal_note = Some("gappa was not run (--no-gappa).".into()),

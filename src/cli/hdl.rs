@@ -1,17 +1,15 @@
 //! `specfx hdl`: the bridge to the reference Verilog (parameter headers, co-simulation
 //! stimulus).
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 
 use super::output::write_atomic;
 use super::sim::parse_probability;
 use super::Outcome;
-use specfx::cycle::sim::{simulate, Stimulus, Stop};
-use specfx::cycle::vcd::write_vcd;
+use specfx::cycle::stimulus::{cosim_stimulus, StimulusRun};
 use specfx::cycle::Arch;
 use specfx::hdl::rom::rom_verilog;
 use specfx::hdl::{render_parameters, ParamsFormat};
@@ -224,12 +222,6 @@ fn params(args: &ParamsArgs) -> Result<Outcome> {
     print_or_write(out, &text)
 }
 
-fn bits_file(bits: &[bool]) -> String {
-    bits.iter()
-        .map(|&b| if b { "1\n" } else { "0\n" })
-        .collect()
-}
-
 /// A Verilog identifier (`--top`): a letter or `_`, then letters, digits, `_` or `$`, at most
 /// 1024 characters; anything else would go into the simulator's flags as more than a name.
 fn verilog_identifier(s: &str) -> std::result::Result<String, String> {
@@ -248,10 +240,6 @@ fn verilog_identifier(s: &str) -> std::result::Result<String, String> {
     }
 }
 
-/// The longest stimulus `specfx hdl stimulus` writes, in cycles (a line of each of its bit
-/// files per cycle).
-pub const MAX_STIMULUS_CYCLES: u64 = 1 << 26;
-
 /// What [`write_stimulus`] wrote: the run's size and latency range.
 pub struct StimulusInfo {
     /// Vectors streamed.
@@ -262,132 +250,44 @@ pub struct StimulusInfo {
     pub latency: (u64, u64),
 }
 
-/// Writes the co-simulation stimulus of an opened vector directory into `out`:
-/// `stim_valid.hex`, `stim_ready.hex`, `expected_cycle.hex` and `stim.json`, from the cycle
-/// model run on the vectors in file order under seeded bubbles and stalls; with `vcd`, also
-/// the model's trace of that run (every cycle until the last output transfers) to that file.
+/// Writes the co-simulation stimulus of an opened vector directory into `out`
+/// ([`cosim_stimulus`]), all files or none; with `vcd`, also the model's trace of that run to
+/// that file.
 pub fn write_stimulus(
     vectors: &super::vectordir::VectorDir,
     run: RunOpts,
     out: &Path,
     vcd: Option<&Path>,
 ) -> Result<StimulusInfo> {
+    let dp = specfx::pipeline::Datapath::new(vectors.config.clone())
+        .context("the manifest's configuration")?;
     let RunOpts {
         arch,
         seed,
         bubble,
         stall,
     } = run;
-    let dp = specfx::pipeline::Datapath::new(vectors.config.clone())
-        .context("the manifest's configuration")?;
-    let ns = dp.config().n.values();
-    // open() checked that every n is in the manifest's n set.
-    let items: Vec<(usize, i64)> = vectors
-        .inputs
-        .iter()
-        .map(|&(n, c)| {
-            (
-                ns.binary_search(&n).expect("n checked by vectordir::open"),
-                c,
-            )
-        })
-        .collect();
-    let mut stim = Stimulus::new(seed, bubble, stall);
-    // Each vector needs about one offer (1 / (1 - bubble) cycles) and, folded, an initiation
-    // interval of accepted outputs (ii / (1 - stall)); twenty times that, plus the latency,
-    // drains any run but one of vanishing probability. Longer stimuli are refused up front.
-    let ii = arch.initiation_interval(dp.config()) as f64;
-    let per_vector = 1.0 / (1.0 - bubble) + ii / (1.0 - stall);
-    let expected = (items.len() as f64 * per_vector).ceil();
-    // With a trace, every cycle is kept in memory: a tighter limit.
-    let (max, what) = match vcd {
-        Some(_) => (
-            specfx::cycle::vcd::MAX_TRACE_CYCLES,
-            "with --vcd, the trace",
-        ),
-        None => (MAX_STIMULUS_CYCLES, "the stimulus"),
-    };
-    if expected > max as f64 {
-        let fit = (max as f64 / per_vector).floor();
-        let advice = if fit < 1.0 {
-            "lower them".to_string()
-        } else {
-            format!("about {fit:.0} vectors fit at these probabilities: lower them or use fewer vectors")
-        };
-        bail!(
-            "--bubble {bubble} and --stall {stall} would need about {expected:.0} cycles for {} vectors; {what} is limited to {max} cycles ({advice})",
-            items.len()
-        );
-    }
-    // The run stops at the limit: a stimulus that has not drained by then is refused below.
-    let limit = (20.0 * expected + 100.0 * arch.latency(dp.config()) as f64 + 1_000.0)
-        .min(max as f64) as u64;
-    let trace_cycles = if vcd.is_some() { max } else { 0 };
-    let result = simulate(
-        &dp,
+    let run = StimulusRun {
         arch,
-        items.iter().copied(),
-        &mut stim,
-        Stop::Drained(limit),
-        trace_cycles,
-    );
-    let s = &result.stats;
-    if s.n_outputs != items.len() as u64 && s.mismatches == 0 && s.order_errors == 0 {
-        bail!(
-            "the stimulus did not drain within {limit} cycles ({} of {} outputs, --bubble {bubble}, --stall {stall}): lower the probabilities or change --seed",
-            s.n_outputs,
-            items.len()
-        );
-    }
-    if s.n_outputs != items.len() as u64 || s.mismatches != 0 || s.order_errors != 0 {
-        bail!(
-            "the cycle model delivered {} of {} outputs with {} mismatches: this is a bug",
-            s.n_outputs,
-            items.len(),
-            s.mismatches
-        );
-    }
-    let mut cycles = String::new();
-    for o in &result.outputs {
-        writeln!(cycles, "{:08x}", o.cycle).expect("write to String");
-    }
-    let info = serde_json::json!({
-        "arch": arch.name(),
-        "latency": arch.latency(dp.config()),
-        "initiation_interval": arch.initiation_interval(dp.config()),
-        "seed": seed,
-        "bubble": bubble,
-        "stall": stall,
-        "n_cycles": s.n_cycles,
-        "n_vectors": items.len(),
-        "latency_min": s.latency_min,
-        "latency_max": s.latency_max,
-    });
-    let mut json = serde_json::to_vec_pretty(&info)?;
-    json.push(b'\n');
-    // All or nothing, stim.json last (see STIMULUS_FILES).
-    let mut files = vec![
-        (
-            out.join("stim_valid.hex"),
-            bits_file(&result.valid_bits).into_bytes(),
-        ),
-        (
-            out.join("stim_ready.hex"),
-            bits_file(&result.ready_bits).into_bytes(),
-        ),
-        (out.join("expected_cycle.hex"), cycles.into_bytes()),
-        (out.join("stim.json"), json),
-    ];
-    if let Some(path) = vcd {
-        let mut buf = Vec::new();
-        write_vcd(&mut buf, &dp, arch, &result.trace)?;
-        files.push((path.to_path_buf(), buf));
+        seed,
+        bubble,
+        stall,
+    };
+    // open() checked that every n is in the manifest's n set.
+    let s = cosim_stimulus(&dp, &vectors.inputs, run, vcd.is_some())?;
+    let mut files: Vec<(PathBuf, Vec<u8>)> = s
+        .files
+        .into_iter()
+        .map(|(name, bytes)| (out.join(name), bytes))
+        .collect();
+    if let (Some(path), Some(trace)) = (vcd, s.vcd) {
+        files.push((path.to_path_buf(), trace));
     }
     super::output::write_all_atomic(&files)?;
     Ok(StimulusInfo {
-        n_vectors: items.len(),
+        n_vectors: s.n_vectors,
         n_cycles: s.n_cycles,
-        latency: (s.latency_min, s.latency_max),
+        latency: s.latency,
     })
 }
 

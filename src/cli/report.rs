@@ -258,7 +258,12 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     steps.start("error budget of baseline (attribution per stage, gappa bounds if installed)");
     let budget_dir = dir.join("budget_baseline");
     let ns: Vec<u32> = dp.constants().iter().map(|c| c.n).collect();
-    let budget = super::budget::budget(&dp, None, Some(&specfx::analysis::gappa::spread(&ns)), &budget_dir)?;
+    let budget = super::budget::budget(
+        &dp,
+        None,
+        Some(&specfx::analysis::gappa::spread(&ns)),
+        &budget_dir,
+    )?;
     written.push(budget_dir.join("budget.html"));
     written.push(budget_dir.join("budget.md"));
     written.push(budget_dir.join("budget.json"));

@@ -26,6 +26,7 @@
 pub mod compare;
 pub mod rtl;
 pub mod sim;
+pub mod stimulus;
 pub mod vcd;
 
 use serde::Serialize;

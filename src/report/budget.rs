@@ -503,11 +503,16 @@ pub fn budget_files(
     let mut md = Vec::new();
     write_markdown(&mut md, &doc).expect("writing into memory cannot fail");
     let mut html = Vec::new();
-    write_html(&mut html, &format!("Error budget: {}", r.config), &doc, |stem| {
-        svgs.iter()
-            .find(|(s, _)| s == stem)
-            .map(|(_, svg)| svg.clone())
-    })
+    write_html(
+        &mut html,
+        &format!("Error budget: {}", r.config),
+        &doc,
+        |stem| {
+            svgs.iter()
+                .find(|(s, _)| s == stem)
+                .map(|(_, svg)| svg.clone())
+        },
+    )
     .expect("writing into memory cannot fail");
     let mut json = serde_json::to_vec_pretty(r).map_err(|e| crate::error::Error::Render {
         message: format!("budget.json: {e}"),
