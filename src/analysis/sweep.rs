@@ -530,3 +530,189 @@ pub fn parse_shard(s: &str) -> Result<(u64, u64), Error> {
     }
     Ok((i, n))
 }
+
+/// `space.json`: what a sweep directory holds, the identity of its sweep and its shard.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepInfo {
+    /// The specfx version that wrote it.
+    pub specfx_version: String,
+    /// The sweep's identity, shared by all its shards: the sha256 of the canonical space and
+    /// the number of shards ([`sweep_sha256`]).
+    pub sweep_sha256: String,
+    /// The design space.
+    pub space: Space,
+    /// This shard's index, `I` of `I/N`.
+    pub shard_index: u64,
+    /// The number of shards, `N` of `I/N`.
+    pub shard_count: u64,
+    /// Points of the whole space.
+    pub n_points: u64,
+}
+
+/// The identity of a sweep: the sha256 of the canonical text of its space and shard count, so
+/// the same space written differently is the same sweep, and a shard of another space or of
+/// another sharding is not.
+pub fn sweep_sha256(space: &Space, shard_count: u64) -> String {
+    let inputs = space
+        .recorded(crate::provenance::Inputs::new("sweep"))
+        .option("shard_count", shard_count.to_string());
+    crate::provenance::sha256_hex(inputs.canonical().as_bytes())
+}
+
+/// Whether two spaces are the same, however they were written.
+pub fn same_space(a: &Space, b: &Space) -> bool {
+    sweep_sha256(a, 1) == sweep_sha256(b, 1)
+}
+
+/// How a points log is read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LogUse {
+    /// By the sweep that writes it: unreadable lines (a torn last line, an interrupted
+    /// write) are dropped and computed again, and the log rewritten without them.
+    Resume,
+    /// By `sweep merge`, which never writes to its inputs: an unreadable line is an error,
+    /// except a torn last line, which only makes the shard incomplete.
+    Merge,
+}
+
+impl SweepInfo {
+    /// The shard `shard_index/shard_count` of a sweep of `space`, by this specfx version.
+    pub fn new(space: Space, shard_index: u64, shard_count: u64) -> SweepInfo {
+        SweepInfo {
+            specfx_version: crate::provenance::VERSION.to_string(),
+            sweep_sha256: sweep_sha256(&space, shard_count),
+            n_points: space.n_points(),
+            space,
+            shard_index,
+            shard_count,
+        }
+    }
+
+    /// Reads and checks `space.json`'s text (`name` names it in errors, `dir` its sweep
+    /// directory): written by this specfx version, its identity matching its space, its shard
+    /// within its count.
+    pub fn from_json(text: &str, name: &str, dir: &str) -> Result<SweepInfo, Error> {
+        let refuse = |problem: String| Error::Manifest { problem };
+        let version = crate::provenance::VERSION;
+        let info: SweepInfo = serde_json::from_str(text).map_err(|e| {
+            refuse(format!(
+                "{dir}: not a sweep directory of specfx {version} (space.json): {}",
+                crate::error::one_line(&e.to_string())
+            ))
+        })?;
+        if info.specfx_version != version {
+            return Err(refuse(format!(
+                "{dir}: written by specfx {}, this is {version}: finish and merge it with specfx {}, or sweep again",
+                info.specfx_version, info.specfx_version
+            )));
+        }
+        if info.shard_count == 0
+            || info.shard_index >= info.shard_count
+            || info.n_points != info.space.n_points()
+            || info.sweep_sha256 != sweep_sha256(&info.space, info.shard_count)
+        {
+            return Err(refuse(format!(
+                "{name}: space.json does not match itself (its sweep_sha256, shard or number of points was changed)"
+            )));
+        }
+        Ok(info)
+    }
+
+    /// `I/N`.
+    pub fn shard(&self) -> String {
+        format!("{}/{}", self.shard_index, self.shard_count)
+    }
+
+    /// Whether point `index` belongs to this shard.
+    pub fn holds(&self, index: u64) -> bool {
+        index < self.n_points && index % self.shard_count == self.shard_index
+    }
+
+    /// The number of points of this shard.
+    pub fn shard_points(&self) -> u64 {
+        let (n, i, c) = (self.n_points, self.shard_index, self.shard_count);
+        if i >= n {
+            0
+        } else {
+            (n - 1 - i) / c + 1
+        }
+    }
+
+    /// `space.json`'s bytes (pretty JSON and a newline).
+    pub fn json(&self) -> Vec<u8> {
+        let mut json = serde_json::to_vec_pretty(self).expect("a sweep's identity serialises");
+        json.push(b'\n');
+        json
+    }
+
+    /// The points of a points log's `text` (`name` names it in errors), each checked to
+    /// belong to this sweep and shard (its index in the shard, its axis values those of the
+    /// space), and the log's good lines (to rewrite it without the others when resuming).
+    pub fn read_points(
+        &self,
+        text: &str,
+        name: &str,
+        how: LogUse,
+    ) -> Result<(BTreeMap<u64, PointResult>, String), Error> {
+        let refuse = |problem: String| Error::Manifest { problem };
+        let mut map = BTreeMap::new();
+        let mut good = String::new();
+        let lines: Vec<&str> = text.split_inclusive('\n').collect();
+        for (i, raw) in lines.iter().enumerate() {
+            let line = raw.trim_end_matches('\n');
+            let at = || format!("{name} line {}", i + 1);
+            let Ok(p) = serde_json::from_str::<PointResult>(line) else {
+                let torn = i + 1 == lines.len() && !raw.ends_with('\n');
+                if how == LogUse::Merge && !torn {
+                    return Err(refuse(format!(
+                        "{}: not a point record (expected one JSON object a line)",
+                        at()
+                    )));
+                }
+                continue;
+            };
+            if p.index >= self.n_points {
+                return Err(refuse(format!(
+                    "{}: point {} is outside the space ({} points): not a point of this sweep",
+                    at(),
+                    p.index,
+                    self.n_points
+                )));
+            }
+            if !self.holds(p.index) {
+                return Err(refuse(format!(
+                    "{}: point {} belongs to shard {}/{}, not to this directory's shard {}",
+                    at(),
+                    p.index,
+                    p.index % self.shard_count,
+                    self.shard_count,
+                    self.shard()
+                )));
+            }
+            let label = self.space.point_label(p.index);
+            if p.values != label {
+                return Err(refuse(format!(
+                    "{}: point {} is '{}' there but '{label}' in the space: not a point of this sweep",
+                    at(),
+                    p.index,
+                    p.values
+                )));
+            }
+            match map.get(&p.index) {
+                Some(q) if *q != p => {
+                    return Err(refuse(format!(
+                        "{}: point {} is recorded twice with different figures",
+                        at(),
+                        p.index
+                    )))
+                }
+                Some(_) => continue,
+                None => {}
+            }
+            good.push_str(line);
+            good.push('\n');
+            map.insert(p.index, p);
+        }
+        Ok((map, good))
+    }
+}

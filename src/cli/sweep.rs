@@ -11,8 +11,10 @@ use serde::{Deserialize, Serialize};
 
 use super::output::OutDir;
 use super::Outcome;
-use specfx::analysis::sweep::{evaluate, mark_pareto, parse_shard, PointResult, Space};
-use specfx::provenance::{sha256_hex, Inputs, Provenance, INPUTS_FILE, PROVENANCE_FILE};
+use specfx::analysis::sweep::{
+    evaluate, mark_pareto, parse_shard, same_space, LogUse, PointResult, Space, SweepInfo,
+};
+use specfx::provenance::{Inputs, Provenance, INPUTS_FILE, PROVENANCE_FILE};
 
 /// Arguments of `specfx sweep`.
 #[derive(Debug, Args)]
@@ -52,119 +54,18 @@ enum SweepCommand {
     },
 }
 
-/// `space.json`: what a sweep directory holds.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-struct SweepInfo {
-    specfx_version: String,
-    /// The sweep's identity, shared by all its shards: the sha256 of the canonical space and
-    /// the number of shards ([`sweep_sha256`]).
-    sweep_sha256: String,
-    space: Space,
-    shard_index: u64,
-    shard_count: u64,
-    n_points: u64,
-}
-
-/// The identity of a sweep: the sha256 of the canonical text of its space and shard count, so
-/// the same space written differently is the same sweep, and a shard of another space or of
-/// another sharding is not.
-fn sweep_sha256(space: &Space, shard_count: u64) -> String {
-    let inputs = space
-        .recorded(Inputs::new("sweep"))
-        .option("shard_count", shard_count.to_string());
-    sha256_hex(inputs.canonical().as_bytes())
-}
-
-/// Whether two spaces are the same, however they were written.
-fn same_space(a: &Space, b: &Space) -> bool {
-    sweep_sha256(a, 1) == sweep_sha256(b, 1)
-}
-
-impl SweepInfo {
-    fn new(space: Space, shard_index: u64, shard_count: u64) -> SweepInfo {
-        SweepInfo {
-            specfx_version: specfx::provenance::VERSION.to_string(),
-            sweep_sha256: sweep_sha256(&space, shard_count),
-            n_points: space.n_points(),
-            space,
-            shard_index,
-            shard_count,
-        }
-    }
-
-    /// `I/N`.
-    fn shard(&self) -> String {
-        format!("{}/{}", self.shard_index, self.shard_count)
-    }
-
-    /// Whether point `index` belongs to this shard.
-    fn holds(&self, index: u64) -> bool {
-        index < self.n_points && index % self.shard_count == self.shard_index
-    }
-
-    /// The number of points of this shard.
-    fn shard_points(&self) -> u64 {
-        let (n, i, c) = (self.n_points, self.shard_index, self.shard_count);
-        if i >= n {
-            0
-        } else {
-            (n - 1 - i) / c + 1
-        }
-    }
-
-    fn json(&self) -> Result<Vec<u8>> {
-        let mut json = serde_json::to_vec_pretty(self)?;
-        json.push(b'\n');
-        Ok(json)
-    }
-}
-
-/// Reads and checks a sweep directory's `space.json`: written by this specfx version, its
-/// identity matching its space, its shard within its count.
+/// Reads and checks a sweep directory's `space.json` ([`SweepInfo::from_json`]).
 fn read_info(dir: &Path) -> Result<SweepInfo> {
     let path = dir.join("space.json");
     if !path.exists() && !path.is_symlink() {
         bail!("{}: not a sweep directory (no space.json)", dir.display());
     }
     let text = super::input::read_text(&path, &path.display().to_string())?;
-    let info: SweepInfo = serde_json::from_str(&text).with_context(|| {
-        format!(
-            "{}: not a sweep directory of specfx {} (space.json)",
-            dir.display(),
-            specfx::provenance::VERSION
-        )
-    })?;
-    if info.specfx_version != specfx::provenance::VERSION {
-        bail!(
-            "{}: written by specfx {}, this is {}: finish and merge it with specfx {}, or sweep again",
-            dir.display(),
-            info.specfx_version,
-            specfx::provenance::VERSION,
-            info.specfx_version
-        );
-    }
-    if info.shard_count == 0
-        || info.shard_index >= info.shard_count
-        || info.n_points != info.space.n_points()
-        || info.sweep_sha256 != sweep_sha256(&info.space, info.shard_count)
-    {
-        bail!(
-            "{}: space.json does not match itself (its sweep_sha256, shard or number of points was changed)",
-            path.display()
-        );
-    }
-    Ok(info)
-}
-
-/// How a points log is read.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum LogUse {
-    /// By the sweep that writes it: unreadable lines (a torn last line, an interrupted
-    /// write) are dropped and computed again, and the log rewritten without them.
-    Resume,
-    /// By `sweep merge`, which never writes to its inputs: an unreadable line is an error,
-    /// except a torn last line, which only makes the shard incomplete.
-    Merge,
+    Ok(SweepInfo::from_json(
+        &text,
+        &path.display().to_string(),
+        &dir.display().to_string(),
+    )?)
 }
 
 /// The largest points log read (about 600 bytes a point, at most 2^20 points).
@@ -174,67 +75,12 @@ const MAX_LOG_BYTES: u64 = 1 << 30;
 /// shard of `info` (its index in the shard, its axis values those of the space).
 fn read_log(dir: &Path, info: &SweepInfo, how: LogUse) -> Result<BTreeMap<u64, PointResult>> {
     let path = dir.join("points.jsonl");
-    let mut map = BTreeMap::new();
     if !path.exists() && !path.is_symlink() {
-        return Ok(map);
+        return Ok(BTreeMap::new());
     }
     let bytes = super::input::read_bytes(&path, &path.display().to_string(), MAX_LOG_BYTES)?;
     let text = String::from_utf8_lossy(&bytes);
-    let mut good = String::new();
-    let lines: Vec<&str> = text.split_inclusive('\n').collect();
-    for (i, raw) in lines.iter().enumerate() {
-        let line = raw.trim_end_matches('\n');
-        let at = || format!("{} line {}", path.display(), i + 1);
-        let Ok(p) = serde_json::from_str::<PointResult>(line) else {
-            let torn = i + 1 == lines.len() && !raw.ends_with('\n');
-            if how == LogUse::Merge && !torn {
-                bail!(
-                    "{}: not a point record (expected one JSON object a line)",
-                    at()
-                );
-            }
-            continue;
-        };
-        if p.index >= info.n_points {
-            bail!(
-                "{}: point {} is outside the space ({} points): not a point of this sweep",
-                at(),
-                p.index,
-                info.n_points
-            );
-        }
-        if !info.holds(p.index) {
-            bail!(
-                "{}: point {} belongs to shard {}/{}, not to this directory's shard {}",
-                at(),
-                p.index,
-                p.index % info.shard_count,
-                info.shard_count,
-                info.shard()
-            );
-        }
-        let label = info.space.point_label(p.index);
-        if p.values != label {
-            bail!(
-                "{}: point {} is '{}' there but '{label}' in the space: not a point of this sweep",
-                at(),
-                p.index,
-                p.values
-            );
-        }
-        match map.get(&p.index) {
-            Some(q) if *q != p => bail!(
-                "{}: point {} is recorded twice with different figures",
-                at(),
-                p.index
-            ),
-            Some(_) => continue,
-            None => {}
-        }
-        good.push_str(line);
-        good.push('\n');
-        map.insert(p.index, p);
-    }
+    let (map, good) = info.read_points(&text, &path.display().to_string(), how)?;
     if how == LogUse::Resume && good.len() != text.len() {
         super::output::write_all_shown(
             dir,
@@ -301,7 +147,7 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
         super::output::write_all_shown(
             staged.path(),
             dir,
-            &[("space.json".to_string(), info.json()?)],
+            &[("space.json".to_string(), info.json())],
         )?;
         staged.commit()?;
     }
@@ -609,7 +455,7 @@ fn merge(out: &Path, shards: &[PathBuf], force: bool) -> Result<Outcome> {
         staged.path(),
         out,
         &[
-            ("space.json".to_string(), merged.json()?),
+            ("space.json".to_string(), merged.json()),
             ("points.jsonl".to_string(), lines.into_bytes()),
         ],
     )?;
