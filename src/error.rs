@@ -219,7 +219,7 @@ pub enum FixedError {
 
 #[cfg(test)]
 mod tests {
-    use crate::analysis::optimize::Budget;
+    use crate::analysis::budget_expr::Budget;
     use crate::fixed::{Format, Rounding};
     use crate::reference::lobe::Cutoff;
 

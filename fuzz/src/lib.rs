@@ -7,7 +7,7 @@
 
 use std::fmt::Display;
 
-use specfx::analysis::optimize::Budget;
+use specfx::analysis::budget_expr::Budget;
 use specfx::analysis::sweep::{Space, MAX_POINTS};
 use specfx::cycle::compare::compare;
 use specfx::fixed::{Format, Overflow, Rounding};

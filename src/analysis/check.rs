@@ -8,10 +8,10 @@
 
 use serde::Serialize;
 
-use crate::analysis::budget::F64Walk;
 use crate::engine::{each_chunk, map_n, Codes, Span};
 use crate::error::Error;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
+use crate::pipeline::f64_walk::F64Walk;
 use crate::pipeline::fast::EventCounts;
 use crate::pipeline::{first_code_where, Datapath, NConstants, MAX_STAGES};
 use crate::reference::lobe::Cutoff;

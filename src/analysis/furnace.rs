@@ -22,10 +22,10 @@ use std::f64::consts::{FRAC_PI_4, PI};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::analysis::budget::F64Walk;
 use crate::analysis::check::MAX_CHECK_CODES;
 use crate::error::Error;
 use crate::nset::NSet;
+use crate::pipeline::f64_walk::F64Walk;
 use crate::pipeline::{Datapath, NConstants, OutputScratch};
 use crate::reference::lobe::{cos_pow, m_of_k, paper_cutoff_cosine, Cutoff};
 use crate::reference::normalisation::{classic_coefficient, coefficient, CoefSource, Form};

@@ -16,9 +16,9 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use crate::analysis::budget::mixed_eval;
 use crate::error::Error;
 use crate::fixed::{Event, Exact, Rounding};
+use crate::pipeline::f64_walk::mixed_eval;
 use crate::pipeline::walk::{walk, Arithmetic};
 use crate::pipeline::{first_code_where, Datapath, NConstants, StageSpec};
 use crate::reference::lobe::Cutoff;

@@ -1,6 +1,7 @@
 //! Analyses over the reference and the datapath: the paper reproduction, method errors, and
 //! exhaustive accuracy checks.
 pub mod budget;
+pub mod budget_expr;
 pub mod check;
 pub mod furnace;
 pub mod gappa;

@@ -7,10 +7,9 @@ use clap::Args;
 
 use super::output::write_atomic;
 use super::Outcome;
+use specfx::analysis::budget_expr::{Budget, Metric};
 use specfx::analysis::check::check;
-use specfx::analysis::optimize::{
-    algorithm_floors, optimize_all, Algorithm, Budget, Metric, SearchResult,
-};
+use specfx::analysis::optimize::{algorithm_floors, optimize_all, Algorithm, SearchResult};
 use specfx::cycle::Arch;
 use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;

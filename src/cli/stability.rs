@@ -10,7 +10,7 @@ use clap::Args;
 use super::output::{print_json, write_atomic, write_chart, write_figure, write_provenance};
 use super::Outcome;
 use specfx::analysis::stability::{
-    analyse, default_paths, FloatPath, Grid, Path as MapPath, StabilityReport, Tolerance,
+    analyse, default_paths, FloatPath, Grid, MapPath, StabilityReport, Tolerance,
 };
 use specfx::nset::NSet;
 use specfx::provenance::{canonical_nset, Inputs, Provenance};

@@ -137,16 +137,9 @@ pub const MAX_NAME_LEN: usize = 64;
 /// a directory.
 ///
 /// # Errors
-/// A description of what was expected.
-///
-/// # Examples
-/// ```
-/// use specfx::pipeline::config::check_name;
-/// assert!(check_name("k5_minimax-2.1").is_ok());
-/// assert!(check_name("a\n`define X").is_err());
-/// assert!(check_name("../escaped").is_err());
-/// ```
-pub fn check_name(name: &str) -> Result<(), String> {
+/// A description of what was expected, which the callers put into their error (a
+/// configuration's `name`, a scene's material, a sweep's base).
+pub(crate) fn check_name(name: &str) -> Result<(), String> {
     let ok_char = |c: char| c.is_ascii_alphanumeric() || "_-.+".contains(c);
     let bad = name.chars().find(|&c| !ok_char(c));
     if name.is_empty()
@@ -480,6 +473,14 @@ impl ConfigFile {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn names_that_could_change_a_file_are_refused() {
+        assert!(super::check_name("k5_minimax-2.1").is_ok());
+        assert!(super::check_name("a\n`define X").is_err());
+        assert!(super::check_name("../escaped").is_err());
+    }
+
     use super::*;
 
     #[test]

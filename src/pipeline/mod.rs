@@ -18,6 +18,7 @@
 
 pub mod config;
 pub mod datapath;
+pub mod f64_walk;
 pub mod fast;
 pub mod walk;
 

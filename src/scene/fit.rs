@@ -11,8 +11,9 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
+use crate::analysis::budget_expr::Verdict;
 use crate::analysis::optimize::{
-    combine, search, start_of, Algorithm, Candidate, Choices, Knob, SearchResult, Space, Verdict,
+    combine, search, start_of, Algorithm, Candidate, Choices, Knob, SearchResult, Space,
 };
 use crate::error::Error;
 use crate::fixed::Rounding;
@@ -96,7 +97,8 @@ impl FromStr for ImageBudget {
         }
         };
         let mut bounds = Vec::new();
-        let parts = crate::analysis::optimize::bound_parts(s).map_err(|why| bad(s.trim(), &why))?;
+        let parts =
+            crate::analysis::budget_expr::bound_parts(s).map_err(|why| bad(s.trim(), &why))?;
         for part in &parts {
             let part = part.as_str();
             let Some((lhs, rhs)) = part.split_once("<=") else {

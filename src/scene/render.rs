@@ -12,7 +12,7 @@
 
 use rayon::prelude::*;
 
-use crate::analysis::budget::F64Walk;
+use crate::pipeline::f64_walk::F64Walk;
 use crate::pipeline::{Datapath, NConstants, OutputScratch};
 use crate::reference::normalisation::{classic_coefficient, Form};
 use crate::scene::{add_scaled, cross, dot, norm, normalize, sub, LightKind, Model, Scene, Shape};

@@ -1,7 +1,7 @@
 //! External programs: yosys, nextpnr-ice40, gappa and the simulators, each run as a child that
 //! ends with specfx, in a work directory of its own. The one place of specfx that starts a
 //! process or writes a file; the rest of the library receives a tool as a closure (as
-//! `analysis::optimize::Synthesise`) or a tool's text to parse.
+//! `analysis::budget_expr::Synthesise`) or a tool's text to parse.
 
 use std::io;
 use std::path::{Path, PathBuf};

@@ -115,15 +115,15 @@ fn check_and_budget_are_the_same_with_one_and_two_threads() {
 /// stream in n order: the same with one and two threads.
 #[test]
 fn stability_and_tradeoff_accuracy_are_the_same_with_one_and_two_threads() {
-    use specfx::analysis::stability::{map, narrow_datapath, Grid, Path};
+    use specfx::analysis::stability::{map, narrow_datapath, Grid, MapPath};
     use specfx::fixed::Overflow;
     let grid = Grid {
         n: "1..=40,500,4000".parse().unwrap(),
         ..Grid::default()
     };
     let paths = [
-        Path::Fixed(Box::new(Config::baseline())),
-        Path::Fixed(Box::new(narrow_datapath(Overflow::Wrap))),
+        MapPath::Fixed(Box::new(Config::baseline())),
+        MapPath::Fixed(Box::new(narrow_datapath(Overflow::Wrap))),
     ];
     let one = in_pool(1, || map(&paths, &grid, &|_, _| {}).unwrap());
     let two = in_pool(2, || map(&paths, &grid, &|_, _| {}).unwrap());

@@ -5,9 +5,10 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use crate::common::specfx;
-use specfx::analysis::budget::{analyse, mixed_eval, sources, Source, ALL_SOURCES};
+use specfx::analysis::budget::analyse;
 use specfx::analysis::check::reference_probes;
 use specfx::analysis::gappa;
+use specfx::pipeline::f64_walk::{mixed_eval, sources, Source, ALL_SOURCES};
 use specfx::pipeline::{Config, Datapath};
 use specfx::reference::lobe::Cutoff;
 

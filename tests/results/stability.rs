@@ -6,8 +6,8 @@ use crate::common::specfx;
 use std::f64::consts::PI;
 
 use specfx::analysis::stability::{
-    map, narrow_datapath, overshoot_threshold, special_outcomes, FloatPath, Grid, Kind, Path,
-    PathMap, Region, Tolerance, Verdict,
+    map, narrow_datapath, overshoot_threshold, special_outcomes, FloatPath, Grid, Kind, MapPath,
+    PathMap, Region, SpecialVerdict, Tolerance,
 };
 use specfx::fixed::Overflow;
 use specfx::pipeline::Config;
@@ -24,11 +24,11 @@ fn grid(n: &str, c_bits: u32) -> Grid {
     }
 }
 
-fn cs(k: u32, cutoff: Cutoff) -> Path {
-    Path::Float(FloatPath::Method(Method::CsM { k, cutoff }))
+fn cs(k: u32, cutoff: Cutoff) -> MapPath {
+    MapPath::Float(FloatPath::Method(Method::CsM { k, cutoff }))
 }
 
-fn run(paths: &[Path], g: &Grid) -> Vec<PathMap> {
+fn run(paths: &[MapPath], g: &Grid) -> Vec<PathMap> {
     map(paths, g, &|_, _| {}).unwrap()
 }
 
@@ -173,7 +173,7 @@ fn below_m_the_lobe_does_not_close() {
 #[test]
 fn schlicks_tail_lies_where_its_closed_form_says() {
     let g = grid("1..=1024", 14);
-    let maps = run(&[Path::Float(FloatPath::Method(Method::Schlick))], &g);
+    let maps = run(&[MapPath::Float(FloatPath::Method(Method::Schlick))], &g);
     let scale = f64::from(1u32 << 14);
     let oracle = |n: u32| {
         let nf = f64::from(n);
@@ -196,9 +196,9 @@ fn schlicks_tail_lies_where_its_closed_form_says() {
 fn underflow_starts_where_the_float_types_run_out() {
     let g = grid("1..=4096", 15);
     let paths = [
-        Path::Float(FloatPath::Method(Method::CosPow)),
-        Path::Float(FloatPath::PowF32),
-        Path::Float(FloatPath::Method(Method::ExpLimit)),
+        MapPath::Float(FloatPath::Method(Method::CosPow)),
+        MapPath::Float(FloatPath::PowF32),
+        MapPath::Float(FloatPath::Method(Method::ExpLimit)),
     ];
     let maps = run(&paths, &g);
     // powf in f64: (j / 2^15)^n < 2^-1022; first at the smallest code, 2^-15n < 2^-1022, so
@@ -264,7 +264,7 @@ fn narrow_wrap_oracle(code: i64, n: i64, coef_raw: i64) -> (i64, i64, bool) {
 fn wrap_around_and_non_monotonic_regions_of_the_narrow_datapath() {
     let g = grid("1..=4096", 9);
     let cfg = narrow_datapath(Overflow::Wrap);
-    let maps = run(&[Path::Fixed(Box::new(cfg))], &g);
+    let maps = run(&[MapPath::Fixed(Box::new(cfg))], &g);
     let m = &maps[0];
     let coef_raw = |n: u32| {
         let c = specfx::reference::normalisation::coefficient(
@@ -313,7 +313,7 @@ fn rounding_alone_never_makes_a_datapath_non_monotonic() {
             s.format = format!("u1.{}", 5 + i).parse().unwrap();
         }
         cfg.out.rounding = mode;
-        paths.push(Path::Fixed(Box::new(cfg)));
+        paths.push(MapPath::Fixed(Box::new(cfg)));
     }
     for m in run(&paths, &g) {
         assert!(m.region(Kind::NonMonotonic).is_none(), "{}", m.path);
@@ -328,7 +328,7 @@ fn baselines_coefficient_does_not_fit_from_n_1514() {
     let n_star = ((256.0 - 2f64.powi(-17)) * 32.0 * PI / 17.0).ceil() as u32;
     assert_eq!(n_star, 1514);
     let g = grid("1400..=1600", 15);
-    let maps = run(&[Path::Fixed(Box::new(Config::baseline()))], &g);
+    let maps = run(&[MapPath::Fixed(Box::new(Config::baseline()))], &g);
     let r = region(&maps[0], Kind::Unrepresentable);
     assert_eq!((r.n_min, r.n_max), (n_star, 1600));
     assert!(r.fails);
@@ -362,7 +362,7 @@ fn baselines_lobe_underflows_where_its_rounded_squares_reach_zero() {
         (b, s)
     };
     let g = grid("64,1024", 15);
-    let maps = run(&[Path::Fixed(Box::new(Config::baseline()))], &g);
+    let maps = run(&[MapPath::Fixed(Box::new(Config::baseline()))], &g);
     assert_region_matches(
         maps[0].region(Kind::Underflow),
         g.n.values(),
@@ -427,13 +427,13 @@ fn overshoot_thresholds_follow_their_closed_forms() {
 #[test]
 fn special_inputs_follow_ieee_754() {
     let paths = [
-        Path::Float(FloatPath::Method(Method::CosPow)),
+        MapPath::Float(FloatPath::Method(Method::CosPow)),
         cs(4, Cutoff::Clamp),
         cs(4, Cutoff::None),
-        Path::Float(FloatPath::Method(Method::Schlick)),
-        Path::Float(FloatPath::Method(Method::ExpLimit)),
-        Path::Float(FloatPath::Method(Method::Minimax { k: 4 })),
-        Path::Fixed(Box::new(Config::baseline())),
+        MapPath::Float(FloatPath::Method(Method::Schlick)),
+        MapPath::Float(FloatPath::Method(Method::ExpLimit)),
+        MapPath::Float(FloatPath::Method(Method::Minimax { k: 4 })),
+        MapPath::Fixed(Box::new(Config::baseline())),
     ];
     let all = special_outcomes(&paths, TOL).unwrap();
     let verdict = |path: &str, input: &str, n: u32| {
@@ -442,27 +442,42 @@ fn special_inputs_follow_ieee_754() {
             .map(|s| s.verdict)
     };
     // powf(NaN) is NaN; max(0, NaN) in Rust (IEEE maxNum) is 0, so the clamp absorbs NaN.
-    assert_eq!(verdict("powf", "NaN", 16), Some(Verdict::Nan));
-    assert_eq!(verdict("cs16_clamp", "NaN", 16), Some(Verdict::Absorbed));
-    assert_eq!(verdict("minimax16", "NaN", 16), Some(Verdict::Absorbed));
-    assert_eq!(verdict("cs16_none", "NaN", 16), Some(Verdict::Nan));
+    assert_eq!(verdict("powf", "NaN", 16), Some(SpecialVerdict::Nan));
+    assert_eq!(
+        verdict("cs16_clamp", "NaN", 16),
+        Some(SpecialVerdict::Absorbed)
+    );
+    assert_eq!(
+        verdict("minimax16", "NaN", 16),
+        Some(SpecialVerdict::Absorbed)
+    );
+    assert_eq!(verdict("cs16_none", "NaN", 16), Some(SpecialVerdict::Nan));
     // +inf: inf^n; Schlick inf / (n - inf + inf) = NaN; exp(+inf) = inf.
-    assert_eq!(verdict("powf", "+inf", 16), Some(Verdict::Inf));
-    assert_eq!(verdict("schlick", "+inf", 16), Some(Verdict::Nan));
-    assert_eq!(verdict("exp_limit", "+inf", 16), Some(Verdict::Inf));
+    assert_eq!(verdict("powf", "+inf", 16), Some(SpecialVerdict::Inf));
+    assert_eq!(verdict("schlick", "+inf", 16), Some(SpecialVerdict::Nan));
+    assert_eq!(verdict("exp_limit", "+inf", 16), Some(SpecialVerdict::Inf));
     // -inf: powf is 0 for c <= 0, the clamp cuts; an even power of -inf is +inf.
-    assert_eq!(verdict("powf", "-inf", 16), Some(Verdict::Absorbed));
-    assert_eq!(verdict("cs16_clamp", "-inf", 1024), Some(Verdict::Absorbed));
-    assert_eq!(verdict("cs16_none", "-inf", 1024), Some(Verdict::Inf));
+    assert_eq!(verdict("powf", "-inf", 16), Some(SpecialVerdict::Absorbed));
+    assert_eq!(
+        verdict("cs16_clamp", "-inf", 1024),
+        Some(SpecialVerdict::Absorbed)
+    );
+    assert_eq!(
+        verdict("cs16_none", "-inf", 1024),
+        Some(SpecialVerdict::Inf)
+    );
     // Just below 0, Schlick's c / (n - n c + c) is negative.
-    assert_eq!(verdict("schlick", "-2^-24", 16), Some(Verdict::Negative));
-    assert_eq!(verdict("powf", "-2^-24", 16), Some(Verdict::Ok));
+    assert_eq!(
+        verdict("schlick", "-2^-24", 16),
+        Some(SpecialVerdict::Negative)
+    );
+    assert_eq!(verdict("powf", "-2^-24", 16), Some(SpecialVerdict::Ok));
     // 1 + 2^-10 to the 4096th is e^4 = 54.6: far off.
-    assert_eq!(verdict("powf", "1+2^-10", 4096), Some(Verdict::Off));
+    assert_eq!(verdict("powf", "1+2^-10", 4096), Some(SpecialVerdict::Off));
     // The datapath rounds the input into u1.15 and clamps codes above 1.0: nothing overshoots;
     // NaN has no code and is left out.
-    assert_eq!(verdict("baseline", "1+2^-10", 16), Some(Verdict::Ok));
-    assert_eq!(verdict("baseline", "-2^-10", 16), Some(Verdict::Ok));
+    assert_eq!(verdict("baseline", "1+2^-10", 16), Some(SpecialVerdict::Ok));
+    assert_eq!(verdict("baseline", "-2^-10", 16), Some(SpecialVerdict::Ok));
     assert_eq!(verdict("baseline", "NaN", 16), None);
 }
 
