@@ -18,7 +18,7 @@ use std::fmt;
 
 use serde::Serialize;
 
-use crate::analysis::budget_expr::{Budget, Metric, Synthesise, Verdict};
+use crate::analysis::budget_expr::{Bound, Budget, Metric, Synthesise, Verdict};
 use crate::analysis::check::check_outputs;
 use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
@@ -727,4 +727,40 @@ pub fn optimize_all(
     }
     out.floors = floors;
     Ok(out)
+}
+
+/// The closest configuration searched when none meets the budget, with its check's figures
+/// and the value of each of the budget's cost ceilings.
+#[derive(Debug, Clone)]
+pub struct Closest {
+    /// The configuration and how far it is from the budget.
+    pub candidate: Candidate,
+    /// Its lobe error against cos^n.
+    pub shape_total: f64,
+    /// Its quantization error.
+    pub shape_quant: f64,
+    /// Its output error in ulp.
+    pub out_ulp: f64,
+    /// The fraction of its outputs correctly rounded.
+    pub correctly_rounded: f64,
+    /// Each cost ceiling of the budget with its value ([`Budget::cost_values`]).
+    pub costs: Vec<(Bound, f64)>,
+}
+
+/// [`Closest`] for the result's closest configuration, if it has one: checked exhaustively,
+/// its cost ceilings valued (yosys's through `synth`).
+pub fn closest(r: &OptimizeAll, synth: Option<Synthesise>) -> Result<Option<Closest>, Error> {
+    let Some(c) = &r.closest else {
+        return Ok(None);
+    };
+    let dp = Datapath::new(c.config.clone())?;
+    let chk = crate::analysis::check::check(&dp)?;
+    Ok(Some(Closest {
+        candidate: c.clone(),
+        shape_total: chk.shape_total_max_abs,
+        shape_quant: chk.shape_quant_max_abs,
+        out_ulp: chk.out_max_ulp,
+        correctly_rounded: chk.stages[dp.stage_out()].correctly_rounded,
+        costs: r.budget.cost_values(&dp, synth)?,
+    }))
 }

@@ -14,6 +14,7 @@ use specfx::cycle::Arch;
 use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;
 use specfx::pipeline::{Datapath, Variant};
+use specfx::report::optimize::write_no_answer;
 use specfx::report::table::{Align, TextTable};
 
 /// The first bytes of the configuration `specfx optimize` writes: a file that begins with
@@ -161,89 +162,10 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         r.n_evaluations
     )?;
     let Some(best) = &r.best else {
-        super::output::outln!("no configuration in the space meets the budget")?;
-        super::output::outln!("the f64 floor of each algorithm (its own error against cos^n before any quantization):")?;
-        let normalised = r.budget.bounds.iter().any(|b| b.metric.is_normalised());
-        let mut columns = vec![
-            ("k", Align::Right),
-            ("variant", Align::Left),
-            ("shape_total floor", Align::Right),
-            ("lsb8", Align::Right),
-        ];
-        if normalised {
-            columns.extend([
-                ("out_rel floor", Align::Right),
-                ("effective bits", Align::Right),
-            ]);
-        }
-        columns.push(("", Align::Left));
-        let mut table = TextTable::new(&columns).indent(2);
-        for f in &r.floors {
-            let a = f.algorithm;
-            let mut row = vec![a.k.to_string(), a.variant.name().to_string()];
-            match (f.shape_total, &f.reason) {
-                (Some(x), _) => {
-                    row.push(format!("{x:.3e}"));
-                    row.push(format!("{:.2}", x / specfx::analysis::LSB8));
-                    if normalised {
-                        match f.norm_rel {
-                            Some(r) => {
-                                row.push(format!("{r:.3e}"));
-                                row.push(format!(
-                                    "{:.1}",
-                                    specfx::analysis::check::effective_bits(r)
-                                ));
-                            }
-                            None => row.extend(["-".to_string(), "-".to_string()]),
-                        }
-                    }
-                    row.push(if f.reachable { "" } else { "beyond the budget" }.to_string());
-                }
-                (None, reason) => {
-                    row.extend(["-".to_string(), "-".to_string()]);
-                    if normalised {
-                        row.extend(["-".to_string(), "-".to_string()]);
-                    }
-                    row.push(format!("not valid: {}", reason.as_deref().unwrap_or("")));
-                }
-            }
-            table.row(row);
-        }
-        super::output::print_with(|w| table.write(w, super::terminal::table_width()))?;
-        if let Some(f) = r
-            .floors
-            .iter()
-            .filter(|f| f.shape_total.is_some())
-            .min_by(|a, b| a.shape_total.unwrap().total_cmp(&b.shape_total.unwrap()))
-        {
-            super::output::outln!(
-                "closest algorithm: k = {} {}, whose f64 floor is {:.3e} ({:.2} lsb8); what would meet the budget: a shape_total limit above that floor (quantization adds to it), or fewer exponents (--n: the floors fall when every n is at least m = 2^k)",
-                f.algorithm.k,
-                f.algorithm.variant.name(),
-                f.shape_total.unwrap(),
-                f.shape_total.unwrap() * 256.0
-            )?;
-        }
-        if let Some(c) = &r.closest {
-            let dp = Datapath::new(c.config.clone())?;
-            let chk = check(&dp)?;
-            super::output::outln!(
-                "closest: k = {}, {}: shape_total {:.3e}, shape_quant {:.3e}, out {:.2} ulp, {:.2}% correct ({:.2}x the budget)",
-                c.config.k,
-                c.config.variant.name(),
-                chk.shape_total_max_abs,
-                chk.shape_quant_max_abs,
-                chk.out_max_ulp,
-                100.0 * chk.stages[dp.stage_out()].correctly_rounded,
-                c.excess
-            )?;
-            let mut budget = r.budget.clone();
-            budget.arch = arch;
-            for (b, value) in budget.cost_values(&dp, Some(&synth))? {
-                let kind = if b.metric.is_yosys() { "" } else { "analytic " };
-                super::output::outln!("  its {kind}{}: {value} (limit {})", b.metric, b.limit)?;
-            }
-        }
+        let closest = specfx::analysis::optimize::closest(&r, Some(&synth))?;
+        super::output::print_with(|w| {
+            write_no_answer(w, &r, closest.as_ref(), super::terminal::table_width())
+        })?;
         return Ok(Outcome::CheckFailed);
     };
     // The proof: the exhaustive check of the answer, against the budget.

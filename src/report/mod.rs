@@ -9,6 +9,7 @@ pub mod doc;
 pub mod fit;
 pub mod furnace;
 pub mod index;
+pub mod optimize;
 pub mod paper;
 pub mod scene;
 pub mod stability;
