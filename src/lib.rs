@@ -16,6 +16,8 @@
 //! assert!((approx - cos_pow(c, n)).abs() < 0.02);
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod csv_dialect;
 pub mod cycle;

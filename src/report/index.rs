@@ -12,15 +12,21 @@ use crate::provenance::{INPUTS_FILE, PROVENANCE_FILE};
 /// report is interrupted, see `cli/resume.rs`).
 #[derive(Serialize, Deserialize)]
 pub struct CostRow {
+    /// The architecture.
     pub arch: crate::cycle::Arch,
-    /// yosys LUTs, DSPs, flip-flops and carry cells.
+    /// yosys LUTs.
     pub luts: u64,
+    /// yosys DSP blocks.
     pub dsps: u64,
+    /// yosys flip-flops.
     pub ffs: u64,
+    /// yosys carry cells.
     pub carries: u64,
-    /// The analytic model's LUTs, latency and initiation interval.
+    /// The analytic model's LUTs.
     pub analytic_luts: u64,
+    /// Latency in cycles.
     pub latency: u64,
+    /// Initiation interval in cycles.
     pub initiation_interval: u64,
     /// yosys LUTs of the constant ROM.
     pub rom_luts: u64,
@@ -33,9 +39,13 @@ pub struct CostRow {
 /// What the index page needs of a place and route.
 #[derive(Serialize, Deserialize)]
 pub struct TimingRow {
+    /// Fmax in MHz, when the design was placed.
     pub fmax_mhz: Option<f64>,
+    /// Whether Fmax is an upper bound (nextpnr does not time through the DSPs).
     pub fmax_is_upper_bound: bool,
+    /// Latency in ns at Fmax.
     pub latency_ns: Option<f64>,
+    /// Throughput at Fmax.
     pub throughput_samples_per_s: Option<f64>,
 }
 
@@ -66,8 +76,11 @@ impl CostRow {
 /// What the index page needs of one method of the trade-off.
 #[derive(Serialize, Deserialize)]
 pub struct FigureRow {
+    /// The method's name.
     pub method: String,
+    /// Its largest error against cos^n.
     pub max_abs_err: f64,
+    /// Its mean error against cos^n.
     pub mean_abs_err: f64,
 }
 
@@ -85,24 +98,39 @@ pub struct StabilitySummary {
 /// What the index page and the summary need of the fit to the built-in scene.
 #[derive(Serialize, Deserialize)]
 pub struct FitSummary {
+    /// The target of the costs.
     pub target: crate::hdl::cost::Target,
+    /// Inputs the scene produces (every one proved).
     pub inputs: u64,
+    /// The generic datapath's cost.
     pub generic_cost: crate::scene::fitting::SideCost,
+    /// The fitted datapath's cost.
     pub fitted_cost: crate::scene::fitting::SideCost,
 }
 
 /// What the index page summarises.
 pub struct Results<'a> {
+    /// The paper's claims.
     pub paper: &'a crate::analysis::paper::PaperReproduction,
+    /// The baseline's exhaustive check.
     pub checked: &'a crate::analysis::check::CheckReport,
+    /// The baseline's error budget.
     pub budget: &'a crate::analysis::budget::BudgetReport,
+    /// The trade-off's methods.
     pub figures: &'a [FigureRow],
+    /// The stability maps.
     pub stability: &'a StabilitySummary,
+    /// The built-in scene through baseline, per material.
     pub render: &'a [crate::report::scene::MaterialRow],
+    /// The fit to the built-in scene.
     pub fit: &'a FitSummary,
+    /// The white furnace.
     pub furnace: &'a crate::analysis::furnace::FurnaceReport,
+    /// The synthesis of each architecture (none without yosys).
     pub costs: &'a [CostRow],
+    /// The cycle model's runs.
     pub sims: &'a [crate::cycle::sim::SimStats],
+    /// The report's provenance.
     pub provenance: &'a crate::provenance::Provenance,
 }
 
