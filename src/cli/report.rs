@@ -1,6 +1,5 @@
 //! `specfx report`: the main job on built-in defaults.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -13,10 +12,10 @@ use specfx::analysis::paper::reproduce;
 use specfx::provenance::{INPUTS_FILE, PROVENANCE_FILE};
 use specfx::report::csv::{write_coefficients, write_method_errors};
 use specfx::report::index::{
-    write_index, CostRow, FigureRow, FitSummary, Results, StabilitySummary,
+    write_index, write_summary, CostRow, FigureRow, FitSummary, Results, StabilitySummary,
+    SummaryParts,
 };
 use specfx::report::paper::write_paper_table;
-use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx report`.
 #[derive(Debug, Args)]
@@ -383,20 +382,20 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     super::output::write_provenance(dir, &provenance)?;
     written.push(dir.join(INPUTS_FILE));
     written.push(dir.join(PROVENANCE_FILE));
+    let results = Results {
+        paper: &paper,
+        checked: &checked,
+        budget: &budget,
+        figures: &figures,
+        stability: &stability,
+        render: &render_rows,
+        fit: &fit,
+        furnace: &furnace,
+        costs: &costs,
+        sims: &sims,
+        provenance: &provenance,
+    };
     written.push(emit(dir, "index.html", |b| {
-        let results = Results {
-            paper: &paper,
-            checked: &checked,
-            budget: &budget,
-            figures: &figures,
-            stability: &stability,
-            render: &render_rows,
-            fit: &fit,
-            furnace: &furnace,
-            costs: &costs,
-            sims: &sims,
-            provenance: &provenance,
-        };
         let files: Vec<String> = written
             .iter()
             .map(|p| {
@@ -417,122 +416,30 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
         Ok(())
     })?);
 
-    let n_claims = paper.forms.len() + 2;
-    let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
-        + usize::from(paper.delta.reproduced_max)
-        + usize::from(paper.delta.reproduced_min);
-    let mut out = super::output::stdout();
+    let vectors = args.out.join("vectors_baseline").display().to_string();
     let staged = out_dir.path().to_path_buf();
-    out_dir.commit()?;
-    writeln!(out, "specfx report: results in {}", args.out.display())?;
-    writeln!(
-        out,
-        "  paper: {n_ok} of {n_claims} printed claims reproduce (details: paper.txt)"
-    )?;
-    for f in paper.forms.iter().filter(|f| !f.reproduced) {
-        writeln!(
-            out,
-            "    {}: printed res {:.1e}, computed {:.2e}",
-            f.form, f.claim_res_max, f.paper_res_max
-        )?;
-    }
-    if !paper.delta.reproduced_min {
-        writeln!(
-            out,
-            "    Delta min: printed {:.1e}, computed {:.1e} (cs16 <= cos^n for n >= 16)",
-            paper.delta.claim_min, paper.delta.min
-        )?;
-    }
-    let worst_exact = paper
-        .forms
+    // Written into the staging directory, renamed to --out below.
+    let shown: Vec<String> = written
         .iter()
-        .map(|f| f.exact_res_max)
-        .fold(0.0, f64::max);
-    writeln!(
-        out,
-        "  exact coefficients: max res {worst_exact:.1e} over every form, n = 16..=1024"
-    )?;
-    let out_stage = &checked.stages[dp.stage_out()];
-    writeln!(
-        out,
-        "  baseline, {} evaluations: lobe error vs cos^n {:.3e} (quantization {:.3e}, approximation {:.3e}); output max {:.2} ulp, {:.2}% correctly rounded; monotonic: {}",
-        checked.n_evaluations,
-        checked.shape_total_max_abs,
-        checked.shape_quant_max_abs,
-        checked.shape_approx_max_abs,
-        checked.out_max_ulp,
-        100.0 * out_stage.correctly_rounded,
-        if checked.monotonic { "yes" } else { "NO" }
-    )?;
-    writeln!(
-        out,
-        "  golden vectors: {n_vectors} in {}",
-        args.out.join("vectors_baseline").display()
-    )?;
-    writeln!(
-        out,
-        "  error budget: output quantization error {:.3e} ({:.0} LSB), {} gappa bounds (details: budget_baseline/budget.html)",
-        budget.attribution.total.max_abs,
-        budget.attribution.total.max_ulp,
-        budget.formal.len()
-    )?;
-    for s in &sims {
-        writeln!(
-            out,
-            "  cycle model {}: latency {}..{} cycles (nominal {}), {:.3} results/cycle under 10% bubbles and stalls, {} mismatches",
-            s.arch, s.latency_min, s.latency_max, s.latency_nominal, s.throughput, s.mismatches
-        )?;
-    }
-    for c in &costs {
-        writeln!(
-            out,
-            "  yosys ice40 {}: {} LUT4, {} carry, {} DSP, {} FF",
-            c.arch, c.luts, c.carries, c.dsps, c.ffs
-        )?;
-    }
-    let passing = stability.paths.iter().filter(|(_, passes)| *passes).count();
-    writeln!(
-        out,
-        "  stability: {passing} of {} paths stay within {} of cos^n over n = {} (details: stability/stability.html)",
-        stability.paths.len(),
-        stability.tol,
-        stability.n
-    )?;
-    writeln!(
-        out,
-        "  fit (built-in scene, each material no worse than baseline): {} exponents, {} analytic {} LUTs with the constant ROM against {} generic (details: fit/fit.md)",
-        fit.fitted_cost.rom_entries,
-        fit.fitted_cost.analytic_total_luts,
-        fit.target,
-        fit.generic_cost.analytic_total_luts
-    )?;
-    let flagged: usize = furnace.summary().iter().map(|s| s.n_flagged_values).sum();
-    writeln!(
-        out,
-        "  furnace: 6 forms, {flagged} reflectance values above 1 (details: furnace/furnace.md)"
-    )?;
-    writeln!(out, "  max |error| against cos^n over n = 16..=1024:")?;
-    let mut table = TextTable::new(&[
-        ("method", Align::Left),
-        ("max |error|", Align::Right),
-        ("at n", Align::Right),
-        ("c", Align::Right),
-    ])
-    .indent(4);
-    for e in &errs {
-        table.row([
-            e.method.to_string(),
-            format!("{:.3e}", e.max_abs_err),
-            e.argmax_n.to_string(),
-            format!("{:.6}", e.argmax_c),
-        ]);
-    }
-    table.write(&mut out, super::terminal::table_width())?;
-    writeln!(out, "  files:")?;
-    for p in &written {
-        // Written into the staging directory, now renamed to --out.
-        let rel = p.strip_prefix(&staged).unwrap_or(p);
-        writeln!(out, "    {}", args.out.join(rel).display())?;
-    }
+        .map(|p| {
+            args.out
+                .join(p.strip_prefix(&staged).unwrap_or(p))
+                .display()
+                .to_string()
+        })
+        .collect();
+    let out = args.out.display().to_string();
+    let parts = SummaryParts {
+        out: &out,
+        vectors: &vectors,
+        n_vectors,
+        errs: &errs,
+        out_correctly_rounded: checked.stages[dp.stage_out()].correctly_rounded,
+        files: &shown,
+    };
+    out_dir.commit()?;
+    super::output::print_with(|w| {
+        write_summary(w, &results, &parts, super::terminal::table_width())
+    })?;
     Ok(Outcome::Ok)
 }

@@ -296,3 +296,151 @@ pub fn write_index(
     )?;
     writeln!(w, "</body></html>")
 }
+
+/// What the report's summary on stdout needs beside [`Results`]: where its files are (as the
+/// command names them), the golden vectors written, the methods' errors, the baseline's
+/// correctly rounded outputs.
+pub struct SummaryParts<'a> {
+    /// The output directory, as the command names it.
+    pub out: &'a str,
+    /// The vector directory, as the command names it.
+    pub vectors: &'a str,
+    /// Golden vectors written.
+    pub n_vectors: u64,
+    /// Every method's largest error against cos^n.
+    pub errs: &'a [crate::analysis::methods::MethodErrors],
+    /// The fraction of the baseline's outputs correctly rounded.
+    pub out_correctly_rounded: f64,
+    /// Every file written, as the command names it.
+    pub files: &'a [String],
+}
+
+/// The report's summary on stdout: where its results are, the paper's claims, the baseline's
+/// figures, the cost, the stability maps, the fit, the furnace, the methods' errors (a table
+/// fitted into `width`), and every file.
+pub fn write_summary(
+    out: &mut impl Write,
+    results: &Results<'_>,
+    s: &SummaryParts<'_>,
+    width: Option<u16>,
+) -> std::io::Result<()> {
+    let Results {
+        paper,
+        checked,
+        budget,
+        stability,
+        fit,
+        furnace,
+        costs,
+        sims,
+        ..
+    } = *results;
+    let n_claims = paper.forms.len() + 2;
+    let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
+        + usize::from(paper.delta.reproduced_max)
+        + usize::from(paper.delta.reproduced_min);
+    writeln!(out, "specfx report: results in {}", s.out)?;
+    writeln!(
+        out,
+        "  paper: {n_ok} of {n_claims} printed claims reproduce (details: paper.txt)"
+    )?;
+    for f in paper.forms.iter().filter(|f| !f.reproduced) {
+        writeln!(
+            out,
+            "    {}: printed res {:.1e}, computed {:.2e}",
+            f.form, f.claim_res_max, f.paper_res_max
+        )?;
+    }
+    if !paper.delta.reproduced_min {
+        writeln!(
+            out,
+            "    Delta min: printed {:.1e}, computed {:.1e} (cs16 <= cos^n for n >= 16)",
+            paper.delta.claim_min, paper.delta.min
+        )?;
+    }
+    let worst_exact = paper
+        .forms
+        .iter()
+        .map(|f| f.exact_res_max)
+        .fold(0.0, f64::max);
+    writeln!(
+        out,
+        "  exact coefficients: max res {worst_exact:.1e} over every form, n = 16..=1024"
+    )?;
+    writeln!(
+        out,
+        "  baseline, {} evaluations: lobe error vs cos^n {:.3e} (quantization {:.3e}, approximation {:.3e}); output max {:.2} ulp, {:.2}% correctly rounded; monotonic: {}",
+        checked.n_evaluations,
+        checked.shape_total_max_abs,
+        checked.shape_quant_max_abs,
+        checked.shape_approx_max_abs,
+        checked.out_max_ulp,
+        100.0 * s.out_correctly_rounded,
+        if checked.monotonic { "yes" } else { "NO" }
+    )?;
+    writeln!(out, "  golden vectors: {} in {}", s.n_vectors, s.vectors)?;
+    writeln!(
+        out,
+        "  error budget: output quantization error {:.3e} ({:.0} LSB), {} gappa bounds (details: budget_baseline/budget.html)",
+        budget.attribution.total.max_abs,
+        budget.attribution.total.max_ulp,
+        budget.formal.len()
+    )?;
+    for st in sims {
+        writeln!(
+            out,
+            "  cycle model {}: latency {}..{} cycles (nominal {}), {:.3} results/cycle under 10% bubbles and stalls, {} mismatches",
+            st.arch, st.latency_min, st.latency_max, st.latency_nominal, st.throughput, st.mismatches
+        )?;
+    }
+    for c in costs {
+        writeln!(
+            out,
+            "  yosys ice40 {}: {} LUT4, {} carry, {} DSP, {} FF",
+            c.arch, c.luts, c.carries, c.dsps, c.ffs
+        )?;
+    }
+    let passing = stability.paths.iter().filter(|(_, passes)| *passes).count();
+    writeln!(
+        out,
+        "  stability: {passing} of {} paths stay within {} of cos^n over n = {} (details: stability/stability.html)",
+        stability.paths.len(),
+        stability.tol,
+        stability.n
+    )?;
+    writeln!(
+        out,
+        "  fit (built-in scene, each material no worse than baseline): {} exponents, {} analytic {} LUTs with the constant ROM against {} generic (details: fit/fit.md)",
+        fit.fitted_cost.rom_entries,
+        fit.fitted_cost.analytic_total_luts,
+        fit.target,
+        fit.generic_cost.analytic_total_luts
+    )?;
+    let flagged: usize = furnace.summary().iter().map(|s| s.n_flagged_values).sum();
+    writeln!(
+        out,
+        "  furnace: 6 forms, {flagged} reflectance values above 1 (details: furnace/furnace.md)"
+    )?;
+    writeln!(out, "  max |error| against cos^n over n = 16..=1024:")?;
+    let mut table = crate::report::table::TextTable::new(&[
+        ("method", crate::report::table::Align::Left),
+        ("max |error|", crate::report::table::Align::Right),
+        ("at n", crate::report::table::Align::Right),
+        ("c", crate::report::table::Align::Right),
+    ])
+    .indent(4);
+    for e in s.errs {
+        table.row([
+            e.method.to_string(),
+            format!("{:.3e}", e.max_abs_err),
+            e.argmax_n.to_string(),
+            format!("{:.6}", e.argmax_c),
+        ]);
+    }
+    table.write(out, width)?;
+    writeln!(out, "  files:")?;
+    for f in s.files {
+        writeln!(out, "    {f}")?;
+    }
+    Ok(())
+}
