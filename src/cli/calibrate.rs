@@ -11,14 +11,15 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
-use serde::Serialize;
 
 use super::output::{print_json, print_with};
 use super::Outcome;
-use specfx::hdl::calibrate::{calibration, fit, read_records, sample, Calibration, Record};
-use specfx::hdl::cost::{Features, Target};
+use specfx::hdl::calibrate::{
+    calibration, fit, read_records, sample, Calibration, Record, TargetFit,
+};
+use specfx::hdl::cost::Target;
 use specfx::pipeline::Datapath;
-use specfx::report::table::{Align, TextTable};
+use specfx::report::calibrate::write_fits;
 
 /// Arguments of `specfx calibrate`.
 #[derive(Debug, Args)]
@@ -49,18 +50,6 @@ pub struct CalibrateArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
-}
-
-/// One target's refit beside the committed calibration.
-#[derive(Debug, Serialize)]
-pub struct TargetFit {
-    /// The fit of the records now in the data directory.
-    pub fitted: Calibration,
-    /// The calibration the model uses (compiled in).
-    pub committed: Calibration,
-    /// Configurations yosys failed on in this run: not records (left out of the fit, not
-    /// stored), tried again by the next run.
-    pub failed: usize,
 }
 
 fn records_path(dir: &Path, target: Target) -> PathBuf {
@@ -329,52 +318,4 @@ pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
         print_with(|w| write_fits(w, &fits, super::terminal::table_width()))?;
     }
     Ok(Outcome::Ok)
-}
-
-/// The fits as text: per target the fit error and the coefficient table, fitted into `width`
-/// characters (`None`: as wide as its content).
-fn write_fits(w: &mut impl Write, fits: &[TargetFit], width: Option<u16>) -> std::io::Result<()> {
-    for f in fits {
-        let (a, b) = (&f.fitted, &f.committed);
-        writeln!(
-            w,
-            "{} ({} records{}): logic {} within {:.1}% of yosys (median), {:.1}% (90th percentile), {:.1}% (worst); flip-flops {:.1}% (median); DSP count exact on {:.0}%",
-            a.target.name(),
-            a.error.records,
-            if f.failed > 0 {
-                format!(
-                    "; yosys failed on {} more, tried again by the next run",
-                    f.failed
-                )
-            } else {
-                String::new()
-            },
-            a.target.logic_unit(),
-            100.0 * a.error.median_rel,
-            100.0 * a.error.p90_rel,
-            100.0 * a.error.max_rel,
-            100.0 * a.error.ff_median_rel,
-            100.0 * a.error.dsp_exact,
-        )?;
-        let mut table = TextTable::new(&[
-            ("coefficient", Align::Left),
-            ("fitted", Align::Right),
-            ("committed", Align::Right),
-        ])
-        .indent(2);
-        for (i, name) in Features::LOGIC_NAMES.iter().enumerate() {
-            table.row([
-                name.to_string(),
-                format!("{:.6}", a.coefficients.logic[i]),
-                format!("{:.6}", b.coefficients.logic[i]),
-            ]);
-        }
-        table.row([
-            "ffs_per_register_bit".to_string(),
-            format!("{:.6}", a.coefficients.ff_per_register_bit),
-            format!("{:.6}", b.coefficients.ff_per_register_bit),
-        ]);
-        table.write(w, width)?;
-    }
-    Ok(())
 }

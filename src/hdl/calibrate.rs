@@ -328,6 +328,18 @@ pub fn read_records(text: &str, path: &str) -> Result<Vec<Record>, Error> {
     Ok(records)
 }
 
+/// One target's refit beside the committed calibration.
+#[derive(Debug, Serialize)]
+pub struct TargetFit {
+    /// The fit of the records now in the data directory.
+    pub fitted: Calibration,
+    /// The calibration the model uses (compiled in).
+    pub committed: Calibration,
+    /// Configurations yosys failed on in this run: not records (left out of the fit, not
+    /// stored), tried again by the next run.
+    pub failed: usize,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

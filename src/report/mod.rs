@@ -1,6 +1,7 @@
 //! Renders results as text tables (comfy-table), CSV (the csv crate) and charts into any writer or
 //! buffer; never opens files.
 pub mod budget;
+pub mod calibrate;
 pub mod chart;
 pub mod check;
 pub mod cost;
