@@ -14,7 +14,7 @@ use super::Outcome;
 use specfx::analysis::sweep::{
     evaluate, mark_pareto, parse_shard, same_space, LogUse, PointResult, Space, SweepInfo,
 };
-use specfx::provenance::{Inputs, Provenance, INPUTS_FILE, PROVENANCE_FILE};
+use specfx::provenance::{Inputs, Provenance};
 
 /// Arguments of `specfx sweep`.
 #[derive(Debug, Args)]
@@ -273,28 +273,8 @@ fn write_results(
     provenance: &Provenance,
 ) -> Result<()> {
     mark_pareto(points);
-    let mut csv = Vec::new();
-    specfx::report::sweep::write_csv(&mut csv, points, target)?;
-    let mut json = serde_json::to_vec_pretty(&points)?;
-    json.push(b'\n');
-    let chart = specfx::report::sweep::chart(points, target);
-    let svg = specfx::report::chart::render_svg(&chart)?;
-    let png = specfx::report::chart::render_png(&chart)?;
-    super::output::write_all_shown(
-        dir,
-        shown,
-        &[
-            ("sweep.csv".to_string(), csv),
-            ("sweep.json".to_string(), json),
-            ("sweep.svg".to_string(), svg.into_bytes()),
-            ("sweep.png".to_string(), png),
-            (
-                INPUTS_FILE.to_string(),
-                provenance.canonical.clone().into_bytes(),
-            ),
-            (PROVENANCE_FILE.to_string(), provenance.json().into_bytes()),
-        ],
-    )
+    let files = specfx::report::sweep::sweep_files(points, target, provenance)?;
+    super::output::write_all_shown(dir, shown, &files)
 }
 
 /// A path made absolute with every symbolic link resolved, also when its last components do

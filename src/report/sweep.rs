@@ -159,6 +159,32 @@ pub fn chart(points: &[PointResult], target: Target) -> Chart {
     }
 }
 
+/// Every file of a sweep's results rendered in memory, `(name, bytes)`: `sweep.csv`,
+/// `sweep.json`, the chart (`sweep.svg`, `sweep.png`) and the provenance's two files.
+pub fn sweep_files(
+    points: &[PointResult],
+    target: Target,
+    provenance: &crate::provenance::Provenance,
+) -> Result<Vec<(String, Vec<u8>)>, crate::error::Error> {
+    let mut csv = Vec::new();
+    write_csv(&mut csv, points, target).expect("writing into memory cannot fail");
+    let mut json = serde_json::to_vec_pretty(&points).map_err(|e| crate::error::Error::Render {
+        message: format!("sweep.json: {e}"),
+    })?;
+    json.push(b'\n');
+    let chart = chart(points, target);
+    let svg = crate::report::chart::render_svg(&chart)?;
+    let png = crate::report::chart::render_png(&chart)?;
+    let mut files = vec![
+        ("sweep.csv".to_string(), csv),
+        ("sweep.json".to_string(), json),
+        ("sweep.svg".to_string(), svg.into_bytes()),
+        ("sweep.png".to_string(), png),
+    ];
+    files.extend(provenance.files());
+    Ok(files)
+}
+
 #[cfg(test)]
 mod csv_tests {
     use super::*;
