@@ -168,11 +168,22 @@ impl WorkDir {
         self.0.as_ref().expect("a live work directory").path()
     }
 
-    /// Keeps the directory (`--keep`): returns its path; it is no longer removed.
+    /// Keeps the directory (`--keep`): returns its path; it is no longer removed, neither now
+    /// nor by a later run's clean-up of dead processes' directories: it is renamed
+    /// `specfx-<tag>-kept-<random>`, which names no process.
     pub fn keep(mut self) -> PathBuf {
         let dir = self.0.take().expect("a live work directory");
         forget(dir.path());
-        dir.keep()
+        let path = dir.keep();
+        let pid = format!("-{}-", std::process::id());
+        let kept = path.file_name().and_then(|n| n.to_str()).and_then(|n| {
+            let renamed = n.replacen(&pid, "-kept-", 1);
+            (renamed != n).then(|| path.with_file_name(renamed))
+        });
+        match kept {
+            Some(k) if std::fs::rename(&path, &k).is_ok() => k,
+            _ => path,
+        }
     }
 
     /// Hands the directory's removal over: it stays registered, so the interrupt handler (and

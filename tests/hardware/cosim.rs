@@ -218,3 +218,37 @@ fn a_missing_simulator_is_named_with_its_package() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("no Verilog simulator"));
 }
+
+/// `--keep` keeps the work directory, whose path the run prints, and a later run does not
+/// take it for a dead run's leftover: it is still there, with the simulator's files.
+#[test]
+fn a_kept_work_directory_outlives_later_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = |keep: bool| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_specfx"));
+        cmd.args(["cosim", "--sim", "icarus", "--n", "16", "--cases", "corner"])
+            .env("TMPDIR", tmp.path());
+        if keep {
+            cmd.arg("--keep");
+        }
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stderr).unwrap()
+    };
+    let err = run(true);
+    let kept = err
+        .lines()
+        .find_map(|l| {
+            l.split_once("cosim: work directory ")
+                .map(|(_, p)| p.trim())
+        })
+        .unwrap_or_else(|| panic!("no kept directory in {err}"));
+    let kept = PathBuf::from(kept);
+    assert!(kept.join("tb.vvp").is_file(), "{}", kept.display());
+    run(false);
+    assert!(
+        kept.join("tb.vvp").is_file(),
+        "a later run removed {}",
+        kept.display()
+    );
+}
