@@ -12,6 +12,7 @@
 
 use serde::Serialize;
 
+use crate::analysis::accumulate::{MaxAt, Moments};
 use crate::analysis::budget_expr::{metric_value, Budget, Metric};
 use crate::analysis::check::{check, CheckReport, Input};
 use crate::engine::{fold_n, Chunk, Codes};
@@ -297,65 +298,6 @@ pub const HIST_BINS: usize = 256;
 /// Intervals of c in [`PerC`].
 pub const C_BINS: usize = 64;
 
-#[derive(Debug, Clone, Copy)]
-struct MaxAt {
-    value: f64,
-    at: (u32, i64),
-}
-
-impl MaxAt {
-    fn new() -> MaxAt {
-        MaxAt {
-            value: -1.0,
-            at: (0, 0),
-        }
-    }
-
-    #[inline]
-    fn add(&mut self, x: f64, at: (u32, i64)) {
-        if x.abs() > self.value {
-            self.value = x.abs();
-            self.at = at;
-        }
-    }
-
-    fn merge(&mut self, o: &MaxAt) {
-        if o.value > self.value {
-            *self = *o;
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Moments {
-    max: MaxAt,
-    sum: f64,
-    sum_sq: f64,
-}
-
-impl Moments {
-    fn new() -> Moments {
-        Moments {
-            max: MaxAt::new(),
-            sum: 0.0,
-            sum_sq: 0.0,
-        }
-    }
-
-    #[inline]
-    fn add(&mut self, e: f64, at: (u32, i64)) {
-        self.max.add(e, at);
-        self.sum += e;
-        self.sum_sq += e * e;
-    }
-
-    fn merge(&mut self, o: &Moments) {
-        self.max.merge(&o.max);
-        self.sum += o.sum;
-        self.sum_sq += o.sum_sq;
-    }
-}
-
 struct Acc {
     sources: Vec<Moments>,
     incremental: Vec<Moments>,
@@ -492,7 +434,7 @@ fn add_chunk(dp: &Datapath, sources: &Sources, acc: &mut Acc, chunk: &Chunk<'_>)
                 m.add(e, at);
                 sum += e;
             }
-            acc.residual.add(e_total - sum, at);
+            acc.residual.add((e_total - sum).abs(), at);
             let mut before = ref_out;
             for (j, m) in acc.incremental.iter_mut().enumerate() {
                 let after = if j + 1 == cumulative.len() {
@@ -510,8 +452,9 @@ fn add_chunk(dp: &Datapath, sources: &Sources, acc: &mut Acc, chunk: &Chunk<'_>)
         } else {
             acc.hist_out.add(0.0);
         }
-        acc.approx.add(ref_out - nc.coef * target, at);
-        acc.total_vs_target.add(fixed_out - nc.coef * target, at);
+        acc.approx.add((ref_out - nc.coef * target).abs(), at);
+        acc.total_vs_target
+            .add((fixed_out - nc.coef * target).abs(), at);
         let shape_total = fixed_lobe - target;
         acc.shape_total = acc.shape_total.max(shape_total.abs());
         acc.shape_approx = acc.shape_approx.max((ref_lobe - target).abs());

@@ -8,6 +8,7 @@
 
 use serde::Serialize;
 
+use crate::analysis::accumulate::MaxAt;
 use crate::engine::{each_chunk, map_n, Codes, Span};
 use crate::error::Error;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
@@ -538,34 +539,6 @@ fn lanes(
         acc[0] = step(acc[0], x);
     }
     join(join(acc[0], acc[1]), join(acc[2], acc[3]))
-}
-
-/// The running maximum of one shape error.
-#[derive(Debug, Clone, Copy)]
-struct MaxAt {
-    value: f64,
-    at: (u32, i64),
-}
-
-impl MaxAt {
-    fn new() -> MaxAt {
-        MaxAt {
-            value: -1.0,
-            at: (0, 0),
-        }
-    }
-    #[inline]
-    fn add(&mut self, v: f64, at: (u32, i64)) {
-        if v > self.value {
-            self.value = v;
-            self.at = at;
-        }
-    }
-    fn merge(&mut self, o: &MaxAt) {
-        if o.value > self.value {
-            *self = *o;
-        }
-    }
 }
 
 /// Everything gathered for one n.

@@ -1,5 +1,6 @@
 //! Analyses over the reference and the datapath: the paper reproduction, method errors, and
 //! exhaustive accuracy checks.
+mod accumulate;
 pub mod budget;
 pub mod budget_expr;
 pub mod check;
