@@ -126,6 +126,13 @@ pub enum Error {
         /// Why.
         reason: String,
     },
+    /// A result file or directory that cannot be written, or an output refused before any
+    /// work (it would replace an input, or something that is not an earlier result).
+    #[error("{message}")]
+    Output {
+        /// What went wrong, with the operating system's reason.
+        message: String,
+    },
     /// A VCD trace that cannot be read, or lacks what a comparison needs.
     #[error("{problem}")]
     Trace {

@@ -28,6 +28,7 @@ pub mod golden;
 pub mod hdl;
 mod names;
 pub mod nset;
+pub mod output;
 pub mod pipeline;
 pub mod provenance;
 pub mod reference;

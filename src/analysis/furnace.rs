@@ -800,6 +800,14 @@ impl FurnaceReport {
     }
 }
 
+/// What determines a furnace, for its provenance: the datapath, the exponents and the angles.
+pub fn inputs(dp: &Datapath, settings: &FurnaceSettings) -> crate::provenance::Inputs {
+    crate::provenance::Inputs::new("furnace")
+        .config(dp.config())
+        .option("n", settings.ns().to_vec())
+        .option("angles", settings.angles_deg().to_vec())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,7 +5,9 @@ use serde::Serialize;
 
 use crate::cycle::Arch;
 use crate::engine::{fold_n, Codes};
+use crate::error::Error;
 use crate::hdl::cost::{analytic_cost, figures_on_targets, CostFigures, Target};
+use crate::nset::NSet;
 use crate::pipeline::{Config, Datapath, ProbeColumns};
 use crate::reference::lobe::Cutoff;
 use crate::reference::method::Method;
@@ -14,6 +16,9 @@ use crate::reference::minimax::sup_abs_error;
 /// Measures how long a piece of work takes, in seconds: the caller's clock (the library has
 /// none, so that everything it computes is deterministic).
 pub type Timer<'a> = &'a mut dyn FnMut(&mut dyn FnMut()) -> f64;
+
+/// A datapath's yosys figures, from the caller (the library runs no tool itself).
+pub type Synthesise<'a> = &'a dyn Fn(&Datapath) -> Result<YosysFigures, Error>;
 
 /// One method's figures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -241,5 +246,60 @@ pub fn fixed_figures(dp: &Datapath, time: Timer) -> MethodFigures {
         yosys: None,
         latency: Some(cost.latency),
         per_n_max_abs_err: per_n,
+    }
+}
+/// The fixed-point datapaths compared: cs16 with 8, 12 and 16 fraction bits, and minimax for
+/// k = 3..=6.
+pub fn fixed_configs() -> Vec<Config> {
+    [8, 12, 16]
+        .into_iter()
+        .map(fixed_config)
+        .chain((3..=6).map(fixed_minimax_config))
+        .collect()
+}
+
+/// How many methods [`tradeoff`] measures: its progress runs to this.
+pub fn method_count() -> usize {
+    f64_methods().len() + 1 + fixed_configs().len()
+}
+
+/// Every method's figures over `ns`, in the table's order (powf, powi, the other f64
+/// methods, the fixed-point datapaths), timed on `time`. `synthesise` gives a datapath's yosys
+/// figures (none without it); `progress` is told each method's name and how many are done
+/// as it starts.
+pub fn tradeoff(
+    ns: &NSet,
+    time: Timer,
+    synthesise: Option<Synthesise>,
+    progress: &dyn Fn(&str, usize),
+) -> Result<Vec<MethodFigures>, Error> {
+    let ns_v = ns.values();
+    let mut figures = Vec::new();
+    for (name, method) in f64_methods() {
+        progress(&name, figures.len());
+        figures.push(f64_figures(&name, method, ns_v, time));
+    }
+    progress("powi", figures.len());
+    figures.insert(1, powi_figures(ns_v, time));
+    for mut cfg in fixed_configs() {
+        cfg.n = ns.clone();
+        let dp = Datapath::new(cfg)?;
+        progress(&dp.config().name, figures.len());
+        let mut f = fixed_figures(&dp, time);
+        if let Some(synthesise) = synthesise {
+            f.yosys = Some(synthesise(&dp)?);
+        }
+        figures.push(f);
+    }
+    Ok(figures)
+}
+
+/// What determines a trade-off, for its provenance: the exponents and the yosys target.
+pub fn inputs(ns: &NSet, yosys: Option<Target>) -> crate::provenance::Inputs {
+    let inputs = crate::provenance::Inputs::new("tradeoff")
+        .option("n", crate::provenance::canonical_nset(ns));
+    match yosys {
+        Some(target) => inputs.option("yosys", target.name()),
+        None => inputs,
     }
 }

@@ -8,12 +8,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
 
-use super::output::{print_json, write_all_in};
+use super::output::print_json;
 use super::Outcome;
 use specfx::analysis::budget::{analyse, BudgetReport};
 use specfx::analysis::budget_expr::Budget;
 use specfx::analysis::gappa;
 use specfx::nset::NSet;
+use specfx::output::write_all_in;
 use specfx::pipeline::Datapath;
 use specfx::provenance::{Inputs, Provenance};
 use specfx::report::budget::budget_files;
@@ -119,7 +120,7 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
         }
         None => Some(gappa::spread(&ns)),
     };
-    let out_dir = super::output::OutDir::begin(
+    let out_dir = specfx::output::OutDir::begin(
         &args.out,
         "budget",
         args.force,

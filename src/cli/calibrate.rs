@@ -212,7 +212,7 @@ fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
         None
     } else {
         let dir = super::hdl_ref::hdl_ref(args.hdl_ref.as_deref())?;
-        super::output::check_can_create(&args.data, "--data")?;
+        specfx::output::check_can_create(&args.data, "--data")?;
         Some(dir)
     };
     let mut plans = Vec::new();
@@ -283,7 +283,7 @@ pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
             let text = records_text(&plan.records)?;
             let on_disk = std::fs::read(&plan.path).ok();
             if !plan.records.is_empty() && on_disk.as_deref() != Some(text.as_bytes()) {
-                super::output::write_atomic(&plan.path, text.as_bytes())?;
+                specfx::output::write_atomic(&plan.path, text.as_bytes())?;
             }
         }
         if let Some((index, first)) = failed.first() {

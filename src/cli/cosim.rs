@@ -97,10 +97,10 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     }
     if let (Some(vcd), Some(v)) = (&args.vcd, &args.vectors) {
         let vector_dir = super::vectordir::dir_of(v);
-        super::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
+        specfx::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
     }
     if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
-        super::output::check_can_create(dir, "--vcd")?;
+        specfx::output::check_can_create(dir, "--vcd")?;
     } else if let Some(dir) = &args.vcd {
         // An earlier cosim's traces (model.vcd begins with the model's header) are replaced;
         // other files of those names only with --force; never an input.
@@ -113,10 +113,10 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         }
         let model = dir.join("model.vcd");
         let header = Some(specfx::cycle::vcd::VCD_HEADER);
-        super::output::check_file_output(&model, "--vcd", &inputs, header, args.force)?;
+        specfx::output::check_file_output(&model, "--vcd", &inputs, header, args.force)?;
         let earlier = model.is_file();
         let rtl = dir.join("rtl.vcd");
-        super::output::check_file_output(&rtl, "--vcd", &inputs, None, args.force || earlier)?;
+        specfx::output::check_file_output(&rtl, "--vcd", &inputs, None, args.force || earlier)?;
     }
     // Absolute: the simulator runs in the work directory.
     let hdl = super::hdl_ref::hdl_ref_dir(args.hdl_ref.as_deref());

@@ -7,11 +7,12 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 
-use super::output::{print_json, write_all_in};
+use super::output::print_json;
 use super::Outcome;
 use specfx::cycle::Arch;
 use specfx::hdl::cost::Target;
 use specfx::nset::NSet;
+use specfx::output::write_all_in;
 use specfx::pipeline::Datapath;
 use specfx::provenance::{Inputs, Provenance};
 use specfx::report::fit::{fit_files, summary, write_no_fit};
@@ -75,7 +76,7 @@ impl FitArgs {
 /// Runs `specfx fit`.
 pub fn run(args: &FitArgs) -> Result<Outcome> {
     let (scene, label) = super::render::load_scene(args.scene.as_deref())?;
-    let out_dir = super::output::OutDir::begin(
+    let out_dir = specfx::output::OutDir::begin(
         &args.out,
         "fit",
         args.force,

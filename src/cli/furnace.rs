@@ -7,17 +7,15 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 
-use super::output::{print_json, write_atomic, write_figure, write_provenance};
+use super::output::print_json;
 use super::Outcome;
 use specfx::analysis::furnace::{
-    furnace_with_progress, parse_angles, FurnaceReport, FurnaceSettings, DEFAULT_ANGLES,
+    furnace_with_progress, inputs, parse_angles, FurnaceReport, FurnaceSettings, DEFAULT_ANGLES,
 };
 use specfx::nset::NSet;
-use specfx::provenance::{Inputs, Provenance};
-use specfx::report::doc::{write_markdown, Block};
-use specfx::report::furnace::{
-    chart_png, chart_stem, chart_svg, document, write_csv, write_summary,
-};
+use specfx::output::write_all_in;
+use specfx::provenance::Provenance;
+use specfx::report::furnace::{furnace_files, write_summary};
 
 /// Arguments of `specfx furnace`.
 #[derive(Debug, Args)]
@@ -50,7 +48,7 @@ pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
     let dp = super::datapath::load(&args.config, None)?;
     let settings = FurnaceSettings::new(&dp, args.n.as_ref(), angles)
         .with_context(|| format!("config {}", args.config))?;
-    let out_dir = super::output::OutDir::begin(
+    let out_dir = specfx::output::OutDir::begin(
         &args.out,
         "furnace",
         args.force,
@@ -88,29 +86,7 @@ pub fn write_furnace(
         bar.set_position(done as u64);
     });
     bar.finish();
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    for (i, f) in report.forms.iter().enumerate() {
-        let svg = chart_svg(&report, i)?;
-        let png = chart_png(&report, i)?;
-        write_figure(out, &chart_stem(f.form), &svg, &png)?;
-    }
-    let provenance = Provenance::new(
-        &Inputs::new("furnace")
-            .config(dp.config())
-            .option("n", settings.ns().to_vec())
-            .option("angles", settings.angles_deg().to_vec()),
-    );
-    let mut doc = document(&report);
-    doc.push(Block::Paragraph(provenance.line()));
-    let mut md = Vec::new();
-    write_markdown(&mut md, &doc)?;
-    write_atomic(&out.join("furnace.md"), &md)?;
-    let mut csv = Vec::new();
-    write_csv(&mut csv, &report)?;
-    write_atomic(&out.join("furnace.csv"), &csv)?;
-    let mut json = serde_json::to_vec_pretty(&report)?;
-    json.push(b'\n');
-    write_atomic(&out.join("furnace.json"), &json)?;
-    write_provenance(out, &provenance)?;
+    let provenance = Provenance::new(&inputs(dp, settings));
+    write_all_in(out, &furnace_files(&report, &provenance)?)?;
     Ok(report)
 }

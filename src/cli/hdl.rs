@@ -6,13 +6,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 
-use super::output::write_atomic;
 use super::sim::parse_probability;
 use super::Outcome;
 use specfx::cycle::stimulus::{cosim_stimulus, StimulusRun};
 use specfx::cycle::Arch;
 use specfx::hdl::rom::rom_verilog;
 use specfx::hdl::{render_parameters, ParamsFormat};
+use specfx::output::write_atomic;
 
 /// `--format` of `specfx hdl params`: the library's [`ParamsFormat`], with its help.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -175,7 +175,7 @@ struct Output<'a> {
 fn print_or_write(out: Output, text: &str) -> Result<Outcome> {
     match out.path {
         Some(path) => {
-            super::output::check_file_output(
+            specfx::output::check_file_output(
                 path,
                 "--out",
                 &out.inputs,
@@ -283,7 +283,7 @@ pub fn write_stimulus(
     if let (Some(path), Some(trace)) = (vcd, s.vcd) {
         files.push((path.to_path_buf(), trace));
     }
-    super::output::write_all_atomic(&files)?;
+    specfx::output::write_all_atomic(&files)?;
     Ok(StimulusInfo {
         n_vectors: s.n_vectors,
         n_cycles: s.n_cycles,
@@ -305,13 +305,13 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
     // reads; an earlier stimulus there (its stim.json) is replaced, other files of the same
     // names only with --force. The outputs are checked before the vectors are read.
     let vector_dir = super::vectordir::dir_of(&args.vectors);
-    super::output::refuse_inside_input_dir(&args.out, "--out", &vector_dir, "--vectors")?;
+    specfx::output::refuse_inside_input_dir(&args.out, "--out", &vector_dir, "--vectors")?;
     if let Some(vcd) = &args.vcd {
-        super::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
+        specfx::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
     }
     let inputs = super::output::config_inputs_as("--vectors", &args.vectors.to_string_lossy());
     let earlier = args.out.join("stim.json").is_file();
-    super::output::check_files_in(
+    specfx::output::check_files_in(
         &args.out,
         &STIMULUS_FILES,
         "--out",
@@ -322,7 +322,7 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
     if let Some(vcd) = &args.vcd {
         let mut inputs = inputs.clone();
         inputs.extend(STIMULUS_FILES.map(|f| ("--out", args.out.join(f))));
-        super::output::check_file_output(
+        specfx::output::check_file_output(
             vcd,
             "--vcd",
             &inputs,

@@ -315,8 +315,15 @@ fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
                 })
                 .collect();
             let names: Vec<&str> = names.iter().map(String::as_str).collect();
-            output::check_files_in(dir, &names, "--out", &[], Some(MAN_HEADER), args.force)?;
-            output::write_all_atomic(&pages)?;
+            specfx::output::check_files_in(
+                dir,
+                &names,
+                "--out",
+                &[],
+                Some(MAN_HEADER),
+                args.force,
+            )?;
+            specfx::output::write_all_atomic(&pages)?;
         }
     }
     Ok(Outcome::Ok)
@@ -511,7 +518,7 @@ pub fn main() -> ExitCode {
         Err(err) => {
             // A summary that cannot reach stdout after the result directory was committed:
             // the files are all there, and the one line says so.
-            let complete = output::last_committed()
+            let complete = specfx::output::last_committed()
                 .filter(|_| output::is_stdout_error(&err))
                 .map_or(String::new(), |dir| {
                     format!(" (the result in {} is complete)", dir.display())

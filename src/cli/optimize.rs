@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::Args;
 
-use super::output::write_atomic;
 use super::Outcome;
 use specfx::analysis::budget_expr::{Budget, Metric};
 use specfx::analysis::check::check;
@@ -13,6 +12,7 @@ use specfx::analysis::optimize::{algorithm_floors, optimize_all, Algorithm, Sear
 use specfx::cycle::Arch;
 use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;
+use specfx::output::write_atomic;
 use specfx::pipeline::{Datapath, Variant};
 use specfx::report::optimize::write_no_answer;
 use specfx::report::table::{Align, TextTable};
@@ -66,7 +66,7 @@ pub struct OptimizeArgs {
 /// Runs `specfx optimize`. Exit code 1 when no configuration meets the budget.
 pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     let dp = super::datapath::load(&args.config, args.n.as_ref())?;
-    super::output::check_file_output(
+    specfx::output::check_file_output(
         &args.out,
         "--out",
         &super::output::inputs(&args.config, None),

@@ -6,9 +6,10 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use rayon::prelude::*;
 
-use super::output::{print_json, print_with, write_atomic};
+use super::output::{print_json, print_with};
 use super::Outcome;
 use specfx::nset::NSet;
+use specfx::output::write_atomic;
 use specfx::reference::lobe::{m_of_k, K_RANGE};
 use specfx::reference::minimax::{self, MinimaxFit, TABLE_N_MAX};
 use specfx::reference::normalisation::{coefficient, CoefSource, Form};
@@ -148,7 +149,7 @@ fn write_table(path: &std::path::Path, n_max: u32, force: bool) -> Result<Outcom
     }
     // An earlier table (its first line the table's header) is replaced without --force.
     let header = format!("{}\n", specfx::reference::minimax::TABLE_HEADER);
-    super::output::check_file_output(path, "--write", &[], Some(&header), force)?;
+    specfx::output::check_file_output(path, "--write", &[], Some(&header), force)?;
     let jobs: Vec<(u32, u32)> = K_RANGE
         .flat_map(|k| (1..=n_max).map(move |n| (k, n)))
         .collect();

@@ -5,10 +5,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 
-use super::output::write_atomic;
 use super::Outcome;
 use specfx::analysis::methods::{max_errors, report_methods};
 use specfx::analysis::paper::reproduce;
+use specfx::output::write_atomic;
 use specfx::provenance::{INPUTS_FILE, PROVENANCE_FILE};
 use specfx::report::csv::{write_coefficients, write_method_errors};
 use specfx::report::index::{
@@ -102,8 +102,13 @@ impl Steps {
 
 /// Runs `specfx report`.
 pub fn run(args: &ReportArgs) -> Result<Outcome> {
-    let (out_dir, resumed) =
-        super::output::OutDir::begin_resumable(&args.out, "report", args.force, &[], args.restart)?;
+    let (out_dir, resumed) = specfx::output::OutDir::begin_resumable(
+        &args.out,
+        "report",
+        args.force,
+        &[],
+        args.restart,
+    )?;
     let dir = out_dir.path();
     let yosys_version = specfx::tools::version("yosys", "-V");
     let nextpnr_version = specfx::tools::version("nextpnr-ice40", "--version");
@@ -329,9 +334,9 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     scene_cfg.n = scene_ns;
     let scene_dp = specfx::pipeline::Datapath::new(scene_cfg)?;
     let render_dir = dir.join("render");
-    let (render_rows, _) =
+    let render_rows =
         super::render::render_scene(&scene, "the built-in scene", &scene_dp, &render_dir)?;
-    for f in super::render::RENDER_FILES {
+    for f in specfx::report::scene::RENDER_FILES {
         written.push(render_dir.join(f));
     }
 

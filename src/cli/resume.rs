@@ -1,6 +1,6 @@
 //! Resuming a multi-step result (`specfx report`): each long step, once its files are written,
 //! leaves a checkpoint in the staging directory; a later run that takes the staging directory
-//! over (see [`super::output::OutDir::begin_resumable`]) reuses every step whose checkpoint is
+//! over (see [`specfx::output::OutDir::begin_resumable`]) reuses every step whose checkpoint is
 //! still true and runs the others.
 //!
 //! A checkpoint (`.resume/<step>.json`) holds the step's summary (what the rest of the run needs
@@ -18,7 +18,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use super::output::{write_atomic, MARKER};
+use specfx::output::{write_atomic, MARKER};
 
 /// The directory of the checkpoints inside a staging directory; removed before the commit.
 pub const CHECKPOINTS: &str = ".resume";

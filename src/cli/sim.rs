@@ -74,7 +74,7 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
     }
     let dp = super::datapath::load(&args.config, args.n.as_ref())?;
     if let Some(path) = &args.vcd {
-        super::output::check_file_output(
+        specfx::output::check_file_output(
             path,
             "--vcd",
             &super::output::inputs(&args.config, None),
@@ -104,7 +104,7 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
     if let Some(path) = &args.vcd {
         let mut buf = Vec::new();
         write_vcd(&mut buf, &dp, args.arch, &result.trace)?;
-        super::output::write_atomic(path, &buf)?;
+        specfx::output::write_atomic(path, &buf)?;
     }
     let s = &result.stats;
     if args.json {

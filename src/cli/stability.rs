@@ -1,24 +1,20 @@
 //! `specfx stability`: maps where every method and datapath fails, with heat maps and tables.
 
-use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 
-use super::output::{print_json, write_atomic, write_chart, write_figure, write_provenance};
+use super::output::print_json;
 use super::Outcome;
 use specfx::analysis::stability::{
     analyse, default_paths, FloatPath, Grid, MapPath, StabilityReport, Tolerance,
 };
 use specfx::nset::NSet;
-use specfx::provenance::{canonical_nset, Inputs, Provenance};
-use specfx::report::doc::{write_html, write_markdown, Block};
-use specfx::report::stability::{
-    document, heatmap_png, heatmap_stem, heatmap_svg, overshoot_chart, overview_png, overview_svg,
-    write_overshoot_csv, write_regions_csv, write_special_csv,
-};
+use specfx::output::write_all_in;
+use specfx::provenance::Provenance;
+use specfx::report::stability::stability_files;
 use specfx::report::table::{Align, TextTable};
 
 /// Arguments of `specfx stability`.
@@ -125,7 +121,6 @@ fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
 
 /// Maps every path of `paths` over `grid` and writes the report into `dir`; returns the report.
 pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<StabilityReport> {
-    fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let bar = super::progress::Progress::new("stability", "path-exponent columns", 0);
     let progress = |done: usize, total: usize| {
         bar.set_len(total as u64);
@@ -141,73 +136,9 @@ pub fn stability(dir: &Path, paths: &[MapPath], grid: &Grid) -> Result<Stability
     let report = analyse(paths, grid, &progress)?;
     bar.finish();
     log::info!("stability: writing heat maps and tables");
-    let tol = grid.tol.value;
-    for m in &report.maps {
-        write_figure(
-            dir,
-            &heatmap_stem(&m.path),
-            &heatmap_svg(m, tol)?,
-            &heatmap_png(m, tol)?,
-        )?;
-    }
-    let overview = overview_svg(&report.maps, tol)?;
-    write_figure(
-        dir,
-        "overview",
-        &overview,
-        &overview_png(&report.maps, tol)?,
-    )?;
-    let overshoot = write_chart(dir, "overshoot", &overshoot_chart(&report))?;
-    let mut buf = Vec::new();
-    write_regions_csv(&mut buf, &report)?;
-    write_atomic(&dir.join("regions.csv"), &buf)?;
-    buf.clear();
-    write_special_csv(&mut buf, &report)?;
-    write_atomic(&dir.join("special_inputs.csv"), &buf)?;
-    buf.clear();
-    write_overshoot_csv(&mut buf, &report)?;
-    write_atomic(&dir.join("overshoot.csv"), &buf)?;
-    let provenance = Provenance::new(&inputs(paths, grid));
-    let mut doc = document(&report);
-    doc.push(Block::Paragraph(provenance.line()));
-    buf.clear();
-    write_markdown(&mut buf, &doc)?;
-    write_atomic(&dir.join("stability.md"), &buf)?;
-    buf.clear();
-    write_html(&mut buf, "specfx stability", &doc, |stem| match stem {
-        "overview" => Some(overview.clone()),
-        "overshoot" => Some(overshoot.clone()),
-        _ => None,
-    })?;
-    write_atomic(&dir.join("stability.html"), &buf)?;
-    let mut json = serde_json::to_vec_pretty(&report)?;
-    json.push(b'\n');
-    write_atomic(&dir.join("stability.json"), &json)?;
-    write_provenance(dir, &provenance)?;
+    let provenance = Provenance::new(&specfx::analysis::stability::inputs(paths, grid));
+    write_all_in(dir, &stability_files(&report, &provenance)?)?;
     Ok(report)
-}
-
-/// What determines a stability map: its paths (float paths by name, datapaths by their
-/// configuration), the exponents, the sampling of c and the tolerance.
-fn inputs(paths: &[MapPath], grid: &Grid) -> Inputs {
-    let floats: Vec<String> = paths
-        .iter()
-        .filter_map(|p| match p {
-            MapPath::Float(f) => Some(f.name().to_string()),
-            MapPath::Fixed(_) => None,
-        })
-        .collect();
-    let mut inputs = Inputs::new("stability")
-        .option("float", floats)
-        .option("n", canonical_nset(&grid.n))
-        .option("c_bits", grid.c_bits)
-        .option("tol", grid.tol.value);
-    for p in paths {
-        if let MapPath::Fixed(config) = p {
-            inputs = inputs.config(config);
-        }
-    }
-    inputs
 }
 
 /// Runs `specfx stability`.
@@ -231,7 +162,7 @@ pub fn run(args: &StabilityArgs) -> Result<Outcome> {
             specfx::analysis::stability::MAX_SAMPLES
         );
     }
-    let out_dir = super::output::OutDir::begin(
+    let out_dir = specfx::output::OutDir::begin(
         &args.out,
         "stability",
         args.force,

@@ -9,11 +9,11 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use serde::{Deserialize, Serialize};
 
-use super::output::OutDir;
 use super::Outcome;
 use specfx::analysis::sweep::{
     evaluate, mark_pareto, parse_shard, same_space, LogUse, PointResult, Space, SweepInfo,
 };
+use specfx::output::OutDir;
 use specfx::provenance::{Inputs, Provenance};
 
 /// Arguments of `specfx sweep`.
@@ -82,7 +82,7 @@ fn read_log(dir: &Path, info: &SweepInfo, how: LogUse) -> Result<BTreeMap<u64, P
     let text = String::from_utf8_lossy(&bytes);
     let (map, good) = info.read_points(&text, &path.display().to_string(), how)?;
     if how == LogUse::Resume && good.len() != text.len() {
-        super::output::write_all_shown(
+        specfx::output::write_all_shown(
             dir,
             dir,
             &[("points.jsonl".to_string(), good.into_bytes())],
@@ -144,7 +144,7 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
             );
         }
         let staged = OutDir::begin(dir, "sweep", false, &[])?;
-        super::output::write_all_shown(
+        specfx::output::write_all_shown(
             staged.path(),
             dir,
             &[("space.json".to_string(), info.json())],
@@ -274,7 +274,7 @@ fn write_results(
 ) -> Result<()> {
     mark_pareto(points);
     let files = specfx::report::sweep::sweep_files(points, target, provenance)?;
-    super::output::write_all_shown(dir, shown, &files)
+    Ok(specfx::output::write_all_shown(dir, shown, &files)?)
 }
 
 /// A path made absolute with every symbolic link resolved, also when its last components do
@@ -315,7 +315,7 @@ fn resolved(path: &Path) -> Result<PathBuf> {
 
 /// Whether `out` is an earlier merge of the sweep `sweep` (which a merge may replace).
 fn earlier_merge_of(out: &Path, sweep: &str) -> bool {
-    let marker = fs::read_to_string(out.join(super::output::MARKER)).unwrap_or_default();
+    let marker = fs::read_to_string(out.join(specfx::output::MARKER)).unwrap_or_default();
     marker.split_whitespace().next() == Some(MERGE_MARKER)
         && read_info(out).is_ok_and(|i| i.sweep_sha256 == sweep)
 }
@@ -431,7 +431,7 @@ fn merge(out: &Path, shards: &[PathBuf], force: bool) -> Result<Outcome> {
         lines.push_str(&serde_json::to_string(p)?);
         lines.push('\n');
     }
-    super::output::write_all_shown(
+    specfx::output::write_all_shown(
         staged.path(),
         out,
         &[

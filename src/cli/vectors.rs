@@ -74,7 +74,7 @@ pub fn run(args: &VectorsArgs) -> Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
-/// Writes a vector directory, staged ([`super::output::OutDir`]): complete or absent, an
+/// Writes a vector directory, staged ([`specfx::output::OutDir`]): complete or absent, an
 /// existing directory replaced only when it is an earlier vector directory (or empty, or with
 /// `force`), never one of `inputs`. Returns the number of vectors and their coverage.
 pub fn write_dir(
@@ -90,7 +90,7 @@ pub fn write_dir(
         .with_context(|| format!("config {}", dp.config().name))?;
     let mut cases = chosen.cases;
     cases::order(&mut cases, order, seed);
-    let staged = super::output::OutDir::begin(out, "vectors", force, inputs)?;
+    let staged = specfx::output::OutDir::begin(out, "vectors", force, inputs)?;
     let partial = staged.path().to_path_buf();
 
     let ports = ports(dp);

@@ -10,12 +10,14 @@ use plotters::prelude::*;
 use crate::analysis::furnace::{Curve, FormSummary, FurnacePath, FurnaceReport};
 use crate::csv_dialect::CsvWriter;
 use crate::error::Error;
+use crate::provenance::Provenance;
 use crate::report::chart::{
     draw_chart, draw_sample, encode_png, register_font, render_error, Chart, Dash, Marker, RefLine,
     Series, OKABE_ITO,
 };
-use crate::report::doc::Block;
+use crate::report::doc::{write_markdown, Block};
 use crate::report::table::{Align, TextTable};
+use crate::report::{in_memory, json_file, File};
 
 /// The file stem of a form's chart: `furnace_<form>`.
 pub fn chart_stem(form: crate::reference::normalisation::Form) -> String {
@@ -433,6 +435,24 @@ pub fn chart_png(r: &FurnaceReport, form_idx: usize) -> Result<Vec<u8>, Error> {
         draw_form(root, r, form_idx)?;
     }
     encode_png(&rgb, size)
+}
+
+/// Every file of a furnace's directory, provenance included, rendered in memory: a chart per
+/// form (SVG and PNG), `furnace.md` (ending with the provenance's line), `.csv` and `.json`.
+pub fn furnace_files(r: &FurnaceReport, provenance: &Provenance) -> Result<Vec<File>, Error> {
+    let mut files: Vec<File> = Vec::new();
+    for (i, f) in r.forms.iter().enumerate() {
+        let stem = chart_stem(f.form);
+        files.push((format!("{stem}.svg"), chart_svg(r, i)?.into_bytes()));
+        files.push((format!("{stem}.png"), chart_png(r, i)?));
+    }
+    let mut doc = document(r);
+    doc.push(Block::Paragraph(provenance.line()));
+    files.push(("furnace.md".into(), in_memory(|w| write_markdown(w, &doc))));
+    files.push(("furnace.csv".into(), in_memory(|w| write_csv(w, r))));
+    files.push(json_file("furnace.json", r)?);
+    files.extend(provenance.files());
+    Ok(files)
 }
 
 #[cfg(test)]

@@ -8,9 +8,15 @@ use plotters::prelude::*;
 
 use crate::csv_dialect::CsvWriter;
 use crate::error::Error;
+use crate::pipeline::Datapath;
+use crate::provenance::Provenance;
 use crate::report::chart::{encode_png, encode_png_depth, register_font, render_error};
 use crate::report::table::{Align, TextTable};
-use crate::scene::render::{ImageError, InputsOfN, Rendered, INPUT_BINS};
+use crate::report::File;
+use crate::scene::render::{
+    difference, flip_errors, image_error, ImageError, InputsOfN, Rendered, INPUT_BINS, PATHS,
+};
+use crate::scene::Scene;
 
 /// One path's picture as PNG: 8 bits per channel, or for 10-bit images 16 bits per channel
 /// holding the 10-bit codes scaled to the full range (`code * 65535 / 1023`, rounded).
@@ -273,4 +279,97 @@ pub fn table_markdown(rows: &[MaterialRow], bits: u32) -> String {
     }
     s.push_str(&format!("\n{}\n", table_legend(bits)));
     s
+}
+/// The files [`render_files`] renders, in its order.
+pub const RENDER_FILES: [&str; 10] = [
+    "f64_cos_n.png",
+    "f64_model.png",
+    "datapath.png",
+    "diff_vs_cos_n.png",
+    "diff_vs_f64_model.png",
+    "flip_vs_cos_n.png",
+    "flip_vs_f64_model.png",
+    "render.md",
+    "render.json",
+    "inputs.csv",
+];
+
+/// The error table of a render of `scene` through a datapath: a row per material and one for
+/// the whole image.
+pub fn material_rows(scene: &Scene, r: &Rendered) -> Vec<MaterialRow> {
+    let datapath = 2;
+    let flip_total = flip_errors(r, datapath, 0);
+    let flip_quant = flip_errors(r, datapath, 1);
+    let mut rows: Vec<MaterialRow> = scene
+        .materials
+        .iter()
+        .enumerate()
+        .map(|(i, m)| MaterialRow {
+            material: m.name.clone(),
+            n: m.n,
+            total: image_error(r, datapath, 0, Some(i as u16), &flip_total),
+            quant: image_error(r, datapath, 1, Some(i as u16), &flip_quant),
+        })
+        .collect();
+    rows.push(MaterialRow {
+        material: "all".into(),
+        n: 0,
+        total: image_error(r, datapath, 0, None, &flip_total),
+        quant: image_error(r, datapath, 1, None, &flip_quant),
+    });
+    rows
+}
+
+/// Every file of a render's directory, provenance included ([`RENDER_FILES`] and then the
+/// provenance's), rendered in memory: the three pictures, the difference and FLIP maps, the
+/// document (naming the scene `label`), the table's JSON and the datapath's inputs.
+pub fn render_files(
+    r: &Rendered,
+    rows: &[MaterialRow],
+    label: &str,
+    dp: &Datapath,
+    provenance: &Provenance,
+) -> Result<Vec<File>, Error> {
+    let datapath = 2;
+    let mut files: Vec<File> = Vec::new();
+    for (p, name) in PATHS.iter().enumerate() {
+        files.push((format!("{name}.png"), path_png(r, p)?));
+    }
+    let (total, quant) = (difference(r, datapath, 0), difference(r, datapath, 1));
+    files.push((
+        "diff_vs_cos_n.png".into(),
+        heatmap_png(r, &total, "vs cos^n")?,
+    ));
+    files.push((
+        "diff_vs_f64_model.png".into(),
+        heatmap_png(r, &quant, "vs f64 model")?,
+    ));
+    let (flip_total, flip_quant) = (flip_errors(r, datapath, 0), flip_errors(r, datapath, 1));
+    files.push((
+        "flip_vs_cos_n.png".into(),
+        flip_png(r, &flip_total, "vs cos^n")?,
+    ));
+    files.push((
+        "flip_vs_f64_model.png".into(),
+        flip_png(r, &flip_quant, "vs f64 model")?,
+    ));
+    let md = format!(
+        "# Render of {} through {}\n\nImages: `f64_cos_n.png` (f64 cos^n, classic coefficient), `f64_model.png` (the f64 model of the datapath's algorithm and coefficient), `datapath.png` (bit-accurate, the fragment's cosine quantized to {}); differences in display LSBs `diff_vs_cos_n.png`, `diff_vs_f64_model.png`, and FLIP maps `flip_vs_cos_n.png`, `flip_vs_f64_model.png`.\n\n\"vs cos^n\" is the total error the viewer sees: the approximation of cos^n by the datapath's algorithm (large near highlights of high n) plus its quantization; \"vs f64 model\" is the quantization alone.\n\n{}\n{}\n",
+        crate::report::doc::md_escape(label),
+        dp.config().name,
+        dp.config().c.format,
+        table_markdown(rows, r.bits),
+        provenance.line(),
+    );
+    files.push(("render.md".into(), md.into_bytes()));
+    // Pretty JSON without a final newline, as render.json has always been written.
+    let json = serde_json::to_vec_pretty(rows).map_err(|e| Error::Render {
+        message: format!("render.json: {e}"),
+    })?;
+    files.push(("render.json".into(), json));
+    let lsb = dp.config().c.format.lsb();
+    let csv = crate::report::in_memory(|w| write_inputs_csv(w, &r.inputs, lsb));
+    files.push(("inputs.csv".into(), csv));
+    files.extend(provenance.files());
+    Ok(files)
 }

@@ -12,8 +12,10 @@ use crate::analysis::stability::{
     Kind, PathMap, StabilityReport, HEAT_ROWS, OVERSHOOT_J_MAX, SPECIAL_N,
 };
 use crate::csv_dialect::CsvWriter;
+use crate::provenance::Provenance;
 use crate::report::chart::{lsb8, register_font, style, Chart, Dash, Series};
-use crate::report::doc::Block;
+use crate::report::doc::{write_html, write_markdown, Block};
+use crate::report::{chart_files, in_memory, json_file, File};
 use plotters::element::DashedPathElement;
 
 /// Heat-map size in pixels (the SVG uses the same user units).
@@ -853,4 +855,54 @@ pub fn document(r: &StabilityReport) -> Vec<Block> {
         });
     }
     doc
+}
+
+/// Every file of a stability map's directory, provenance included, rendered in memory:
+/// `(name, bytes)`. The heat maps, the overview and the overshoot chart each as SVG and PNG,
+/// the three tables, the document (Markdown and HTML, ending with the provenance's line) and
+/// the JSON.
+pub fn stability_files(r: &StabilityReport, provenance: &Provenance) -> Result<Vec<File>, Error> {
+    let tol = r.grid.tol.value;
+    let mut files: Vec<File> = Vec::new();
+    let mut figure = |stem: &str, svg: &str, png: Vec<u8>| {
+        files.push((format!("{stem}.svg"), svg.as_bytes().to_vec()));
+        files.push((format!("{stem}.png"), png));
+    };
+    for m in &r.maps {
+        figure(
+            &heatmap_stem(&m.path),
+            &heatmap_svg(m, tol)?,
+            heatmap_png(m, tol)?,
+        );
+    }
+    let overview = overview_svg(&r.maps, tol)?;
+    figure("overview", &overview, overview_png(&r.maps, tol)?);
+    let (overshoot, chart) = chart_files("overshoot", &overshoot_chart(r))?;
+    files.extend(chart);
+    files.push(("regions.csv".into(), in_memory(|w| write_regions_csv(w, r))));
+    files.push((
+        "special_inputs.csv".into(),
+        in_memory(|w| write_special_csv(w, r)),
+    ));
+    files.push((
+        "overshoot.csv".into(),
+        in_memory(|w| write_overshoot_csv(w, r)),
+    ));
+    let mut doc = document(r);
+    doc.push(Block::Paragraph(provenance.line()));
+    files.push((
+        "stability.md".into(),
+        in_memory(|w| write_markdown(w, &doc)),
+    ));
+    let html = in_memory(|w| {
+        write_html(w, "specfx stability", &doc, |stem| match stem {
+            "overview" => Some(overview.clone()),
+            "overshoot" => Some(overshoot.clone()),
+            _ => None,
+        })
+    });
+    files.push(("stability.html".into(), html));
+    files.push(json_file("stability.json", r)?);
+    files.extend(provenance.files());
+    Ok(files)
 }

@@ -7,9 +7,12 @@ use std::io::{self, Write};
 use crate::analysis::tradeoff::MethodFigures;
 use crate::analysis::LSB8;
 use crate::csv_dialect::CsvWriter;
+use crate::error::Error;
 use crate::hdl::cost::{CostFigures, Target};
+use crate::provenance::Provenance;
 use crate::report::chart::{front_2d, Chart, Dash, Marker, RefLine, Series};
 use crate::report::table::{Align, TextTable};
+use crate::report::{chart_files, in_memory, json_file, File};
 
 /// A method's analytic cost on a target, if it has one.
 fn cost_on(f: &MethodFigures, t: Target) -> Option<CostFigures> {
@@ -278,4 +281,41 @@ pub fn per_n_chart(figures: &[MethodFigures], ns: &[u32], names: &[&str]) -> Cha
             .collect(),
         ..Chart::default()
     }
+}
+
+/// Every file of a trade-off's directory, provenance included, rendered in memory: the table
+/// (CSV, JSON), the cost charts, and apart the wall-clock measurements of this run (every
+/// other file is the same on every run).
+pub fn tradeoff_files(
+    figures: &[MethodFigures],
+    ns: &[u32],
+    provenance: &Provenance,
+) -> Result<Vec<File>, Error> {
+    let mut files: Vec<File> = vec![
+        ("tradeoff.csv".into(), in_memory(|w| write_csv(w, figures))),
+        json_file("tradeoff.json", &figures)?,
+    ];
+    for (axis, stem) in CostAxis::CHARTS {
+        files.extend(chart_files(stem, &cost_chart(figures, axis))?.1);
+    }
+    files.push((
+        "measured_speed.csv".into(),
+        in_memory(|w| write_speed_csv(w, figures)),
+    ));
+    files.extend(chart_files("measured_speed_accuracy", &speed_chart(figures))?.1);
+    let per_n = per_n_chart(
+        figures,
+        ns,
+        &[
+            "cs16_clamp",
+            "minimax16",
+            "schlick",
+            "exp_limit",
+            "fixed_sq12",
+            "cs128_clamp",
+        ],
+    );
+    files.extend(chart_files("error_vs_n", &per_n)?.1);
+    files.extend(provenance.files());
+    Ok(files)
 }

@@ -707,3 +707,9 @@ pub fn image_error_of(
     }
     e
 }
+/// What determines a render, for its provenance: the scene and the datapath.
+pub fn inputs(scene: &Scene, dp: &Datapath) -> crate::provenance::Inputs {
+    crate::provenance::Inputs::new("render")
+        .table("scene", scene.canonical())
+        .config(dp.config())
+}

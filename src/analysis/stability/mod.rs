@@ -271,6 +271,29 @@ pub fn analyse(
     })
 }
 
+/// What determines a stability map, for its provenance: its paths (float paths by name,
+/// datapaths by their configuration), the exponents, the sampling of c and the tolerance.
+pub fn inputs(paths: &[MapPath], grid: &Grid) -> crate::provenance::Inputs {
+    let floats: Vec<String> = paths
+        .iter()
+        .filter_map(|p| match p {
+            MapPath::Float(f) => Some(f.name().to_string()),
+            MapPath::Fixed(_) => None,
+        })
+        .collect();
+    let mut inputs = crate::provenance::Inputs::new("stability")
+        .option("float", floats)
+        .option("n", crate::provenance::canonical_nset(&grid.n))
+        .option("c_bits", grid.c_bits)
+        .option("tol", grid.tol.value);
+    for p in paths {
+        if let MapPath::Fixed(config) = p {
+            inputs = inputs.config(config);
+        }
+    }
+    inputs
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
