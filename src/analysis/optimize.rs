@@ -144,6 +144,31 @@ fn never_overflows(cfg: &Config, stage: Stage) -> Result<bool, Error> {
         .is_some_and(|s| s.wrapped == 0 && s.saturated == 0 && s.zeroed == 0))
 }
 
+/// What the optimiser minimises: the calibrated analytic model's logic cells (instant) or
+/// yosys's count (seconds per candidate).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Objective {
+    /// The analytic cost model.
+    Analytic,
+    /// yosys's synthesis.
+    Yosys,
+}
+
+impl Objective {
+    /// Every objective.
+    pub const ALL: [Objective; 2] = [Objective::Analytic, Objective::Yosys];
+
+    /// The name used on the command line and in provenance.
+    pub fn name(self) -> &'static str {
+        match self {
+            Objective::Analytic => "analytic",
+            Objective::Yosys => "yosys",
+        }
+    }
+}
+
+crate::names::named_enum!(Objective, "objective", "analytic or yosys");
+
 /// What the search may change beyond the internal stages' fraction bits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Space {

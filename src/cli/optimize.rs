@@ -8,7 +8,9 @@ use clap::Args;
 use super::Outcome;
 use specfx::analysis::budget_expr::{Budget, Metric};
 use specfx::analysis::check::check;
-use specfx::analysis::optimize::{algorithm_floors, optimize_all, Algorithm, SearchResult};
+use specfx::analysis::optimize::{
+    algorithm_floors, optimize_all, Algorithm, Objective, SearchResult,
+};
 use specfx::cycle::Arch;
 use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;
@@ -38,7 +40,7 @@ pub struct OptimizeArgs {
     /// Cost to minimise: analytic (the calibrated model's logic cells on --target, instant) or
     /// yosys (yosys's count on --target, seconds per candidate).
     #[arg(long, default_value = "analytic")]
-    objective: String,
+    objective: Objective,
     /// Target whose logic cells are minimised: ice40 (LUTs), xilinx (LUTs) or generic (gates).
     #[arg(long, default_value = "ice40")]
     target: Target,
@@ -47,8 +49,9 @@ pub struct OptimizeArgs {
     #[arg(long, default_value = "1..=7", value_parser = super::datapath::parse_k_set)]
     k: NSet,
     /// Variants to try: plain, minimax or both.
-    #[arg(long, default_value = "plain,minimax", value_delimiter = ',')]
-    variants: Vec<String>,
+    #[arg(long, default_value = "plain,minimax", value_delimiter = ',',
+          value_parser = |v: &str| v.trim().parse::<Variant>())]
+    variants: Vec<Variant>,
     /// Fraction bits every searched stage starts from (must meet the budget).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=48))]
     start_frac: i32,
@@ -82,11 +85,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     {
         bail!("--k: expected numbers of squarings in 1..=7, got {k}");
     }
-    let yosys = match args.objective.as_str() {
-        "analytic" => false,
-        "yosys" => true,
-        other => bail!("--objective: expected analytic or yosys, got '{other}'"),
-    };
+    let yosys = args.objective == Objective::Yosys;
     let hdl = super::hdl_ref::hdl_ref_dir(None);
     let arch = args.arch;
     let target = args.target;
@@ -98,24 +97,20 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             Ok(analytic_cost(dp, arch, target).luts as f64)
         }
     };
-    let variants: Vec<Variant> = args
-        .variants
-        .iter()
-        .map(|v| match v.trim() {
-            "plain" => Ok(Variant::Plain),
-            "minimax" => Ok(Variant::Minimax),
-            other => bail!("--variants: expected plain, minimax or both, got '{other}'"),
-        })
-        .collect::<Result<_>>()?;
+    let variants = &args.variants;
     log::info!(
         "optimize: f64 floor of {} algorithms (k in {}, {})",
         args.k.len() * variants.len(),
         args.k,
-        args.variants.join(", ")
+        variants
+            .iter()
+            .map(|v| v.name())
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     let mut budget = args.budget.clone();
     budget.arch = arch;
-    let floors = algorithm_floors(&base, &budget, args.k.values(), &variants, args.start_frac);
+    let floors = algorithm_floors(&base, &budget, args.k.values(), variants, args.start_frac);
     let reachable = floors.iter().filter(|f| f.reachable).count();
     let bar = super::progress::Progress::new("optimize", "algorithms", reachable as u64);
     let done = |a: Algorithm, r: &SearchResult| {
@@ -212,7 +207,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         &Inputs::new("optimize")
             .config(&base)
             .option("budget", args.budget.canonical())
-            .option("objective", args.objective.as_str())
+            .option("objective", args.objective.name())
             .option("target", target.name())
             .option("k", canonical_nset(&args.k))
             .option("variants", variant_names)

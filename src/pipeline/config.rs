@@ -23,6 +23,9 @@ pub enum Variant {
 }
 
 impl Variant {
+    /// Every variant.
+    pub const ALL: [Variant; 2] = [Variant::Plain, Variant::Minimax];
+
     /// The name used in TOML and reports.
     pub fn name(self) -> &'static str {
         match self {
@@ -31,6 +34,8 @@ impl Variant {
         }
     }
 }
+
+crate::names::named_enum!(Variant, "variant", "plain or minimax");
 
 /// A stage's output quantization: its format, rounding mode and overflow mode.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
