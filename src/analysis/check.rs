@@ -9,7 +9,7 @@
 use serde::Serialize;
 
 use crate::analysis::accumulate::MaxAt;
-use crate::engine::{each_chunk, map_n, Codes, Span};
+use crate::engine::{each_chunk, map_n, Chunk, Codes, Span};
 use crate::error::Error;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
 use crate::pipeline::f64_walk::F64Walk;
@@ -627,206 +627,288 @@ struct CodeColumns {
     ref_d: Vec<f64>,
 }
 
-fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
-    let codes = &shared.codes.codes[..];
-    let cfg = dp.config();
-    let stages = dp.stages();
-    let n_stages = stages.len();
-    let lsb: Vec<f64> = stages.iter().map(|s| s.format.lsb()).collect();
-    let c_lsb = cfg.c.format.lsb();
-    let one = dp.one_code();
-    let last_sq = dp.stage_last_square();
-    let coef_idx = dp.stage_coef();
-    let out = dp.stage_out();
-    let nf = f64::from(nc.n);
-    let threshold = nc.threshold.unwrap_or(i64::MIN);
-    let mut acc = vec![Acc::new(); n_stages];
-    let mut quant = MaxAt::new();
-    let mut approx = MaxAt::new();
-    let mut total = MaxAt::new();
-    let mut norm = MaxAt::new();
-    let mut norm_approx: f64 = -1.0;
-    let norm_peak = classic_coefficient(cfg.coef.form, nf);
-    let mut violations = Vec::new();
-    let mut n_violations = 0;
-    let mut n_cut = 0;
-    let mut prev_out: Option<i64> = None;
-    // The largest code whose fixed and f64 lobes are both 0: cos^n is increasing in c, so
-    // its error there is the largest of all such codes and needs one evaluation at the end.
-    let mut zero_lobe_code: Option<(i64, f64)> = None;
-    let mut refs: Vec<Vec<f64>> = vec![Vec::new(); n_stages];
-    let mut errs: Vec<f64> = Vec::with_capacity(CHUNK);
-    // Compacted columns of the inputs whose base is not 0 in both models ("live").
-    let mut live: Vec<usize> = Vec::with_capacity(CHUNK);
-    let mut live_codes: Vec<i64> = Vec::with_capacity(CHUNK);
-    let mut live_raws: Vec<i64> = Vec::with_capacity(CHUNK);
-    let mut live_refs: Vec<f64> = Vec::with_capacity(CHUNK);
-    let dead_end = dead_prefix_end(dp, nc, codes);
-    // d = c - 1 is exact in its format; when c has at most 52 bits and d at most 53, its f64
-    // reference and its fixed-point value are the same f64 for every code, so every error is
-    // +0.0 and d's figures follow without computing them (the same bits as computing them).
-    let d_is_exact = cfg.c.format.width() <= 52 && cfg.d.format.width() <= 53;
-    let span = Span {
-        from: 0,
-        dead_end,
-        chunk_codes: CHUNK,
-    };
-    each_chunk(dp, nc, &shared.codes, span, |c| {
-        let (chunk, ln_chunk, cols) = (c.codes, c.ln_c, c.probes);
-        let ref_d_chunk = &shared.ref_d[c.start..c.start + chunk.len()];
-        // A chunk below the dead prefix's end: every base is cut, and 0 in the f64 model too.
-        let dead_chunk = c.dead;
-        for (a, counts) in acc.iter_mut().zip(&cols.event_counts) {
+/// One exponent's exhaustive check as a fold over the stream's chunks: the phases of a chunk
+/// are methods, in the order [`check_one_n`] calls them.
+struct NFold<'a> {
+    dp: &'a Datapath,
+    nc: &'a NConstants,
+    lsb: Vec<f64>,
+    c_lsb: f64,
+    one: i64,
+    last_sq: usize,
+    coef_idx: usize,
+    out: usize,
+    nf: f64,
+    threshold: i64,
+    norm_peak: f64,
+    /// d = c - 1 is exact in its format; when c has at most 52 bits and d at most 53, its f64
+    /// reference and its fixed-point value are the same f64 for every code, so every error is
+    /// +0.0 and d's figures follow without computing them (the same bits as computing them).
+    d_is_exact: bool,
+    acc: Vec<Acc>,
+    quant: MaxAt,
+    approx: MaxAt,
+    total: MaxAt,
+    norm: MaxAt,
+    norm_approx: f64,
+    violations: Vec<MonotonicityViolation>,
+    n_violations: u64,
+    n_cut: u64,
+    prev_out: Option<i64>,
+    /// The largest code whose fixed and f64 lobes are both 0: cos^n is increasing in c, so
+    /// its error there is the largest of all such codes and needs one evaluation at the end.
+    zero_lobe_code: Option<(i64, f64)>,
+    refs: Vec<Vec<f64>>,
+    errs: Vec<f64>,
+    /// Compacted columns of the inputs whose base is not 0 in both models ("live").
+    live: Vec<usize>,
+    live_codes: Vec<i64>,
+    live_raws: Vec<i64>,
+    live_refs: Vec<f64>,
+}
+
+impl<'a> NFold<'a> {
+    fn new(dp: &'a Datapath, nc: &'a NConstants) -> NFold<'a> {
+        let cfg = dp.config();
+        let n_stages = dp.stages().len();
+        NFold {
+            dp,
+            nc,
+            lsb: dp.stages().iter().map(|s| s.format.lsb()).collect(),
+            c_lsb: cfg.c.format.lsb(),
+            one: dp.one_code(),
+            last_sq: dp.stage_last_square(),
+            coef_idx: dp.stage_coef(),
+            out: dp.stage_out(),
+            nf: f64::from(nc.n),
+            threshold: nc.threshold.unwrap_or(i64::MIN),
+            norm_peak: classic_coefficient(cfg.coef.form, f64::from(nc.n)),
+            d_is_exact: cfg.c.format.width() <= 52 && cfg.d.format.width() <= 53,
+            acc: vec![Acc::new(); n_stages],
+            quant: MaxAt::new(),
+            approx: MaxAt::new(),
+            total: MaxAt::new(),
+            norm: MaxAt::new(),
+            norm_approx: -1.0,
+            violations: Vec::new(),
+            n_violations: 0,
+            n_cut: 0,
+            prev_out: None,
+            zero_lobe_code: None,
+            refs: vec![Vec::new(); n_stages],
+            errs: Vec::with_capacity(CHUNK),
+            live: Vec::with_capacity(CHUNK),
+            live_codes: Vec::with_capacity(CHUNK),
+            live_raws: Vec::with_capacity(CHUNK),
+            live_refs: Vec::with_capacity(CHUNK),
+        }
+    }
+
+    /// Folds one chunk of the stream.
+    #[inline]
+    fn chunk(&mut self, c: &Chunk<'_>, ref_d: &[f64]) {
+        for (a, counts) in self.acc.iter_mut().zip(&c.probes.event_counts) {
             a.add_events(counts);
         }
-        // The f64 value of d, t and b by the same algorithm (see `reference_probes`).
-        for r in refs.iter_mut() {
+        self.reference_columns(c, ref_d);
+        self.fold_d_t_coef(c);
+        self.find_live(c);
+        self.fold_live_stages(c);
+        self.fold_cuts_and_monotonicity(c);
+    }
+
+    /// The f64 value of d, t and b by the same algorithm (see `reference_probes`); b's only
+    /// above the dead prefix (below it every base is cut, and 0 in the f64 model too).
+    fn reference_columns(&mut self, c: &Chunk<'_>, ref_d: &[f64]) {
+        let (nc, cutoff, one, threshold) =
+            (self.nc, self.dp.config().cutoff, self.one, self.threshold);
+        for r in self.refs.iter_mut() {
             r.clear();
         }
         // d's f64 reference, needed by t's (and by d's own figures when it is not exact).
-        refs[STAGE_D].extend_from_slice(ref_d_chunk);
-        let (head, tail) = refs.split_at_mut(STAGE_T);
+        self.refs[STAGE_D].extend_from_slice(ref_d);
+        let (head, tail) = self.refs.split_at_mut(STAGE_T);
         tail[0].extend(head[STAGE_D].iter().map(|&d| nc.slope * d));
-        if !dead_chunk {
-            let (head, tail) = refs.split_at_mut(STAGE_B);
+        if !c.dead {
+            let (head, tail) = self.refs.split_at_mut(STAGE_B);
             tail[0].extend(
-                head[STAGE_T].iter().zip(chunk).map(|(&t, &k)| {
-                    reference_base(cfg.cutoff, t, nc.offset, k.min(one) < threshold)
-                }),
+                head[STAGE_T]
+                    .iter()
+                    .zip(c.codes)
+                    .map(|(&t, &k)| reference_base(cutoff, t, nc.offset, k.min(one) < threshold)),
             );
         }
-        if d_is_exact {
+    }
+
+    /// d's, t's and the coefficient's figures, over every input of the chunk.
+    fn fold_d_t_coef(&mut self, c: &Chunk<'_>) {
+        let (chunk, cols, n) = (c.codes, c.probes, self.nc.n);
+        if self.d_is_exact {
             let d = &cols.values[STAGE_D];
-            acc[STAGE_D].add_exact_column(
+            self.acc[STAGE_D].add_exact_column(
                 d[0],
                 d[d.len() - 1],
                 chunk.len() as u64,
-                (nc.n, chunk[0]),
+                (n, chunk[0]),
             );
         } else {
-            acc[STAGE_D].add_column(
+            self.acc[STAGE_D].add_column(
                 &cols.values[STAGE_D],
-                lsb[STAGE_D],
-                &refs[STAGE_D],
+                self.lsb[STAGE_D],
+                &self.refs[STAGE_D],
                 chunk,
-                nc.n,
-                &mut errs,
+                n,
+                &mut self.errs,
             );
         }
-        acc[STAGE_T].add_column(
+        self.acc[STAGE_T].add_column(
             &cols.values[STAGE_T],
-            lsb[STAGE_T],
-            &refs[STAGE_T],
+            self.lsb[STAGE_T],
+            &self.refs[STAGE_T],
             chunk,
-            nc.n,
-            &mut errs,
+            n,
+            &mut self.errs,
         );
-        acc[coef_idx].add_constant(
-            nc.coef_raw,
-            lsb[coef_idx],
-            nc.coef,
+        self.acc[self.coef_idx].add_constant(
+            self.nc.coef_raw,
+            self.lsb[self.coef_idx],
+            self.nc.coef,
             chunk.len() as u64,
-            (nc.n, chunk[0]),
+            (n, chunk[0]),
         );
+    }
 
-        // From b on, an input whose base is 0 in both models stays exactly 0 in both: such
-        // inputs count as exact without being looked at again.
-        live.clear();
-        if !dead_chunk {
-            live.extend(
-                (0..chunk.len())
-                    .filter(|&i| cols.values[STAGE_B][i] != 0 || refs[STAGE_B][i] != 0.0),
-            );
+    /// From b on, an input whose base is 0 in both models stays exactly 0 in both: such
+    /// inputs count as exact without being looked at again. Compacts the others ("live")
+    /// and remembers the largest dead code.
+    fn find_live(&mut self, c: &Chunk<'_>) {
+        let (chunk, b) = (c.codes, &c.probes.values[STAGE_B]);
+        let ref_b = &self.refs[STAGE_B];
+        self.live.clear();
+        if !c.dead {
+            self.live
+                .extend((0..chunk.len()).filter(|&i| b[i] != 0 || ref_b[i] != 0.0));
         }
-        let n_dead = (chunk.len() - live.len()) as u64;
-        if n_dead > 0 {
-            let largest_dead = if dead_chunk {
+        if self.live.len() < chunk.len() {
+            let largest_dead = if c.dead {
                 chunk.len() - 1
             } else {
                 (0..chunk.len())
                     .rev()
-                    .find(|&i| cols.values[STAGE_B][i] == 0 && refs[STAGE_B][i] == 0.0)
+                    .find(|&i| b[i] == 0 && ref_b[i] == 0.0)
                     .expect("a dead input exists")
             };
-            if zero_lobe_code.is_none_or(|(k, _)| chunk[largest_dead] > k) {
-                zero_lobe_code = Some((chunk[largest_dead], ln_chunk[largest_dead]));
+            if self
+                .zero_lobe_code
+                .is_none_or(|(k, _)| chunk[largest_dead] > k)
+            {
+                self.zero_lobe_code = Some((chunk[largest_dead], c.ln_c[largest_dead]));
             }
         }
-        live_codes.clear();
-        live_codes.extend(live.iter().map(|&i| chunk[i]));
-        live_refs.clear();
-        live_refs.extend(live.iter().map(|&i| refs[STAGE_B][i]));
-        for stage_idx in (STAGE_B..=last_sq).chain([out]) {
-            if stage_idx == out {
+        self.live_codes.clear();
+        self.live_codes.extend(self.live.iter().map(|&i| chunk[i]));
+        self.live_refs.clear();
+        self.live_refs.extend(self.live.iter().map(|&i| ref_b[i]));
+    }
+
+    /// b, the squarings and the output on the live inputs (the dead ones are exact zeros);
+    /// the lobe against cos^n after the last squaring, the normalised output against the
+    /// exact normalised cos^n at the output.
+    fn fold_live_stages(&mut self, c: &Chunk<'_>) {
+        let (chunk, cols, n) = (c.codes, c.probes, self.nc.n);
+        let n_dead = (chunk.len() - self.live.len()) as u64;
+        for stage_idx in (STAGE_B..=self.last_sq).chain([self.out]) {
+            if stage_idx == self.out {
                 // live_refs holds the last squaring's references here.
-                for r in &mut live_refs {
-                    *r *= nc.coef;
+                for r in &mut self.live_refs {
+                    *r *= self.nc.coef;
                 }
             } else if stage_idx > STAGE_B {
-                for r in &mut live_refs {
+                for r in &mut self.live_refs {
                     *r *= *r;
                 }
             }
-            live_raws.clear();
-            live_raws.extend(live.iter().map(|&i| cols.values[stage_idx][i]));
-            acc[stage_idx].add_column(
-                &live_raws,
-                lsb[stage_idx],
-                &live_refs,
-                &live_codes,
-                nc.n,
-                &mut errs,
+            self.live_raws.clear();
+            self.live_raws
+                .extend(self.live.iter().map(|&i| cols.values[stage_idx][i]));
+            self.acc[stage_idx].add_column(
+                &self.live_raws,
+                self.lsb[stage_idx],
+                &self.live_refs,
+                &self.live_codes,
+                n,
+                &mut self.errs,
             );
-            acc[stage_idx].add_exact_zeros(n_dead);
-            if stage_idx == out {
-                // The normalised output against the exact normalised cos^n.
-                for (j, &i) in live.iter().enumerate() {
-                    let c = chunk[i] as f64 * c_lsb;
-                    let cos_n = if c <= 0.0 {
-                        0.0
-                    } else {
-                        (nf * ln_chunk[i]).exp()
-                    };
-                    let o = live_raws[j] as f64 * lsb[out];
-                    norm.add((o - norm_peak * cos_n).abs(), (nc.n, chunk[i]));
-                    // live_refs holds the f64 lobe times the f64 coefficient here.
-                    norm_approx = norm_approx.max((live_refs[j] - norm_peak * cos_n).abs());
-                }
+            self.acc[stage_idx].add_exact_zeros(n_dead);
+            if stage_idx == self.out {
+                self.fold_normalised(c);
             }
-            if stage_idx == last_sq {
-                // The lobe against cos^n, on the live inputs.
-                for (j, &i) in live.iter().enumerate() {
-                    let at = (nc.n, chunk[i]);
-                    let s_fixed = live_raws[j] as f64 * lsb[last_sq];
-                    let s_ref = live_refs[j];
-                    let c = chunk[i] as f64 * c_lsb;
-                    let cos_n = if c <= 0.0 {
-                        0.0
-                    } else {
-                        (nf * ln_chunk[i]).exp()
-                    };
-                    quant.add((s_fixed - s_ref).abs(), at);
-                    approx.add((s_ref - cos_n).abs(), at);
-                    total.add((s_fixed - cos_n).abs(), at);
-                }
+            if stage_idx == self.last_sq {
+                self.fold_lobe(c);
             }
         }
+    }
 
-        // A dead chunk is all cut with all outputs 0: only its first output can fall below
-        // the one before it.
-        let (n_chunk_cut, checked) = if dead_chunk {
-            (chunk.len() as u64, 1)
+    /// cos^n of a code of the chunk: 0 at and below c = 0.
+    #[inline]
+    fn cos_n(&self, c: &Chunk<'_>, i: usize) -> f64 {
+        if c.codes[i] as f64 * self.c_lsb <= 0.0 {
+            0.0
         } else {
-            (cols.cut.iter().filter(|&&c| c).count() as u64, chunk.len())
+            (self.nf * c.ln_c[i]).exp()
+        }
+    }
+
+    /// The normalised output against the exact normalised cos^n, on the live inputs
+    /// (`live_raws` and `live_refs` hold the output's values and the f64 lobe times the f64
+    /// coefficient).
+    fn fold_normalised(&mut self, c: &Chunk<'_>) {
+        let lsb_out = self.lsb[self.out];
+        for (j, &i) in self.live.iter().enumerate() {
+            let cos_n = self.cos_n(c, i);
+            let o = self.live_raws[j] as f64 * lsb_out;
+            self.norm
+                .add((o - self.norm_peak * cos_n).abs(), (self.nc.n, c.codes[i]));
+            self.norm_approx = self
+                .norm_approx
+                .max((self.live_refs[j] - self.norm_peak * cos_n).abs());
+        }
+    }
+
+    /// The lobe against cos^n on the live inputs (`live_raws` and `live_refs` hold the last
+    /// squaring's values): its quantization, approximation and total error.
+    fn fold_lobe(&mut self, c: &Chunk<'_>) {
+        let lsb_sq = self.lsb[self.last_sq];
+        for (j, &i) in self.live.iter().enumerate() {
+            let at = (self.nc.n, c.codes[i]);
+            let s_fixed = self.live_raws[j] as f64 * lsb_sq;
+            let s_ref = self.live_refs[j];
+            let cos_n = self.cos_n(c, i);
+            self.quant.add((s_fixed - s_ref).abs(), at);
+            self.approx.add((s_ref - cos_n).abs(), at);
+            self.total.add((s_fixed - cos_n).abs(), at);
+        }
+    }
+
+    /// Counts the cut inputs and the outputs below the one before them. A dead chunk is all
+    /// cut with all outputs 0: only its first output can fall below the one before it.
+    fn fold_cuts_and_monotonicity(&mut self, c: &Chunk<'_>) {
+        let (n_chunk_cut, checked) = if c.dead {
+            (c.codes.len() as u64, 1)
+        } else {
+            (
+                c.probes.cut.iter().filter(|&&cut| cut).count() as u64,
+                c.codes.len(),
+            )
         };
-        n_cut += n_chunk_cut;
-        for (&o, &code) in cols.values[out].iter().zip(chunk).take(checked) {
-            if let Some(prev) = prev_out {
+        self.n_cut += n_chunk_cut;
+        for (&o, &code) in c.probes.values[self.out].iter().zip(c.codes).take(checked) {
+            if let Some(prev) = self.prev_out {
                 if o < prev {
-                    n_violations += 1;
-                    if violations.len() < MAX_LISTED_VIOLATIONS {
-                        violations.push(MonotonicityViolation {
-                            n: nc.n,
+                    self.n_violations += 1;
+                    if self.violations.len() < MAX_LISTED_VIOLATIONS {
+                        self.violations.push(MonotonicityViolation {
+                            n: self.nc.n,
                             c_raw: code,
                             out_before: prev,
                             out_here: o,
@@ -834,30 +916,53 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
                     }
                 }
             }
-            prev_out = Some(o);
+            self.prev_out = Some(o);
         }
+    }
+
+    /// The exponent's figures, with the largest code of zero lobes counted once.
+    fn finish(mut self) -> PerN {
+        if let Some((code, lnc)) = self.zero_lobe_code {
+            let at = (self.nc.n, code);
+            let cos_n = if code <= 0 {
+                0.0
+            } else {
+                (self.nf * lnc).exp()
+            };
+            self.quant.add(0.0, at);
+            self.approx.add(cos_n, at);
+            self.total.add(cos_n, at);
+            self.norm.add(self.norm_peak * cos_n, at);
+            self.norm_approx = self.norm_approx.max(self.norm_peak * cos_n);
+        }
+        PerN {
+            stages: self.acc,
+            quant: self.quant,
+            approx: self.approx,
+            total: self.total,
+            norm_rel: self.norm.value / self.norm_peak,
+            norm_approx_rel: self.norm_approx / self.norm_peak,
+            norm: self.norm,
+            n_violations: self.n_violations,
+            violations: self.violations,
+            n_cut: self.n_cut,
+        }
+    }
+}
+
+/// One exponent's exhaustive check: every chunk of the stream above the dead prefix's start,
+/// folded by [`NFold`].
+fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
+    let span = Span {
+        from: 0,
+        dead_end: dead_prefix_end(dp, nc, &shared.codes.codes),
+        chunk_codes: CHUNK,
+    };
+    let mut fold = NFold::new(dp, nc);
+    each_chunk(dp, nc, &shared.codes, span, |c| {
+        fold.chunk(c, &shared.ref_d[c.start..c.start + c.codes.len()]);
     });
-    if let Some((code, lnc)) = zero_lobe_code {
-        let at = (nc.n, code);
-        let cos_n = if code <= 0 { 0.0 } else { (nf * lnc).exp() };
-        quant.add(0.0, at);
-        approx.add(cos_n, at);
-        total.add(cos_n, at);
-        norm.add(norm_peak * cos_n, at);
-        norm_approx = norm_approx.max(norm_peak * cos_n);
-    }
-    PerN {
-        stages: acc,
-        quant,
-        approx,
-        total,
-        norm_rel: norm.value / norm_peak,
-        norm_approx_rel: norm_approx / norm_peak,
-        norm,
-        n_violations,
-        violations,
-        n_cut,
-    }
+    fold.finish()
 }
 
 /// The largest number of input codes an exhaustive check evaluates per exponent.

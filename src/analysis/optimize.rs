@@ -279,61 +279,24 @@ pub fn search(
     progress: &mut dyn FnMut(&str),
 ) -> Result<SearchResult, Error> {
     let choices = &space.choices;
-    let start_frac = space.start_frac;
-    let knobs_of = |k: u32| -> Vec<Knob> {
-        searched_stages(k)
-            .into_iter()
-            .map(Knob::Frac)
-            .chain(space.extra_knobs.iter().copied())
-            .collect()
-    };
-    let mut n_eval = 0u64;
-    let mut memo: BTreeMap<String, Option<Candidate>> = BTreeMap::new();
-    let mut evaluate = |cfg: &Config, n_eval: &mut u64| -> Result<Option<Candidate>, Error> {
-        let key = cfg.to_toml();
-        if let Some(c) = memo.get(&key) {
-            return Ok(c.clone());
-        }
-        let c = match Datapath::new(cfg.clone()) {
-            Err(_) => None,
-            Ok(dp) => {
-                *n_eval += 1;
-                let v = judge(&dp)?;
-                Some(Candidate {
-                    config: cfg.clone(),
-                    cost: cost(&dp)?,
-                    feasible: v.feasible,
-                    excess: v.excess,
-                })
-            }
-        };
-        memo.insert(key, c.clone());
-        Ok(c)
+    let mut eval = Evaluator {
+        judge,
+        cost,
+        memo: BTreeMap::new(),
+        n_eval: 0,
     };
     let mut best: Option<Candidate> = None;
     let mut closest: Option<Candidate> = None;
     for &k in &choices.k {
         for &variant in &choices.variants {
             for &rounding in &choices.roundings {
-                let mut cfg = base.clone();
-                cfg.k = k;
-                cfg.square = vec![base.square[0]; k as usize];
-                cfg.variant = variant;
-                let knobs = knobs_of(k);
-                for &knob in knobs.iter().filter(|k| k.starts_wide()) {
-                    knob.set(&mut cfg, start_frac)?;
-                }
-                cfg.t.rounding = rounding;
-                cfg.b.rounding = rounding;
-                cfg.out.rounding = rounding;
-                for sq in &mut cfg.square {
-                    sq.rounding = rounding;
-                }
+                let cfg = start_config(base, space, k, variant, rounding)?;
                 progress(&format!(
-                    "k = {k}, {}, {rounding}: start at {start_frac} fraction bits",
-                    variant.name()
+                    "k = {k}, {}, {rounding}: start at {} fraction bits",
+                    variant.name(),
+                    space.start_frac
                 ));
-                let Some(start) = evaluate(&cfg, &mut n_eval)? else {
+                let Some(start) = eval.evaluate(&cfg)? else {
                     continue;
                 };
                 if !start.feasible {
@@ -342,35 +305,7 @@ pub fn search(
                     }
                     continue;
                 }
-                // Per-stage bisection until nothing shrinks.
-                let mut current = start;
-                loop {
-                    let mut changed = false;
-                    for &knob in &knobs {
-                        let (mut lo, mut hi) = (-1, knob.get(&current.config));
-                        // Invariant: hi feasible; find the smallest feasible in (lo, hi], down
-                        // to 0 bits.
-                        while hi - lo > 1 {
-                            let mid = (lo + hi) / 2;
-                            let mut trial = current.config.clone();
-                            if knob.set(&mut trial, mid).is_err() {
-                                lo = mid;
-                                continue;
-                            }
-                            match evaluate(&trial, &mut n_eval)? {
-                                Some(c) if c.feasible => {
-                                    hi = mid;
-                                    current = c;
-                                    changed = true;
-                                }
-                                _ => lo = mid,
-                            }
-                        }
-                    }
-                    if !changed {
-                        break;
-                    }
-                }
+                let current = bisect(&mut eval, &space.knobs(k), start)?;
                 progress(&format!("  -> {:.0} LUTs", current.cost));
                 if best.as_ref().is_none_or(|b| current.cost < b.cost) {
                     best = Some(current);
@@ -378,115 +313,250 @@ pub fn search(
             }
         }
     }
-    // Local search over each stage's rounding and overflow modes (the output's too: its
-    // format is the interface, its modes are not), alone or with one fraction bit less, until
-    // no single move is both feasible and cheaper.
     let mut n_moves = 0u64;
-    if let Some(mut current) = best.take() {
-        let mut stages = searched_stages(current.config.k);
-        stages.push(Stage::Out);
-        loop {
-            let mut improved = false;
-            for &s in &stages {
-                let spec = *spec_mut(&mut current.config.clone(), s);
-                let mut trials = Vec::new();
-                for &r in space
-                    .local_roundings
-                    .iter()
-                    .filter(|&&r| r != spec.rounding)
-                {
-                    let mut trial = current.config.clone();
-                    spec_mut(&mut trial, s).rounding = r;
-                    if s != Stage::Out {
-                        let mut fewer = trial.clone();
-                        if set_frac(&mut fewer, s, spec.format.frac_bits() - 1).is_ok() {
-                            trials.push(fewer);
-                        }
-                    }
-                    trials.push(trial);
-                }
-                // An overflow mode may change only where the exhaustive check proves the stage
-                // never overflows: there every mode gives the same values.
-                let overflows = if space.overflow_moves && never_overflows(&current.config, s)? {
-                    Overflow::ALL.to_vec()
-                } else {
-                    Vec::new()
-                };
-                for o in overflows.into_iter().filter(|&o| o != spec.overflow) {
-                    let mut trial = current.config.clone();
-                    spec_mut(&mut trial, s).overflow = o;
-                    trials.push(trial);
-                }
-                for trial in trials {
-                    n_moves += 1;
-                    if let Some(c) = evaluate(&trial, &mut n_eval)? {
-                        if c.feasible && c.cost < current.cost {
-                            let now = *spec_mut(&mut c.config.clone(), s);
-                            progress(&format!(
-                                "  local search: {s} {} {} {}: {:.0} LUTs",
-                                now.format, now.rounding, now.overflow, c.cost
-                            ));
-                            current = c;
-                            improved = true;
-                            // The other trials of this stage were built from the old point.
-                            break;
-                        }
-                    }
-                }
+    if let Some(start) = best.take() {
+        let (current, moves) = local_search(&mut eval, space, start, progress)?;
+        best = Some(current);
+        n_moves = moves;
+    }
+    let minimality = match &best {
+        Some(b) => minimality(&mut eval, space, b, n_moves)?,
+        None => Vec::new(),
+    };
+    Ok(SearchResult {
+        best,
+        closest,
+        n_evaluations: eval.n_eval,
+        minimality,
+    })
+}
+
+impl Space {
+    /// The knobs searched for k squarings: every searched stage's fraction bits, then the
+    /// extra knobs.
+    fn knobs(&self, k: u32) -> Vec<Knob> {
+        searched_stages(k)
+            .into_iter()
+            .map(Knob::Frac)
+            .chain(self.extra_knobs.iter().copied())
+            .collect()
+    }
+}
+
+/// The search's judge and cost with a memo: each configuration is judged once, and counted.
+struct Evaluator<'a> {
+    judge: &'a mut dyn FnMut(&Datapath) -> Result<Verdict, Error>,
+    cost: &'a mut dyn FnMut(&Datapath) -> Result<f64, Error>,
+    memo: BTreeMap<String, Option<Candidate>>,
+    n_eval: u64,
+}
+
+impl Evaluator<'_> {
+    /// The candidate `cfg` is, or None when it is not a valid datapath.
+    fn evaluate(&mut self, cfg: &Config) -> Result<Option<Candidate>, Error> {
+        let key = cfg.to_toml();
+        if let Some(c) = self.memo.get(&key) {
+            return Ok(c.clone());
+        }
+        let c = match Datapath::new(cfg.clone()) {
+            Err(_) => None,
+            Ok(dp) => {
+                self.n_eval += 1;
+                let v = (self.judge)(&dp)?;
+                Some(Candidate {
+                    config: cfg.clone(),
+                    cost: (self.cost)(&dp)?,
+                    feasible: v.feasible,
+                    excess: v.excess,
+                })
             }
-            if !improved {
-                break;
+        };
+        self.memo.insert(key, c.clone());
+        Ok(c)
+    }
+}
+
+/// The starting point of one combination of the discrete choices: every knob that starts
+/// wide at `start_frac` fraction bits, every rounding stage at `rounding`.
+fn start_config(
+    base: &Config,
+    space: &Space,
+    k: u32,
+    variant: Variant,
+    rounding: Rounding,
+) -> Result<Config, Error> {
+    let mut cfg = base.clone();
+    cfg.k = k;
+    cfg.square = vec![base.square[0]; k as usize];
+    cfg.variant = variant;
+    for knob in space.knobs(k).into_iter().filter(|k| k.starts_wide()) {
+        knob.set(&mut cfg, space.start_frac)?;
+    }
+    cfg.t.rounding = rounding;
+    cfg.b.rounding = rounding;
+    cfg.out.rounding = rounding;
+    for sq in &mut cfg.square {
+        sq.rounding = rounding;
+    }
+    Ok(cfg)
+}
+
+/// Per-knob bisection from a feasible `start` until no knob shrinks.
+fn bisect(eval: &mut Evaluator, knobs: &[Knob], start: Candidate) -> Result<Candidate, Error> {
+    let mut current = start;
+    loop {
+        let mut changed = false;
+        for &knob in knobs {
+            let (mut lo, mut hi) = (-1, knob.get(&current.config));
+            // Invariant: hi feasible; find the smallest feasible in (lo, hi], down to 0 bits.
+            while hi - lo > 1 {
+                let mid = (lo + hi) / 2;
+                let mut trial = current.config.clone();
+                if knob.set(&mut trial, mid).is_err() {
+                    lo = mid;
+                    continue;
+                }
+                match eval.evaluate(&trial)? {
+                    Some(c) if c.feasible => {
+                        hi = mid;
+                        current = c;
+                        changed = true;
+                    }
+                    _ => lo = mid,
+                }
             }
         }
-        best = Some(current);
+        if !changed {
+            return Ok(current);
+        }
     }
-    let mut minimality = Vec::new();
-    if let Some(b) = &best {
-        minimality.push(format!(
+}
+
+/// Local search over each stage's rounding and overflow modes (the output's too: its format
+/// is the interface, its modes are not), alone or with one fraction bit less, until no single
+/// move is both feasible and cheaper. Returns the point and the number of moves tried.
+fn local_search(
+    eval: &mut Evaluator,
+    space: &Space,
+    start: Candidate,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Candidate, u64), Error> {
+    let mut n_moves = 0u64;
+    let mut current = start;
+    let mut stages = searched_stages(current.config.k);
+    stages.push(Stage::Out);
+    loop {
+        let mut improved = false;
+        for &s in &stages {
+            for trial in local_moves(space, &current.config, s)? {
+                n_moves += 1;
+                if let Some(c) = eval.evaluate(&trial)? {
+                    if c.feasible && c.cost < current.cost {
+                        let now = *spec_mut(&mut c.config.clone(), s);
+                        progress(&format!(
+                            "  local search: {s} {} {} {}: {:.0} LUTs",
+                            now.format, now.rounding, now.overflow, c.cost
+                        ));
+                        current = c;
+                        improved = true;
+                        // The other trials of this stage were built from the old point.
+                        break;
+                    }
+                }
+            }
+        }
+        if !improved {
+            return Ok((current, n_moves));
+        }
+    }
+}
+
+/// The local search's moves on stage `s` of `config`: every other rounding mode, alone and
+/// (internal stages) with one fraction bit less; every other overflow mode where allowed.
+fn local_moves(space: &Space, config: &Config, s: Stage) -> Result<Vec<Config>, Error> {
+    let spec = *spec_mut(&mut config.clone(), s);
+    let mut trials = Vec::new();
+    for &r in space
+        .local_roundings
+        .iter()
+        .filter(|&&r| r != spec.rounding)
+    {
+        let mut trial = config.clone();
+        spec_mut(&mut trial, s).rounding = r;
+        if s != Stage::Out {
+            let mut fewer = trial.clone();
+            if set_frac(&mut fewer, s, spec.format.frac_bits() - 1).is_ok() {
+                trials.push(fewer);
+            }
+        }
+        trials.push(trial);
+    }
+    // An overflow mode may change only where the exhaustive check proves the stage never
+    // overflows: there every mode gives the same values.
+    let overflows = if space.overflow_moves && never_overflows(config, s)? {
+        Overflow::ALL.to_vec()
+    } else {
+        Vec::new()
+    };
+    for o in overflows.into_iter().filter(|&o| o != spec.overflow) {
+        let mut trial = config.clone();
+        spec_mut(&mut trial, s).overflow = o;
+        trials.push(trial);
+    }
+    Ok(trials)
+}
+
+/// Why `best` is minimal within the search: how it was found, and each knob's verdict one
+/// bit narrower.
+fn minimality(
+    eval: &mut Evaluator,
+    space: &Space,
+    best: &Candidate,
+    n_moves: u64,
+) -> Result<Vec<String>, Error> {
+    let choices = &space.choices;
+    let mut lines = vec![
+        format!(
             "cheapest of {} starting points (k in {:?}, variants {:?}, roundings {:?}), each shrunk by per-stage bisection until no stage could lose a fraction bit",
             choices.k.len() * choices.variants.len() * choices.roundings.len(),
             choices.k,
             choices.variants.iter().map(|v| v.name()).collect::<Vec<_>>(),
             choices.roundings.iter().map(|r| r.name()).collect::<Vec<_>>()
-        ));
-        minimality.push(format!(
+        ),
+        format!(
             "then a local search over every stage's rounding{} modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried, none of the final ones both feasible and cheaper",
             if space.overflow_moves { " and overflow" } else { "" }
-        ));
-        if space.overflow_moves {
-            minimality.push("overflow modes were changed only on stages an exhaustive check proves never overflow, where every mode gives the same values".to_string());
-        }
-        minimality.push(format!(
-            "the knobs searched: {}",
-            knobs_of(b.config.k)
-                .iter()
-                .map(|k| k.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
-        for knob in knobs_of(b.config.k) {
-            let mut trial = b.config.clone();
-            let bits = knob.get(&trial);
-            let verdict = if knob.set(&mut trial, bits - 1).is_err() {
-                "cannot lose a bit (format limit)".to_string()
-            } else {
-                match evaluate(&trial, &mut n_eval)? {
-                    Some(c) if c.feasible => {
-                        format!("ALSO FEASIBLE with {} bits (cost {:.0})", bits - 1, c.cost)
-                    }
-                    Some(_) => format!("{bits}: one fewer breaks the budget"),
-                    None => "one fewer bit is not a valid configuration".to_string(),
-                }
-            };
-            minimality.push(format!("{knob}: {verdict}"));
-        }
+        ),
+    ];
+    if space.overflow_moves {
+        lines.push("overflow modes were changed only on stages an exhaustive check proves never overflow, where every mode gives the same values".to_string());
     }
-    Ok(SearchResult {
-        best,
-        closest,
-        n_evaluations: n_eval,
-        minimality,
-    })
+    let knobs = space.knobs(best.config.k);
+    lines.push(format!(
+        "the knobs searched: {}",
+        knobs
+            .iter()
+            .map(|k| k.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    for knob in knobs {
+        let mut trial = best.config.clone();
+        let bits = knob.get(&trial);
+        let verdict = if knob.set(&mut trial, bits - 1).is_err() {
+            "cannot lose a bit (format limit)".to_string()
+        } else {
+            match eval.evaluate(&trial)? {
+                Some(c) if c.feasible => {
+                    format!("ALSO FEASIBLE with {} bits (cost {:.0})", bits - 1, c.cost)
+                }
+                Some(_) => format!("{bits}: one fewer breaks the budget"),
+                None => "one fewer bit is not a valid configuration".to_string(),
+            }
+        };
+        lines.push(format!("{knob}: {verdict}"));
+    }
+    Ok(lines)
 }
 
 /// One algorithm the optimiser may choose: k squarings and a variant.

@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::hdl::cost::{analytic_cost, figures_on_targets, CostFigures, Target};
 use crate::nset::NSet;
 use crate::pipeline::{Config, Datapath, ProbeColumns};
-use crate::reference::lobe::Cutoff;
+use crate::reference::lobe::{cos_pow, Cutoff};
 use crate::reference::method::Method;
 use crate::reference::minimax::sup_abs_error;
 
@@ -88,12 +88,9 @@ fn grid() -> Vec<f64> {
     (0..=4096).map(|i| f64::from(i) / 4096.0).collect()
 }
 
+/// cos^n of `c`, 0 at and below 0: the one rule ([`cos_pow`]).
 fn cos_n(c: f64, n: u32) -> f64 {
-    if c <= 0.0 {
-        0.0
-    } else {
-        c.powf(f64::from(n))
-    }
+    cos_pow(c, f64::from(n))
 }
 
 /// Figures of an f64 method over the exponents `ns`; `time` measures its speed.

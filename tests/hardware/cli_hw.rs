@@ -185,8 +185,13 @@ fn cost_flags_what_exceeds_the_device() {
 fn a_repeated_synthesis_comes_from_the_cache_and_only_for_the_same_inputs() {
     let root = tempfile::tempdir().unwrap();
     let cache = root.path().join("cache");
-    let narrow = root.path().join("narrow.toml");
-    std::fs::write(&narrow, "[out]\nformat = \"u1.7\"\n").unwrap();
+    // A small datapath (8-bit stages, four exponents): the cache does not depend on size,
+    // and each synthesis and place and route of it takes seconds.
+    let small = "n = \"16..=19\"\n[c]\nformat = \"u1.7\"\n[d]\nformat = \"s1.7\"\n[t]\nformat = \"s1.7\"\n[b]\nformat = \"u1.7\"\n[square]\nformat = \"u1.7\"\n[coef]\nformat = \"u4.4\"\n";
+    let (tiny, narrow) = (root.path().join("tiny.toml"), root.path().join("narrow.toml"));
+    std::fs::write(&tiny, format!("{small}[out]\nformat = \"u1.7\"\n")).unwrap();
+    std::fs::write(&narrow, format!("{small}[out]\nformat = \"u1.6\"\n")).unwrap();
+    let tiny = tiny.to_str().unwrap();
     let cost = |config: &str, cache: &str| {
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_specfx"))
             .args(["cost", "--timing", "--json", "--config", config])
@@ -202,7 +207,7 @@ fn a_repeated_synthesis_comes_from_the_cache_and_only_for_the_same_inputs() {
             v["timing"]["synthesis"]["luts"].as_u64().unwrap(),
         )
     };
-    let first = figures(&cost("baseline", cache.to_str().unwrap()));
+    let first = figures(&cost(tiny, cache.to_str().unwrap()));
     // One entry per synthesis: the datapath and its ROM (yosys), the place and route.
     let entries = |tool: &str| -> Vec<std::path::PathBuf> {
         let mut v: Vec<_> = std::fs::read_dir(cache.join(tool))
@@ -223,11 +228,11 @@ fn a_repeated_synthesis_comes_from_the_cache_and_only_for_the_same_inputs() {
         std::fs::write(&stat, serde_json::to_vec(&v).unwrap()).unwrap();
     }
     assert_eq!(
-        figures(&cost("baseline", cache.to_str().unwrap())),
+        figures(&cost(tiny, cache.to_str().unwrap())),
         (7777, 7777, 7777)
     );
     // Without the cache: the tools' own figures, the same as the first run's.
-    assert_eq!(figures(&cost("baseline", "off")), first);
+    assert_eq!(figures(&cost(tiny, "off")), first);
     // Another configuration is other inputs: synthesised, and its figures are not 7777.
     let other = figures(&cost(narrow.to_str().unwrap(), cache.to_str().unwrap()));
     assert!(other.0 != 7777 && other.2 != 7777, "{other:?}");
