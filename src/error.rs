@@ -83,7 +83,9 @@ pub enum Error {
         message: String,
     },
     /// An input format with more codes than an exhaustive analysis evaluates.
-    #[error("c.format {format} has {n_codes} input codes up to 1.0; an exhaustive check evaluates at most {limit}")]
+    #[error(
+        "c.format {format} has {n_codes} input codes up to 1.0; an exhaustive check evaluates at most {limit}"
+    )]
     TooManyCodes {
         /// The input format.
         format: String,
@@ -148,7 +150,9 @@ pub enum Error {
         problem: String,
     },
     /// The minimax table has no entry for this (n, k).
-    #[error("no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..=7")]
+    #[error(
+        "no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..=7"
+    )]
     NoMinimaxEntry {
         /// The exponent asked for.
         n: u32,
@@ -195,7 +199,9 @@ pub enum FixedError {
         max: i64,
     },
     /// An unsigned format is 64 bits wide: its largest raw value would not fit in `i64`.
-    #[error("width (int bits + frac bits) of unsigned {notation} must be at most 63 so that raws fit in i64, got {got}")]
+    #[error(
+        "width (int bits + frac bits) of unsigned {notation} must be at most 63 so that raws fit in i64, got {got}"
+    )]
     UnsignedWidth {
         /// The format as it was given, in the usual notation.
         notation: String,

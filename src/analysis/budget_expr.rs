@@ -131,7 +131,9 @@ impl FromStr for Budget {
         let bad = |part: &str, why: &str| {
             Error::Config {
             key: "budget".into(),
-            problem: format!("{why} in '{part}'; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'"),
+            problem: format!(
+                "{why} in '{part}'; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'"
+            ),
         }
         };
         let mut bounds = Vec::new();
@@ -213,7 +215,7 @@ impl FromStr for Budget {
                     return Err(bad(
                         part,
                         &format!("unit '{unit}' does not fit this metric"),
-                    ))
+                    ));
                 }
             };
             if !value.is_finite() || value < 0.0 {

@@ -533,7 +533,7 @@ fn curve(
     let flagged_angles_deg = angles_deg
         .iter()
         .zip(&rho)
-        .filter(|(_, &v)| v > 1.0 + FLAG_TOLERANCE)
+        .filter(|&(_, &v)| v > 1.0 + FLAG_TOLERANCE)
         .map(|(&a, _)| a)
         .collect();
     Curve {

@@ -357,7 +357,7 @@ pub fn parse_results(text: &str) -> Result<BTreeMap<String, (f64, f64)>, Error> 
                 return Err(unreadable(format!(
                     "cannot read gappa's interval '{}'",
                     line.trim()
-                )))
+                )));
             }
         }
     }

@@ -520,12 +520,24 @@ fn minimality(
             "cheapest of {} starting points (k in {:?}, variants {:?}, roundings {:?}), each shrunk by per-stage bisection until no stage could lose a fraction bit",
             choices.k.len() * choices.variants.len() * choices.roundings.len(),
             choices.k,
-            choices.variants.iter().map(|v| v.name()).collect::<Vec<_>>(),
-            choices.roundings.iter().map(|r| r.name()).collect::<Vec<_>>()
+            choices
+                .variants
+                .iter()
+                .map(|v| v.name())
+                .collect::<Vec<_>>(),
+            choices
+                .roundings
+                .iter()
+                .map(|r| r.name())
+                .collect::<Vec<_>>()
         ),
         format!(
             "then a local search over every stage's rounding{} modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried, none of the final ones both feasible and cheaper",
-            if space.overflow_moves { " and overflow" } else { "" }
+            if space.overflow_moves {
+                " and overflow"
+            } else {
+                ""
+            }
         ),
     ];
     if space.overflow_moves {

@@ -704,7 +704,7 @@ impl SweepInfo {
                         "{}: point {} is recorded twice with different figures",
                         at(),
                         p.index
-                    )))
+                    )));
                 }
                 Some(_) => continue,
                 None => {}

@@ -22,7 +22,9 @@ pub fn load(arg: &str, n: Option<&NSet>) -> Result<Datapath> {
             super::vectordir::open(path)?.config
         }
         None if path.extension().is_some_and(|e| e == "json") => {
-            bail!("config {arg}: a JSON file, expected a TOML configuration, a built-in name (baseline) or a vector directory (or its manifest.json)")
+            bail!(
+                "config {arg}: a JSON file, expected a TOML configuration, a built-in name (baseline) or a vector directory (or its manifest.json)"
+            )
         }
         None => {
             // A dangling symbolic link exists as a link: read_text names it.

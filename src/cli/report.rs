@@ -123,7 +123,11 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
             "specfx report: resuming the interrupted run in {} ({} finished {} kept; --restart starts afresh)",
             args.out.display(),
             resume.n_reusable(),
-            if resume.n_reusable() == 1 { "step" } else { "steps" }
+            if resume.n_reusable() == 1 {
+                "step"
+            } else {
+                "steps"
+            }
         );
     }
     *super::output::RESUME_HINT.lock().expect("hint") = Some(format!(

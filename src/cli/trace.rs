@@ -215,7 +215,9 @@ fn write_comparison(
     } else if c.signals_compared == 0 || c.cycles_compared == 0 {
         "TRACES DIFFER: nothing to compare".to_string()
     } else if c.first_difference.is_none() && c.width_mismatches.is_empty() {
-        format!("TRACES DIFFER: {missing} signals missing from one file (--ignore-missing accepts them)")
+        format!(
+            "TRACES DIFFER: {missing} signals missing from one file (--ignore-missing accepts them)"
+        )
     } else {
         "TRACES DIFFER".to_string()
     };

@@ -35,8 +35,8 @@ impl Stimulus {
             // reads this generator.
             return (true, true);
         }
-        let valid = self.rng.gen::<f64>() >= self.bubble;
-        let ready = self.rng.gen::<f64>() >= self.stall;
+        let valid = self.rng.r#gen::<f64>() >= self.bubble;
+        let ready = self.rng.r#gen::<f64>() >= self.stall;
         (valid, ready)
     }
 }

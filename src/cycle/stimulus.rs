@@ -97,7 +97,9 @@ pub fn cosim_stimulus(
         let advice = if fit < 1.0 {
             "lower them".to_string()
         } else {
-            format!("about {fit:.0} vectors fit at these probabilities: lower them or use fewer vectors")
+            format!(
+                "about {fit:.0} vectors fit at these probabilities: lower them or use fewer vectors"
+            )
         };
         return Err(refuse(format!(
             "--bubble {bubble} and --stall {stall} would need about {expected:.0} cycles for {} vectors; {what} is limited to {max} cycles ({advice})",

@@ -526,7 +526,7 @@ mod tests {
         let mut s0 = ChaCha8Rng::seed_from_u64(9);
         let mut s1 = ChaCha8Rng::seed_from_u64(9);
         s1.set_stream(ORDER_STREAM);
-        assert_ne!(s0.gen::<u64>(), s1.gen::<u64>());
+        assert_ne!(s0.r#gen::<u64>(), s1.r#gen::<u64>());
     }
 
     #[test]

@@ -605,7 +605,12 @@ mod tests {
                     .iter()
                     .find(|r| r.stage == dp.stages()[st.stage_idx].name)
                     .unwrap();
-                assert_eq!(report.classes, classes.len() as u64, "{toml} {}", report.stage);
+                assert_eq!(
+                    report.classes,
+                    classes.len() as u64,
+                    "{toml} {}",
+                    report.stage
+                );
                 for key in classes {
                     let all = &want[key];
                     // Each class: at least one kept input, at most TIES_PER_CLASS, and every
@@ -613,7 +618,10 @@ mod tests {
                     let mine: Vec<&(u32, i64)> = all.iter().filter(|p| kept.contains(p)).collect();
                     assert!(!mine.is_empty(), "{toml} {key:?}");
                     let n_with: BTreeSet<u32> = all.iter().map(|p| p.0).collect();
-                    assert!(mine.len() >= n_with.len().min(TIES_PER_CLASS), "{toml} {key:?}");
+                    assert!(
+                        mine.len() >= n_with.len().min(TIES_PER_CLASS),
+                        "{toml} {key:?}"
+                    );
                     for &&(n, c) in &mine {
                         let top = all.iter().filter(|p| p.0 == n).map(|p| p.1).max().unwrap();
                         if c != top {

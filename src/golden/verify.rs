@@ -116,7 +116,9 @@ impl VerifiedManifest {
         })
         .expect("csv info serialises");
         if m.csv != want_csv {
-            return Err(fail(format!("{name}: key 'csv': expected file {CSV_FILE} with one column per port, in the order of 'ports'")));
+            return Err(fail(format!(
+                "{name}: key 'csv': expected file {CSV_FILE} with one column per port, in the order of 'ports'"
+            )));
         }
 
         // The hashes: exactly the CSV and one hex file per port, and the record of what
@@ -197,7 +199,10 @@ impl VerifiedManifest {
             ))
         })?;
         if &digest != want {
-            return Err(fail(format!("{what}: sha256 {digest} differs from the manifest's {} (the file was changed after specfx vectors wrote it; write the vectors again)", OneLine(want))));
+            return Err(fail(format!(
+                "{what}: sha256 {digest} differs from the manifest's {} (the file was changed after specfx vectors wrote it; write the vectors again)",
+                OneLine(want)
+            )));
         }
         Ok(())
     }
@@ -220,7 +225,9 @@ impl VerifiedManifest {
             return Err(fail(if header.contains(':') {
                 format!("{what} line 1: expected the header {want}")
             } else {
-                format!("{what} line 1: expected the header {want} (written by an older specfx? write the vectors again)")
+                format!(
+                    "{what} line 1: expected the header {want} (written by an older specfx? write the vectors again)"
+                )
             }));
         }
         let mut values = Vec::new();
@@ -229,7 +236,9 @@ impl VerifiedManifest {
             let line_no = i + 2;
             n_rows += 1;
             if n_rows > n_vectors {
-                return Err(fail(format!("{what} line {line_no}: the manifest says {n_vectors} vectors, the file has more rows")));
+                return Err(fail(format!(
+                    "{what} line {line_no}: the manifest says {n_vectors} vectors, the file has more rows"
+                )));
             }
             let mut fields = line.split(',');
             for (j, (col, format)) in self.columns.iter().zip(&self.formats).enumerate() {
@@ -365,7 +374,9 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(
-            e.starts_with("m.json: key 'config.variant': unknown variant `a b`, expected `plain` or `minimax`"),
+            e.starts_with(
+                "m.json: key 'config.variant': unknown variant `a b`, expected `plain` or `minimax`"
+            ),
             "{e}"
         );
         let e = VerifiedManifest::parse("{\n", "m.json")

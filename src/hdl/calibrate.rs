@@ -321,7 +321,7 @@ pub fn read_records(text: &str, path: &str) -> Result<Vec<Record>, Error> {
                 return Err(Error::Config {
                     key: format!("{path}: line {}", i + 1),
                     problem: format!("not a calibration record: {e}"),
-                })
+                });
             }
         }
     }

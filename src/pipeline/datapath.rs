@@ -359,7 +359,9 @@ impl Datapath {
             if bits > MAX_EXACT_BITS {
                 return Err(config_error(
                     &stage,
-                    format!("the stage's exact input would need {bits} bits; the model computes at most {MAX_EXACT_BITS}: narrow the formats feeding it"),
+                    format!(
+                        "the stage's exact input would need {bits} bits; the model computes at most {MAX_EXACT_BITS}: narrow the formats feeding it"
+                    ),
                 ));
             }
         }

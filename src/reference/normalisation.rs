@@ -78,7 +78,11 @@ impl Form {
     }
 }
 
-crate::names::named_enum!(Form, "form", "phong, phong_modified, blinn_phong, blinn_phong_modified, blinn_phong_ndf or blinn_phong_heightfield");
+crate::names::named_enum!(
+    Form,
+    "form",
+    "phong, phong_modified, blinn_phong, blinn_phong_modified, blinn_phong_ndf or blinn_phong_heightfield"
+);
 
 /// Where a coefficient comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

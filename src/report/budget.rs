@@ -212,7 +212,11 @@ pub fn document(r: &BudgetReport) -> Vec<Block> {
         Block::Heading(1, format!("Error budget: {}", r.config)),
         Block::Paragraph(format!(
             "{} evaluations: {} input codes up to 1.0 for each of {} exponents (n = {}). Output LSB = {}.",
-            c.n_evaluations, c.n_input_codes, c.n_exponents, c.n_set, e(r.out_lsb)
+            c.n_evaluations,
+            c.n_input_codes,
+            c.n_exponents,
+            c.n_set,
+            e(r.out_lsb)
         )),
     ];
     match (&r.budget, r.pass) {

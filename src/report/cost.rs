@@ -99,9 +99,10 @@ pub fn write_cost(
             .join(", "),
         if rom.addressed_by_n { "n" } else { "index" },
         rom.luts,
-        r.rom_yosys
-            .as_ref()
-            .map_or("-".to_string(), |y| format!("{} LUTs, {} cells", y.luts, y.cells))
+        r.rom_yosys.as_ref().map_or("-".to_string(), |y| format!(
+            "{} LUTs, {} cells",
+            y.luts, y.cells
+        ))
     )?;
     if let Some(d) = r.device {
         if r.over_limit.is_empty() {

@@ -154,8 +154,14 @@ pub fn write_index(
         sims,
         provenance,
     } = *results;
-    writeln!(w, "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>specfx report</title>")?;
-    writeln!(w, "<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em}}.table{{overflow-x:auto}}td,th{{padding:2px 8px;text-align:right;white-space:nowrap}}td:first-child,th:first-child{{text-align:left}}img{{max-width:100%;height:auto}}</style></head><body>")?;
+    writeln!(
+        w,
+        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>specfx report</title>"
+    )?;
+    writeln!(
+        w,
+        "<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em}}.table{{overflow-x:auto}}td,th{{padding:2px 8px;text-align:right;white-space:nowrap}}td:first-child,th:first-child{{text-align:left}}img{{max-width:100%;height:auto}}</style></head><body>"
+    )?;
     writeln!(w, "<h1>specfx report</h1>")?;
     // The verdict first: the numbers a designer acts on.
     let lsb8 = crate::analysis::LSB8;
@@ -180,9 +186,21 @@ pub fn write_index(
     let n_ok = paper.forms.iter().filter(|f| f.reproduced).count()
         + usize::from(paper.delta.reproduced_max)
         + usize::from(paper.delta.reproduced_min);
-    writeln!(w, "<h2>The paper</h2><p>{n_ok} of {} printed claims reproduce to 2 significant digits: <a href=\"paper.txt\">paper.txt</a>, <a href=\"paper.json\">paper.json</a>.</p>", paper.forms.len() + 2)?;
-    writeln!(w, "<h2>The baseline datapath</h2><p>{} evaluations, every input code and n = 16..1024: lobe error against cos^n {:.3e} (quantization {:.3e}, approximation {:.3e}), output max {:.2} ulp, monotonic: {}. <a href=\"check_baseline.txt\">check_baseline.txt</a>, <a href=\"check_baseline.json\">check_baseline.json</a>.</p>",
-        checked.n_evaluations, checked.shape_total_max_abs, checked.shape_quant_max_abs, checked.shape_approx_max_abs, checked.out_max_ulp, if checked.monotonic { "yes" } else { "no" })?;
+    writeln!(
+        w,
+        "<h2>The paper</h2><p>{n_ok} of {} printed claims reproduce to 2 significant digits: <a href=\"paper.txt\">paper.txt</a>, <a href=\"paper.json\">paper.json</a>.</p>",
+        paper.forms.len() + 2
+    )?;
+    writeln!(
+        w,
+        "<h2>The baseline datapath</h2><p>{} evaluations, every input code and n = 16..1024: lobe error against cos^n {:.3e} (quantization {:.3e}, approximation {:.3e}), output max {:.2} ulp, monotonic: {}. <a href=\"check_baseline.txt\">check_baseline.txt</a>, <a href=\"check_baseline.json\">check_baseline.json</a>.</p>",
+        checked.n_evaluations,
+        checked.shape_total_max_abs,
+        checked.shape_quant_max_abs,
+        checked.shape_approx_max_abs,
+        checked.out_max_ulp,
+        if checked.monotonic { "yes" } else { "no" }
+    )?;
     let a = &budget.attribution;
     let top = a
         .incremental
@@ -194,11 +212,25 @@ pub fn write_index(
         .iter()
         .map(|f| f.bound_ulp / f.exhaustive_ulp.max(1e-300))
         .fold(0.0, f64::max);
-    writeln!(w, "<h2>Error budget of the baseline</h2><p>Output quantization error {:.3e} ({:.0} output LSBs); the largest part comes from stage <code>{top}</code>. {} <a href=\"budget_baseline/budget.html\">budget_baseline/budget.html</a> (also .md, .json).</p><img src=\"budget_baseline/error_vs_n.png\" alt=\"error per exponent\">",
-        a.total.max_abs, a.total.max_ulp,
-        if budget.formal.is_empty() { budget.formal_note.clone().unwrap_or_default() } else { format!("gappa proves bounds for {} exponents, at most {formal:.2} times the exhaustive maximum.", budget.formal.len()) })?;
+    writeln!(
+        w,
+        "<h2>Error budget of the baseline</h2><p>Output quantization error {:.3e} ({:.0} output LSBs); the largest part comes from stage <code>{top}</code>. {} <a href=\"budget_baseline/budget.html\">budget_baseline/budget.html</a> (also .md, .json).</p><img src=\"budget_baseline/error_vs_n.png\" alt=\"error per exponent\">",
+        a.total.max_abs,
+        a.total.max_ulp,
+        if budget.formal.is_empty() {
+            budget.formal_note.clone().unwrap_or_default()
+        } else {
+            format!(
+                "gappa proves bounds for {} exponents, at most {formal:.2} times the exhaustive maximum.",
+                budget.formal.len()
+            )
+        }
+    )?;
     if !costs.is_empty() {
-        writeln!(w, "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the calibrated analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><div class=\"table\"><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>ROM LUTs (yosys)</th></tr>")?;
+        writeln!(
+            w,
+            "<h2>Cost</h2><p>The baseline synthesised by yosys for iCE40, beside the calibrated analytic model (details: <a href=\"cost_baseline.txt\">cost_baseline.txt</a>; the per-n constant ROM is counted apart).</p><div class=\"table\"><table><tr><th>architecture</th><th>yosys LUTs</th><th>analytic LUTs</th><th>DSPs</th><th>flip-flops</th><th>ROM LUTs (yosys)</th></tr>"
+        )?;
         for c in costs {
             writeln!(
                 w,
@@ -206,7 +238,10 @@ pub fn write_index(
                 c.arch, c.luts, c.analytic_luts, c.dsps, c.ffs, c.rom_luts,
             )?;
         }
-        writeln!(w, "</table></div><div class=\"table\"><table><tr><th>architecture</th><th>latency (cycles)</th><th>initiation interval</th><th>Fmax on UP5K (nextpnr)</th><th>latency (ns)</th><th>throughput (Msamples/s)</th></tr>")?;
+        writeln!(
+            w,
+            "</table></div><div class=\"table\"><table><tr><th>architecture</th><th>latency (cycles)</th><th>initiation interval</th><th>Fmax on UP5K (nextpnr)</th><th>latency (ns)</th><th>throughput (Msamples/s)</th></tr>"
+        )?;
         for c in costs {
             let t = c.timing.as_ref();
             writeln!(
@@ -228,13 +263,19 @@ pub fn write_index(
         }
         writeln!(w, "</table></div>")?;
         if costs.iter().any(|c| c.timing.is_some()) {
-            writeln!(w, "<p>Fmax is register to register inside a serial harness, placed and routed by nextpnr on an iCE40 UP5K; it is an upper bound because nextpnr does not time the delay through the SB_MAC16 DSP blocks (<code>specfx timing</code>, <code>hdl_ref/README.md</code>). The analytic figures are the calibrated model's (<code>docs/cost.md</code>).</p>")?;
+            writeln!(
+                w,
+                "<p>Fmax is register to register inside a serial harness, placed and routed by nextpnr on an iCE40 UP5K; it is an upper bound because nextpnr does not time the delay through the SB_MAC16 DSP blocks (<code>specfx timing</code>, <code>hdl_ref/README.md</code>). The analytic figures are the calibrated model's (<code>docs/cost.md</code>).</p>"
+            )?;
         }
         for flag in costs.iter().flat_map(|c| &c.over_limit) {
             writeln!(w, "<p><b>Exceeds the UP5K:</b> {flag}</p>")?;
         }
     }
-    writeln!(w, "<h2>The cycle model</h2><p>20,000 cycles of each microarchitecture under seeded bubbles and stalls, every output checked against the functional model (<a href=\"sim_baseline.json\">sim_baseline.json</a>; a VCD of the first 300 cycles: <a href=\"sim_baseline_pipelined.vcd\">sim_baseline_pipelined.vcd</a>).</p><div class=\"table\"><table><tr><th>architecture</th><th>outputs</th><th>results per cycle</th><th>latency (nominal)</th><th>latency seen</th><th>mismatches</th></tr>")?;
+    writeln!(
+        w,
+        "<h2>The cycle model</h2><p>20,000 cycles of each microarchitecture under seeded bubbles and stalls, every output checked against the functional model (<a href=\"sim_baseline.json\">sim_baseline.json</a>; a VCD of the first 300 cycles: <a href=\"sim_baseline_pipelined.vcd\">sim_baseline_pipelined.vcd</a>).</p><div class=\"table\"><table><tr><th>architecture</th><th>outputs</th><th>results per cycle</th><th>latency (nominal)</th><th>latency seen</th><th>mismatches</th></tr>"
+    )?;
     for st in sims {
         writeln!(
             w,
@@ -249,8 +290,14 @@ pub fn write_index(
         )?;
     }
     writeln!(w, "</table></div>")?;
-    writeln!(w, "<h2>Error against hardware cost</h2><p>Each fixed-point datapath of the trade-off (plain k = 4 at 8, 12 and 16 fraction bits; minimax k = 3..6) by its lobe error in lsb8 against the calibrated analytic cost on each target (<a href=\"tradeoff/tradeoff.csv\">tradeoff.csv</a>; the model and its calibration error: <code>docs/cost.md</code>).</p><img src=\"tradeoff/error_vs_luts_ice40.png\" alt=\"error against iCE40 LUTs\"><img src=\"tradeoff/error_vs_dsps_ice40.png\" alt=\"error against iCE40 DSPs\"><img src=\"tradeoff/error_vs_luts_xilinx.png\" alt=\"error against Xilinx LUTs\"><img src=\"tradeoff/error_vs_latency.png\" alt=\"error against latency\">")?;
-    writeln!(w, "<h2>Speed against accuracy</h2><p>Software speed is measured in this run on this machine (one core), so the chart and <a href=\"tradeoff/measured_speed.csv\">measured_speed.csv</a> differ from run to run; every other file of the report is the same on every run.</p><img src=\"tradeoff/measured_speed_accuracy.png\" alt=\"speed against accuracy (measured)\"><img src=\"tradeoff/error_vs_n.png\" alt=\"error against n\">")?;
+    writeln!(
+        w,
+        "<h2>Error against hardware cost</h2><p>Each fixed-point datapath of the trade-off (plain k = 4 at 8, 12 and 16 fraction bits; minimax k = 3..6) by its lobe error in lsb8 against the calibrated analytic cost on each target (<a href=\"tradeoff/tradeoff.csv\">tradeoff.csv</a>; the model and its calibration error: <code>docs/cost.md</code>).</p><img src=\"tradeoff/error_vs_luts_ice40.png\" alt=\"error against iCE40 LUTs\"><img src=\"tradeoff/error_vs_dsps_ice40.png\" alt=\"error against iCE40 DSPs\"><img src=\"tradeoff/error_vs_luts_xilinx.png\" alt=\"error against Xilinx LUTs\"><img src=\"tradeoff/error_vs_latency.png\" alt=\"error against latency\">"
+    )?;
+    writeln!(
+        w,
+        "<h2>Speed against accuracy</h2><p>Software speed is measured in this run on this machine (one core), so the chart and <a href=\"tradeoff/measured_speed.csv\">measured_speed.csv</a> differ from run to run; every other file of the report is the same on every run.</p><img src=\"tradeoff/measured_speed_accuracy.png\" alt=\"speed against accuracy (measured)\"><img src=\"tradeoff/error_vs_n.png\" alt=\"error against n\">"
+    )?;
     writeln!(
         w,
         "<div class=\"table\"><table><tr><th>method</th><th>max |err|</th><th>mean |err|</th></tr>"
@@ -269,21 +316,46 @@ pub fn write_index(
         .filter(|(_, passes)| *passes)
         .map(|(path, _)| path.as_str())
         .collect();
-    writeln!(w, "<h2>Where the methods fail</h2><p>{} paths mapped over n = {} and theta in [0, 90] degrees against a tolerance of {}; {} stay within it everywhere ({}). Failure regions, special inputs (NaN, infinities, cosines just outside [0, 1]) and one heat map per path: <a href=\"stability/stability.html\">stability/stability.html</a> (also .md, .json, regions.csv).</p><img src=\"stability/overview.png\" alt=\"where each path passes or fails\">",
-        stability.paths.len(), stability.n, stability.tol, passing.len(), passing.join(", "))?;
+    writeln!(
+        w,
+        "<h2>Where the methods fail</h2><p>{} paths mapped over n = {} and theta in [0, 90] degrees against a tolerance of {}; {} stay within it everywhere ({}). Failure regions, special inputs (NaN, infinities, cosines just outside [0, 1]) and one heat map per path: <a href=\"stability/stability.html\">stability/stability.html</a> (also .md, .json, regions.csv).</p><img src=\"stability/overview.png\" alt=\"where each path passes or fails\">",
+        stability.paths.len(),
+        stability.n,
+        stability.tol,
+        passing.len(),
+        passing.join(", ")
+    )?;
     if let Some(all) = render.iter().find(|r| r.material == "all") {
-        writeln!(w, "<h2>The datapath in an image</h2><p>The built-in scene (cells, a vessel, a bone-like ring; n = 16 to 1024) rendered with the baseline datapath's specular lobe: at most {} display LSBs from f64 cos^n ({:.2}% of covered pixels differ, FLIP mean {:.4}), at most {} from the f64 model of its own algorithm (the quantization alone). Per material: <a href=\"render/render.md\">render/render.md</a>.</p><img src=\"render/datapath.png\" alt=\"the scene through the datapath\"><img src=\"render/diff_vs_cos_n.png\" alt=\"difference from cos^n in display LSBs\">",
-            all.total.max_lsb, 100.0 * all.total.differing, all.total.flip_mean, all.quant.max_lsb)?;
+        writeln!(
+            w,
+            "<h2>The datapath in an image</h2><p>The built-in scene (cells, a vessel, a bone-like ring; n = 16 to 1024) rendered with the baseline datapath's specular lobe: at most {} display LSBs from f64 cos^n ({:.2}% of covered pixels differ, FLIP mean {:.4}), at most {} from the f64 model of its own algorithm (the quantization alone). Per material: <a href=\"render/render.md\">render/render.md</a>.</p><img src=\"render/datapath.png\" alt=\"the scene through the datapath\"><img src=\"render/diff_vs_cos_n.png\" alt=\"difference from cos^n in display LSBs\">",
+            all.total.max_lsb,
+            100.0 * all.total.differing,
+            all.total.flip_mean,
+            all.quant.max_lsb
+        )?;
     }
     let (g, f) = (&fit.generic_cost, &fit.fitted_cost);
     let yosys = match (g.yosys_total_luts, f.yosys_total_luts) {
         (Some(a), Some(b)) => format!(", yosys {b} LUTs against {a}"),
         _ => String::new(),
     };
-    writeln!(w, "<h2>No more than the scene needs</h2><p><code>specfx fit</code> on the built-in scene, with the default budget (every material no worse than the generic baseline renders it, against f64 cos^n): the fitted datapath serves only the scene's exponents ({} entries in its constant ROM, against {}) and costs {} analytic {} LUTs with its ROM against {} for the generic n = 16..1024 datapath{}; proved on all {} inputs the scene produces. Configuration <a href=\"fit/fitted.toml\">fit/fitted.toml</a>, report <a href=\"fit/fit.md\">fit/fit.md</a>.</p><img src=\"fit/fitted.png\" alt=\"the scene through the fitted datapath\"><img src=\"fit/diff_fitted_vs_generic.png\" alt=\"fitted against generic, display LSBs\">",
-        f.rom_entries, g.rom_entries, f.analytic_total_luts, fit.target, g.analytic_total_luts, yosys, fit.inputs)?;
+    writeln!(
+        w,
+        "<h2>No more than the scene needs</h2><p><code>specfx fit</code> on the built-in scene, with the default budget (every material no worse than the generic baseline renders it, against f64 cos^n): the fitted datapath serves only the scene's exponents ({} entries in its constant ROM, against {}) and costs {} analytic {} LUTs with its ROM against {} for the generic n = 16..1024 datapath{}; proved on all {} inputs the scene produces. Configuration <a href=\"fit/fitted.toml\">fit/fitted.toml</a>, report <a href=\"fit/fit.md\">fit/fit.md</a>.</p><img src=\"fit/fitted.png\" alt=\"the scene through the fitted datapath\"><img src=\"fit/diff_fitted_vs_generic.png\" alt=\"fitted against generic, display LSBs\">",
+        f.rom_entries,
+        g.rom_entries,
+        f.analytic_total_luts,
+        fit.target,
+        g.analytic_total_luts,
+        yosys,
+        fit.inputs
+    )?;
     let flagged: usize = furnace.summary().iter().map(|s| s.n_flagged_values).sum();
-    writeln!(w, "<h2>Energy conservation</h2><p>The white furnace: the reflectance of each of the six normalised forms against incident angle, for f64 cos^n, the f64 lobe with the paper's and with the exact coefficient, and the bit-accurate datapath; {flagged} values above 1 are flagged (see <a href=\"furnace/furnace.md\">furnace/furnace.md</a>: the paper's coefficients overshoot slightly, the microfacet forms gain energy near grazing without a masking term).</p><img src=\"furnace/furnace_phong.png\" alt=\"white furnace, Phong\">")?;
+    writeln!(
+        w,
+        "<h2>Energy conservation</h2><p>The white furnace: the reflectance of each of the six normalised forms against incident angle, for f64 cos^n, the f64 lobe with the paper's and with the exact coefficient, and the bit-accurate datapath; {flagged} values above 1 are flagged (see <a href=\"furnace/furnace.md\">furnace/furnace.md</a>: the paper's coefficients overshoot slightly, the microfacet forms gain energy near grazing without a masking term).</p><img src=\"furnace/furnace_phong.png\" alt=\"white furnace, Phong\">"
+    )?;
     writeln!(w, "<h2>Every file</h2><ul>")?;
     for r in files {
         writeln!(w, "<li><a href=\"{r}\">{r}</a></li>")?;
@@ -390,7 +462,12 @@ pub fn write_summary(
         writeln!(
             out,
             "  cycle model {}: latency {}..{} cycles (nominal {}), {:.3} results/cycle under 10% bubbles and stalls, {} mismatches",
-            st.arch, st.latency_min, st.latency_max, st.latency_nominal, st.throughput, st.mismatches
+            st.arch,
+            st.latency_min,
+            st.latency_max,
+            st.latency_nominal,
+            st.throughput,
+            st.mismatches
         )?;
     }
     for c in costs {

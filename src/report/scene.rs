@@ -168,7 +168,9 @@ pub struct MaterialRow {
 
 /// What the table's figures mean, after it.
 fn table_legend(bits: u32) -> String {
-    format!("Errors are in display LSBs of the {bits}-bit sRGB image (the largest channel difference of a pixel); \"differing\" is the share of the material's pixels where any channel differs; FLIP is the mean of NVIDIA's FLIP (LDR, 67 pixels per degree) over the material's pixels.")
+    format!(
+        "Errors are in display LSBs of the {bits}-bit sRGB image (the largest channel difference of a pixel); \"differing\" is the share of the material's pixels where any channel differs; FLIP is the mean of NVIDIA's FLIP (LDR, 67 pixels per degree) over the material's pixels."
+    )
 }
 
 /// Writes the table for the terminal, fitted into `width` characters (`None`: as wide as its

@@ -595,7 +595,10 @@ mod tests {
         bin.extend_from_slice(&2u32.to_le_bytes());
         bin.extend_from_slice(&[0u8; 60]);
         let e = err(&bin, MeshFormat::Stl);
-        assert_eq!(e, "m: binary STL: its header says 2 triangles, which take 184 bytes, but the file has 144");
+        assert_eq!(
+            e,
+            "m: binary STL: its header says 2 triangles, which take 184 bytes, but the file has 144"
+        );
         assert!(err(&bin[..50], MeshFormat::Stl).contains("got 50 bytes"));
         // Its header starting with `solid ` and its size wrong: the size is what is said.
         let mut solid_bin = bin.clone();

@@ -112,7 +112,7 @@ impl ObjectFile {
                         "expected sphere, capsule, torus or mesh, got '{}'",
                         other.escape_debug()
                     ),
-                })
+                });
             }
         };
         if let Some(extra) = present.iter().find(|k| !wants.contains(k)) {

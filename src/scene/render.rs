@@ -321,7 +321,7 @@ impl<'a> ModelLobe<'a> {
 }
 
 /// The f64 cos^n lobe of a scene's materials, with the classic coefficient of `form`.
-pub fn cos_n_lobe(scene: &Scene, form: Form) -> impl Fn(usize, f64) -> f64 + Sync {
+pub fn cos_n_lobe(scene: &Scene, form: Form) -> impl Fn(usize, f64) -> f64 + Sync + use<> {
     let per_material: Vec<(f64, f64)> = scene
         .materials
         .iter()

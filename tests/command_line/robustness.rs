@@ -74,7 +74,13 @@ const CASES: &[Case] = &[
         expect: "name: expected 1..=64 ASCII letters",
     },
     Case {
-        args: &["stability", "--config", "{dir}/c.toml", "--out", "{dir}/out"],
+        args: &[
+            "stability",
+            "--config",
+            "{dir}/c.toml",
+            "--out",
+            "{dir}/out",
+        ],
         inputs: &[Input::File("c.toml", "name = \"x/y\"\n")],
         expect: "'/' is not allowed",
     },
@@ -95,17 +101,35 @@ const CASES: &[Case] = &[
     },
     // Budgets that cannot mean anything.
     Case {
-        args: &["optimize", "--budget", "shape_total <= NaN", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total <= NaN",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "the limit must be a finite number >= 0",
     },
     Case {
-        args: &["optimize", "--budget", "shape_total <= -1 lsb8", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total <= -1 lsb8",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "the limit must be a finite number >= 0",
     },
     Case {
-        args: &["optimize", "--budget", "correct >= 150%", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "correct >= 150%",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "at most 100%",
     },
@@ -115,12 +139,24 @@ const CASES: &[Case] = &[
         expect: "the limit must be a finite number >= 0",
     },
     Case {
-        args: &["optimize", "--budget", "effective_bits >= 65", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "effective_bits >= 65",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "effective bits are at most 64",
     },
     Case {
-        args: &["optimize", "--budget", "shape_total <= 1 lsb999", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total <= 1 lsb999",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "lsbN needs a number N in 1..=64",
     },
@@ -162,12 +198,20 @@ const CASES: &[Case] = &[
         expect: "at most 67108864 in all",
     },
     Case {
-        args: &["vectors", "--cases", "random:1000000000000", "--out", "{dir}/v"],
+        args: &[
+            "vectors",
+            "--cases",
+            "random:1000000000000",
+            "--out",
+            "{dir}/v",
+        ],
         inputs: &[],
         expect: "at most 67108864 in all",
     },
     Case {
-        args: &["cosim", "--bubble", "0.9999", "--sim", "icarus", "--cases", "corner"],
+        args: &[
+            "cosim", "--bubble", "0.9999", "--sim", "icarus", "--cases", "corner",
+        ],
         inputs: &[],
         expect: "the stimulus is limited to 67108864 cycles",
     },
@@ -188,7 +232,16 @@ const CASES: &[Case] = &[
         expect: "expected numbers of squarings k in 1..=7",
     },
     Case {
-        args: &["hdl", "stimulus", "--vectors", "{dir}", "--bubble", "1", "--out", "{dir}/s"],
+        args: &[
+            "hdl",
+            "stimulus",
+            "--vectors",
+            "{dir}",
+            "--bubble",
+            "1",
+            "--out",
+            "{dir}/s",
+        ],
         inputs: &[],
         expect: "expected a probability in [0, 1)",
     },
@@ -205,7 +258,10 @@ const CASES: &[Case] = &[
     },
     Case {
         args: &["trace", "compare", "{dir}/a.vcd", "{dir}/fifo.vcd"],
-        inputs: &[Input::File("a.vcd", "$enddefinitions $end\n"), Input::Fifo("fifo.vcd")],
+        inputs: &[
+            Input::File("a.vcd", "$enddefinitions $end\n"),
+            Input::Fifo("fifo.vcd"),
+        ],
         expect: "expected a regular file, got a FIFO",
     },
     Case {
@@ -335,7 +391,10 @@ const CASES: &[Case] = &[
     },
     Case {
         args: &["check", "--config", "{dir}/c.toml"],
-        inputs: &[Input::File("c.toml", "name = \"xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx\"\n")],
+        inputs: &[Input::File(
+            "c.toml",
+            "name = \"xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx\"\n",
+        )],
         expect: "65 characters",
     },
     Case {
@@ -484,7 +543,14 @@ const CASES: &[Case] = &[
         expect: "/s: is inside the input --vectors directory",
     },
     Case {
-        args: &["hdl", "stimulus", "--vectors", "{dir}/v", "--out", "{dir}/s"],
+        args: &[
+            "hdl",
+            "stimulus",
+            "--vectors",
+            "{dir}/v",
+            "--out",
+            "{dir}/s",
+        ],
         inputs: &[Input::File("v/readme.txt", "not vectors")],
         expect: "/v: no manifest.json",
     },
@@ -494,7 +560,15 @@ const CASES: &[Case] = &[
         expect: "a.vcd",
     },
     Case {
-        args: &["coef", "--form", "cook_torrance", "--source", "exact", "--n", "16"],
+        args: &[
+            "coef",
+            "--form",
+            "cook_torrance",
+            "--source",
+            "exact",
+            "--n",
+            "16",
+        ],
         inputs: &[],
         expect: "cook_torrance",
     },
@@ -504,37 +578,79 @@ const CASES: &[Case] = &[
         expect: "oracle",
     },
     Case {
-        args: &["optimize", "--budget", "shape_total < 1 lsb8", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total < 1 lsb8",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "budget",
     },
     Case {
-        args: &["optimize", "--budget", "correct <= 99%", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "correct <= 99%",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "budget",
     },
     Case {
-        args: &["optimize", "--budget", "shape_total <= 1 parsecs", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total <= 1 parsecs",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "budget",
     },
     Case {
-        args: &["optimize", "--budget", "luts <= 8 on fpga", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "luts <= 8 on fpga",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "budget",
     },
     Case {
-        args: &["optimize", "--budget", "out <= 1 lsb8", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "out <= 1 lsb8",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "budget",
     },
     Case {
-        args: &["optimize", "--budget", "shape_total <= lsb8", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total <= lsb8",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "budget",
     },
     Case {
-        args: &["optimize", "--budget", "shape_total <= 1 lsb8,", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total <= 1 lsb8,",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "budget",
     },
@@ -555,12 +671,18 @@ const CASES: &[Case] = &[
     },
     Case {
         args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
-        inputs: &[Input::File("s.toml", "target = \"asic\"\n[vary]\nk = [4]\n")],
+        inputs: &[Input::File(
+            "s.toml",
+            "target = \"asic\"\n[vary]\nk = [4]\n",
+        )],
         expect: "target",
     },
     Case {
         args: &["sweep", "--space", "{dir}/s.toml", "--out", "{dir}/sw"],
-        inputs: &[Input::File("s.toml", "[vary]\n\"square.frac\" = \"a..=b\"\n")],
+        inputs: &[Input::File(
+            "s.toml",
+            "[vary]\n\"square.frac\" = \"a..=b\"\n",
+        )],
         expect: "vary.square.frac",
     },
     Case {
@@ -570,22 +692,34 @@ const CASES: &[Case] = &[
     },
     Case {
         args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
-        inputs: &[Input::File("sc.toml", "[image]\nwidth = 0\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n")],
+        inputs: &[Input::File(
+            "sc.toml",
+            "[image]\nwidth = 0\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n",
+        )],
         expect: "width",
     },
     Case {
         args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
-        inputs: &[Input::File("sc.toml", "[image]\nwidth = 100000\nheight = 100000\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n")],
+        inputs: &[Input::File(
+            "sc.toml",
+            "[image]\nwidth = 100000\nheight = 100000\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n",
+        )],
         expect: "image",
     },
     Case {
         args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
-        inputs: &[Input::File("sc.toml", "[image]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 0\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n")],
+        inputs: &[Input::File(
+            "sc.toml",
+            "[image]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 0\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n",
+        )],
         expect: "n",
     },
     Case {
         args: &["render", "--scene", "{dir}/sc.toml", "--out", "{dir}/r"],
-        inputs: &[Input::File("sc.toml", "[image]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n\n[[object]]\nkind = \"mesh\"\nmaterial = \"a\"\nfile = \"missing.obj\"\n")],
+        inputs: &[Input::File(
+            "sc.toml",
+            "[image]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0.0, 0.3, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_deg = 36.0\n\n[[light]]\nkind = \"directional\"\ndirection = [-0.5, 0.6, 0.7]\nintensity = 1.5\n\n[[material]]\nname = \"a\"\nn = 64\nk_s = 0.05\nk_d = 0.8\ncolour = [0.85, 0.5, 0.6]\n\n[[object]]\nkind = \"mesh\"\nmaterial = \"a\"\nfile = \"missing.obj\"\n",
+        )],
         expect: "missing.obj",
     },
     Case {
@@ -611,7 +745,16 @@ const CASES: &[Case] = &[
         expect: "--out /dev/null: is not a regular file",
     },
     Case {
-        args: &["vectors", "--n", "16", "--cases", "corner", "--out", "{dir}/vz/..", "--force"],
+        args: &[
+            "vectors",
+            "--n",
+            "16",
+            "--cases",
+            "corner",
+            "--out",
+            "{dir}/vz/..",
+            "--force",
+        ],
         inputs: &[],
         expect: "expected a directory name",
     },
@@ -620,12 +763,23 @@ const CASES: &[Case] = &[
         args: &["render", "--scene", "{dir}/s.toml", "--out", "{dir}/r"],
         inputs: &[Input::File(
             "s.toml",
-            scene!("width = 8192\nheight = 8192", "[[light]]\nkind = \"directional\"\ndirection = [0.0, 1.0, 1.0]\n"),
+            scene!(
+                "width = 8192\nheight = 8192",
+                "[[light]]\nkind = \"directional\"\ndirection = [0.0, 1.0, 1.0]\n"
+            ),
         )],
         expect: "light: 8192 x 8192 pixels x 2 lights is 134217728, above the limit of 67108864",
     },
     Case {
-        args: &["stability", "--n", "1..=65535", "--c-bits", "24", "--out", "{dir}/st"],
+        args: &[
+            "stability",
+            "--n",
+            "1..=65535",
+            "--c-bits",
+            "24",
+            "--out",
+            "{dir}/st",
+        ],
         inputs: &[],
         expect: "samples, above the limit of 2^34 = 17179869184",
     },
@@ -644,7 +798,10 @@ const CASES: &[Case] = &[
         inputs: &[
             Input::File(
                 "s.toml",
-                scene!("width = 4\nheight = 4", "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m.obj\"\n"),
+                scene!(
+                    "width = 4\nheight = 4",
+                    "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m.obj\"\n"
+                ),
             ),
             Input::File("m.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n"),
         ],
@@ -655,9 +812,15 @@ const CASES: &[Case] = &[
         inputs: &[
             Input::File(
                 "s.toml",
-                scene!("width = 4\nheight = 4", "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m.stl\"\n"),
+                scene!(
+                    "width = 4\nheight = 4",
+                    "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m.stl\"\n"
+                ),
             ),
-            Input::File("m.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"),
+            Input::File(
+                "m.stl",
+                "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n",
+            ),
         ],
         expect: "(m.stl): line 4: the ASCII STL ends before `endsolid` (expected vertex x y z)",
     },
@@ -666,7 +829,12 @@ const CASES: &[Case] = &[
         args: &["trace", "compare", "{dir}/a.vcd", "{dir}/deep.vcd"],
         inputs: &[
             Input::File("a.vcd", trace!("#5 1!\n")),
-            Input::Repeated("deep.vcd", "$scope module tb_specfx $end\n", "$scope module a $end\n", 30_000),
+            Input::Repeated(
+                "deep.vcd",
+                "$scope module tb_specfx $end\n",
+                "$scope module a $end\n",
+                30_000,
+            ),
         ],
         expect: "deep.vcd: line 257: $scope nested deeper than 256",
     },
@@ -709,7 +877,13 @@ const CASES: &[Case] = &[
         expect: "config {dir}/c.toml: a symbolic link to gone.toml, which cannot be read",
     },
     Case {
-        args: &["budget", "--budget", "shape_total <= 1 lsb8 and", "--out", "{dir}/b"],
+        args: &[
+            "budget",
+            "--budget",
+            "shape_total <= 1 lsb8 and",
+            "--out",
+            "{dir}/b",
+        ],
         inputs: &[],
         expect: "an empty bound (',' or 'and' with nothing before or after it)",
     },
@@ -766,12 +940,26 @@ const CASES: &[Case] = &[
         expect: "config {dir}/x.json: a JSON file, expected a TOML configuration",
     },
     Case {
-        args: &["hdl", "stimulus", "--vectors", "{dir}/nosuch", "--out", "{dir}/st"],
+        args: &[
+            "hdl",
+            "stimulus",
+            "--vectors",
+            "{dir}/nosuch",
+            "--out",
+            "{dir}/st",
+        ],
         inputs: &[],
         expect: "{dir}/nosuch: no such file or directory, expected a vector directory",
     },
     Case {
-        args: &["hdl", "stimulus", "--vectors", "{dir}/loop", "--out", "{dir}/st"],
+        args: &[
+            "hdl",
+            "stimulus",
+            "--vectors",
+            "{dir}/loop",
+            "--out",
+            "{dir}/st",
+        ],
         inputs: &[Input::Symlink("loop", "loop")],
         expect: "{dir}/loop: Too many levels of symbolic links",
     },
@@ -853,23 +1041,45 @@ const CASES: &[Case] = &[
         expect: "with --vcd, the trace is limited to 131072 cycles",
     },
     Case {
-        args: &["render", "--scene", "{dir}/s.toml", "--out", "{dir}/m", "--force"],
+        args: &[
+            "render",
+            "--scene",
+            "{dir}/s.toml",
+            "--out",
+            "{dir}/m",
+            "--force",
+        ],
         inputs: &[
             Input::File(
                 "s.toml",
-                scene!("width = 4\nheight = 4", "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m/ok.obj\"\n"),
+                scene!(
+                    "width = 4\nheight = 4",
+                    "[[object]]\nkind = \"mesh\"\nmaterial = \"m\"\nfile = \"m/ok.obj\"\n"
+                ),
             ),
             Input::File("m/ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
         ],
         expect: "would replace the directory that holds the input a mesh of --scene",
     },
     Case {
-        args: &["optimize", "--budget", "shape_total <= 1 lsb8 shape_quant <= 1", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total <= 1 lsb8 shape_quant <= 1",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "two bounds need ',' or 'and' between them",
     },
     Case {
-        args: &["optimize", "--budget", "dsps <= 1.5 on ice40", "--out", "{dir}/o.toml"],
+        args: &[
+            "optimize",
+            "--budget",
+            "dsps <= 1.5 on ice40",
+            "--out",
+            "{dir}/o.toml",
+        ],
         inputs: &[],
         expect: "a count of cells is a whole number",
     },
@@ -885,7 +1095,10 @@ const CASES: &[Case] = &[
     },
     Case {
         args: &["sweep", "--space", "{dir}/sp.toml", "--out", "{dir}/sw"],
-        inputs: &[Input::File("sp.toml", "[base]\nname = \"a b\"\n[vary]\nk = [3]\n")],
+        inputs: &[Input::File(
+            "sp.toml",
+            "[base]\nname = \"a b\"\n[vary]\nk = [3]\n",
+        )],
         expect: "base.name: expected 1..=64 ASCII letters",
     },
     // A negative number reaches the option's own check (clap took it for an option).

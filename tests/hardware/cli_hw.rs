@@ -188,7 +188,10 @@ fn a_repeated_synthesis_comes_from_the_cache_and_only_for_the_same_inputs() {
     // A small datapath (8-bit stages, four exponents): the cache does not depend on size,
     // and each synthesis and place and route of it takes seconds.
     let small = "n = \"16..=19\"\n[c]\nformat = \"u1.7\"\n[d]\nformat = \"s1.7\"\n[t]\nformat = \"s1.7\"\n[b]\nformat = \"u1.7\"\n[square]\nformat = \"u1.7\"\n[coef]\nformat = \"u4.4\"\n";
-    let (tiny, narrow) = (root.path().join("tiny.toml"), root.path().join("narrow.toml"));
+    let (tiny, narrow) = (
+        root.path().join("tiny.toml"),
+        root.path().join("narrow.toml"),
+    );
     std::fs::write(&tiny, format!("{small}[out]\nformat = \"u1.7\"\n")).unwrap();
     std::fs::write(&narrow, format!("{small}[out]\nformat = \"u1.6\"\n")).unwrap();
     let tiny = tiny.to_str().unwrap();

@@ -368,7 +368,11 @@ fn check_coverage(config: &str, dir: &Path, m: &Value, printed: &str) {
         cov["n_with_nonzero"],
         per_n.values().filter(|&&x| x).count() as u64
     );
-    let without: Vec<i64> = per_n.iter().filter(|(_, &x)| !x).map(|(&n, _)| n).collect();
+    let without: Vec<i64> = per_n
+        .iter()
+        .filter(|&(_, &x)| !x)
+        .map(|(&n, _)| n)
+        .collect();
     assert_eq!(cov["n_without_nonzero"], serde_json::json!(without));
     let one = dp.one_code();
     assert_eq!(

@@ -199,7 +199,7 @@ fn a_wholly_visible_cs_lobe_reflects_cos_theta_or_one() {
     // since ∫ L(R.w) w dw is parallel to R. With the exact coefficient rho(0) = 1; with the
     // paper's 1.063 n/(2 pi) and Int = 16/(17 n), rho(0) = 1.063 * 16/17.
     let r = baseline_report(&[256], &default_angles());
-    for (i, &deg) in r.angles_deg.iter().enumerate().filter(|(_, &d)| d <= 65.0) {
+    for (i, &deg) in r.angles_deg.iter().enumerate().filter(|&(_, &d)| d <= 65.0) {
         let cos = deg.to_radians().cos();
         let exact = curve(&r, Form::Phong, 256, FurnacePath::F64CsMExact).rho[i];
         assert!((exact - 1.0).abs() < 1e-10, "{deg}: {exact}");

@@ -91,7 +91,10 @@ fn oracle_image(f: &Fragments, lobe: &dyn Fn(usize, f64) -> f64) -> Vec<[u16; 3]
 
 /// The datapath's lobe by the plain transcription `Datapath::eval`, one input at a time: the
 /// cosine rounded to the nearest input code (c <= 1, so at most the code of 1.0).
-fn oracle_datapath<'a>(dp: &'a Datapath, scene: &Scene) -> impl Fn(usize, f64) -> f64 + 'a {
+fn oracle_datapath<'a>(
+    dp: &'a Datapath,
+    scene: &Scene,
+) -> impl Fn(usize, f64) -> f64 + 'a + use<'a> {
     let ns: Vec<u32> = scene.materials.iter().map(|m| m.n).collect();
     move |m, c| {
         let cfg = dp.config();

@@ -361,14 +361,15 @@ pub(super) fn representable(
     for &n in ns {
         let mut cfg = config.clone();
         cfg.n = NSet::range(n, n)?;
-        if let Err(e) = Datapath::new(cfg) {
-            let text = e.to_string();
-            if !text.contains(&format!("n = {n}")) {
-                return Err(e);
+        match Datapath::new(cfg) {
+            Ok(_) => good.push(n),
+            Err(e) => {
+                let text = e.to_string();
+                if !text.contains(&format!("n = {n}")) {
+                    return Err(e);
+                }
+                reason.get_or_insert(text);
             }
-            reason.get_or_insert(text);
-        } else {
-            good.push(n);
         }
     }
     if good.is_empty() {

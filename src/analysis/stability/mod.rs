@@ -173,11 +173,17 @@ impl Kind {
         match self {
             Kind::Over => "the lobe is above cos^n by more than the tolerance",
             Kind::Under => "the lobe is below cos^n by more than the tolerance",
-            Kind::NegativeBase => "the base is negative and the cutoff lets it through: an even power makes a spurious lobe past the zero of the base",
-            Kind::NBelowM => "n < m: the base never reaches zero in the hemisphere, so the lobe does not close at the horizon",
+            Kind::NegativeBase => {
+                "the base is negative and the cutoff lets it through: an even power makes a spurious lobe past the zero of the base"
+            }
+            Kind::NBelowM => {
+                "n < m: the base never reaches zero in the hemisphere, so the lobe does not close at the horizon"
+            }
             Kind::Wrap => "a fixed-point stage wrapped around",
             Kind::Saturate => "a fixed-point stage saturated",
-            Kind::Underflow => "the lobe is flushed to zero (below the smallest normal float, or below half an LSB) while its value is positive: relative error 100%",
+            Kind::Underflow => {
+                "the lobe is flushed to zero (below the smallest normal float, or below half an LSB) while its value is positive: relative error 100%"
+            }
             Kind::NonMonotonic => "the lobe decreases as c increases",
             Kind::NonFinite => "the lobe is NaN or infinite",
             Kind::Unrepresentable => "the datapath cannot hold this n's constants",
