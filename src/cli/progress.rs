@@ -291,6 +291,60 @@ fn human(d: Duration, fine: bool) -> String {
     }
 }
 
+/// A command's steps (the report's): a line each on stderr, a bar over them on a terminal (a
+/// line every tenth elsewhere), and with `-v` how long each took.
+pub struct Steps {
+    label: &'static str,
+    bar: Progress,
+    current: Option<(String, std::time::Instant)>,
+}
+
+impl Steps {
+    /// Starts showing `count` steps of `label` (`specfx report`).
+    pub fn new(label: &'static str, count: u64) -> Steps {
+        Steps {
+            label,
+            bar: Progress::new(label.trim_start_matches("specfx "), "steps", count),
+            current: None,
+        }
+    }
+
+    /// Ends the step under way and starts the next, logged at `level`.
+    pub fn start_at(&mut self, level: log::Level, msg: &str) {
+        self.end_current();
+        log::log!(level, "{}: {msg}", self.label);
+        self.bar.set_message(msg.to_string());
+        self.current = Some((msg.to_string(), std::time::Instant::now()));
+    }
+
+    /// Ends the step under way and starts the next.
+    pub fn start(&mut self, msg: &str) {
+        self.start_at(log::Level::Info, msg);
+    }
+
+    /// A part of the step under way, logged and shown but not counted.
+    pub fn part(&self, msg: &str) {
+        log::info!("{}: {msg}", self.label);
+        self.bar.set_message(msg.to_string());
+    }
+
+    fn end_current(&mut self) {
+        if let Some((msg, start)) = self.current.take() {
+            log::debug!(
+                "{}: {:.3}s for: {msg}",
+                self.label,
+                start.elapsed().as_secs_f64()
+            );
+            self.bar.inc(1);
+        }
+    }
+
+    pub fn finish(mut self) {
+        self.end_current();
+        self.bar.finish();
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

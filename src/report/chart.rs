@@ -769,359 +769,434 @@ pub fn draw_chart<DB: DrawingBackend>(
     chart: &Chart,
     compact: bool,
 ) -> Result<(), Error> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| render_error(e.to_string());
-    let sz = if compact {
-        Sizes {
-            title: 15,
-            label: 12,
-            desc: 12,
-            margin: 8.0,
-            line: 2,
-            marker: 3,
-        }
-    } else {
-        Sizes {
-            title: 20,
-            label: 14,
-            desc: 16,
-            margin: 16.0,
-            line: 2,
-            marker: 4,
-        }
-    };
-    let (w, h) = area.dim_in_pixel();
-    let (w, h) = (f64::from(w), f64::from(h));
-    let text_w = |s: &str, size: u32| {
-        area.estimate_text_size(s, &font(size))
-            .map_or(0.0, |(tw, _)| f64::from(tw))
-    };
+    Painter::new(area, chart, compact)
+        .draw()
+        .map_err(|e| render_error(e.to_string()))
+}
 
-    // The axes: every point, the reference lines, and the bars' edges and base.
-    let mut xs = Vec::new();
-    let mut ys = Vec::new();
-    for s in &chart.series {
-        for &(x, y) in &s.points {
-            match s.bar_width {
-                Some(bw) => xs.extend([x - 0.5 * bw, x + 0.5 * bw]),
-                None => xs.push(x),
+/// A chart laid out in its drawing area, drawn in layers by [`Painter::draw`].
+struct Painter<'a, DB: DrawingBackend> {
+    area: &'a DrawingArea<DB, Shift>,
+    chart: &'a Chart,
+    compact: bool,
+    sz: Sizes,
+    w: f64,
+    h: f64,
+    styles: Vec<(Dash, Marker)>,
+    /// The series with a label.
+    labelled: Vec<usize>,
+    /// The width of the direct labels' gutter on the right (0 without one).
+    gutter: f64,
+    title_size: u32,
+    frame: Frame,
+}
+
+impl<'a, DB: DrawingBackend> Painter<'a, DB> {
+    /// The layout: the axes over every point, the reference lines and the bars' edges and
+    /// base; the title, y tick labels and description on the left, x below, direct labels in
+    /// a gutter on the right.
+    fn new(area: &'a DrawingArea<DB, Shift>, chart: &'a Chart, compact: bool) -> Self {
+        let sz = if compact {
+            Sizes {
+                title: 15,
+                label: 12,
+                desc: 12,
+                margin: 8.0,
+                line: 2,
+                marker: 3,
             }
-            ys.push(y);
+        } else {
+            Sizes {
+                title: 20,
+                label: 14,
+                desc: 16,
+                margin: 16.0,
+                line: 2,
+                marker: 4,
+            }
+        };
+        let (w, h) = area.dim_in_pixel();
+        let (w, h) = (f64::from(w), f64::from(h));
+        let text_w = |s: &str, size: u32| text_width(area, s, size);
+        let mut xs = Vec::new();
+        let mut ys = Vec::new();
+        for s in &chart.series {
+            for &(x, y) in &s.points {
+                match s.bar_width {
+                    Some(bw) => xs.extend([x - 0.5 * bw, x + 0.5 * bw]),
+                    None => xs.push(x),
+                }
+                ys.push(y);
+            }
+            if s.bar_width.is_some() && !chart.log_y {
+                ys.push(0.0);
+            }
         }
-        if s.bar_width.is_some() && !chart.log_y {
-            ys.push(0.0);
-        }
-    }
-    ys.extend(chart.ref_lines.iter().map(|r| r.at));
-    xs.extend(chart.x_ref_lines.iter().map(|r| r.at));
-    let x = Axis::new(&xs, chart.log_x, chart.x_integer);
-    let y = Axis::new(&ys, chart.log_y, chart.y_integer);
+        ys.extend(chart.ref_lines.iter().map(|r| r.at));
+        xs.extend(chart.x_ref_lines.iter().map(|r| r.at));
+        let x = Axis::new(&xs, chart.log_x, chart.x_integer);
+        let y = Axis::new(&ys, chart.log_y, chart.y_integer);
 
-    // The layout: title, y tick labels and description on the left, x below, direct labels
-    // in a gutter on the right.
-    let styles = distinct_styles(&chart.series);
-    let labelled: Vec<usize> = (0..chart.series.len())
-        .filter(|&i| !chart.series[i].label.is_empty())
-        .collect();
-    let gutter = if chart.direct_labels && !compact {
-        let widest = labelled
-            .iter()
-            .filter(|&&i| chart.series[i].line && chart.series[i].bar_width.is_none())
-            .map(|&i| text_w(&chart.series[i].label, sz.label))
-            .fold(0.0, f64::max);
-        if widest > 0.0 {
-            (widest + 44.0).min(0.4 * w)
+        let labelled: Vec<usize> = (0..chart.series.len())
+            .filter(|&i| !chart.series[i].label.is_empty())
+            .collect();
+        let gutter = if chart.direct_labels && !compact {
+            let widest = labelled
+                .iter()
+                .filter(|&&i| chart.series[i].line && chart.series[i].bar_width.is_none())
+                .map(|&i| text_w(&chart.series[i].label, sz.label))
+                .fold(0.0, f64::max);
+            if widest > 0.0 {
+                (widest + 44.0).min(0.4 * w)
+            } else {
+                0.0
+            }
         } else {
             0.0
-        }
-    } else {
-        0.0
-    };
-    let y_tick_w = y
-        .ticks
-        .iter()
-        .filter_map(|t| t.label.as_deref())
-        .map(|l| text_w(l, sz.label))
-        .fold(0.0, f64::max);
-    let title_size = {
-        let mut s = sz.title;
-        while s > 10 && text_w(&chart.title, s) > w - 2.0 * sz.margin {
-            s -= 1;
-        }
-        s
-    };
-    let top = sz.margin + f64::from(title_size) * 1.6;
-    let frame = Frame {
-        left: sz.margin + f64::from(sz.desc) * 1.5 + y_tick_w + 10.0,
-        right: w - sz.margin - gutter,
-        top,
-        bottom: h - sz.margin - f64::from(sz.label) * 1.4 - f64::from(sz.desc) * 1.5 - 6.0,
-        x,
-        y,
-    };
-    let (l, r, t, b) = (frame.left, frame.right, frame.top, frame.bottom);
-
-    area.fill(&WHITE).map_err(err)?;
-    area.draw(&Text::new(
-        chart.title.clone(),
-        ipt((0.5 * w, sz.margin)),
-        font(title_size).pos(Pos::new(HPos::Center, VPos::Top)),
-    ))
-    .map_err(err)?;
-
-    // The band of exact zeros, and the grid.
-    let grid = RGBColor(225, 225, 225);
-    let minor_grid = RGBColor(242, 242, 242);
-    let band = RGBColor(246, 246, 246);
-    if let Some((_, decades_lo)) = frame.y.zero {
-        let edge = frame.py(decades_lo);
-        area.draw(&Rectangle::new(
-            [ipt((l, edge)), ipt((r, b))],
-            band.filled(),
-        ))
-        .map_err(err)?;
-    }
-    if let Some((_, decades_lo)) = frame.x.zero {
-        let edge = frame.px(decades_lo);
-        area.draw(&Rectangle::new(
-            [ipt((l, t)), ipt((edge, b))],
-            band.filled(),
-        ))
-        .map_err(err)?;
-    }
-    for tick in &frame.x.ticks {
-        let px = frame.px(tick.at);
-        let c = if tick.label.is_some() {
-            grid
-        } else {
-            minor_grid
         };
-        area.draw(&PathElement::new(vec![ipt((px, t)), ipt((px, b))], c))
-            .map_err(err)?;
-    }
-    for tick in &frame.y.ticks {
-        let py = frame.py(tick.at);
-        let c = if tick.label.is_some() {
-            grid
-        } else {
-            minor_grid
+        let y_tick_w = y
+            .ticks
+            .iter()
+            .filter_map(|t| t.label.as_deref())
+            .map(|l| text_w(l, sz.label))
+            .fold(0.0, f64::max);
+        let title_size = {
+            let mut s = sz.title;
+            while s > 10 && text_w(&chart.title, s) > w - 2.0 * sz.margin {
+                s -= 1;
+            }
+            s
         };
-        area.draw(&PathElement::new(vec![ipt((l, py)), ipt((r, py))], c))
-            .map_err(err)?;
-    }
-
-    // Reference lines.
-    let ref_color = RGBColor(85, 85, 85);
-    for rl in &chart.x_ref_lines {
-        if let Some(at) = frame.x.map(rl.at) {
-            let px = frame.px(at);
-            draw_polyline(
-                area,
-                &[(px, t), (px, b)],
-                Dash::Dashed,
-                ref_color.stroke_width(1),
-            )
-            .map_err(err)?;
-            // Beside the line, on the side with room: left of a negative one, and left of
-            // any that would run past the frame.
-            let room = r - px > text_w(&rl.label, sz.label) + 8.0;
-            let (dx, h_pos) = if rl.at < 0.0 || !room {
-                (-4.0, HPos::Right)
-            } else {
-                (4.0, HPos::Left)
-            };
-            area.draw(&Text::new(
-                rl.label.clone(),
-                ipt((px + dx, t + 4.0)),
-                font(sz.label)
-                    .color(&ref_color)
-                    .pos(Pos::new(h_pos, VPos::Top)),
-            ))
-            .map_err(err)?;
-        }
-    }
-    for rl in &chart.ref_lines {
-        if let Some(at) = frame.y.map(rl.at) {
-            let py = frame.py(at);
-            draw_polyline(
-                area,
-                &[(l, py), (r, py)],
-                Dash::Dashed,
-                ref_color.stroke_width(1),
-            )
-            .map_err(err)?;
-            // The label at the right end, above the line, on a white patch.
-            let tw = text_w(&rl.label, sz.label);
-            let th = f64::from(sz.label);
-            area.draw(&Rectangle::new(
-                [
-                    ipt((r - tw - 10.0, py - th - 4.0)),
-                    ipt((r - 2.0, py - 2.0)),
-                ],
-                WHITE.filled(),
-            ))
-            .map_err(err)?;
-            area.draw(&Text::new(
-                rl.label.clone(),
-                ipt((r - 6.0, py - 3.0)),
-                font(sz.label)
-                    .color(&ref_color)
-                    .pos(Pos::new(HPos::Right, VPos::Bottom)),
-            ))
-            .map_err(err)?;
+        let top = sz.margin + f64::from(title_size) * 1.6;
+        let frame = Frame {
+            left: sz.margin + f64::from(sz.desc) * 1.5 + y_tick_w + 10.0,
+            right: w - sz.margin - gutter,
+            top,
+            bottom: h - sz.margin - f64::from(sz.label) * 1.4 - f64::from(sz.desc) * 1.5 - 6.0,
+            x,
+            y,
+        };
+        Painter {
+            area,
+            chart,
+            compact,
+            sz,
+            w,
+            h,
+            styles: distinct_styles(&chart.series),
+            labelled,
+            gutter,
+            title_size,
+            frame,
         }
     }
 
-    // The series: bars, then lines, then markers on top.
-    let mut hidden = 0usize;
-    let mut ends: Vec<(usize, (f64, f64))> = Vec::new();
-    let pixels: Vec<Vec<Option<(f64, f64)>>> = chart
-        .series
-        .iter()
-        .map(|s| s.points.iter().map(|&p| frame.pixel(p)).collect())
-        .collect();
-    for (s, px) in chart.series.iter().zip(&pixels) {
-        hidden += px.iter().filter(|p| p.is_none()).count();
-        if let Some(bw) = s.bar_width {
-            let c = RGBColor(s.color.0, s.color.1, s.color.2);
-            let base = frame.py(frame.y.base());
-            for &(x, y) in &s.points {
-                let (Some(x0), Some(x1), Some(y1)) = (
-                    frame.x.map(x - 0.5 * bw),
-                    frame.x.map(x + 0.5 * bw),
-                    frame.y.map(y),
-                ) else {
-                    continue;
-                };
-                let (x0, x1) = (frame.px(x0), frame.px(x1));
-                let y1 = frame.py(y1);
-                area.draw(&Rectangle::new(
-                    [ipt((x0, y1)), ipt((x1.max(x0 + 1.0), base))],
-                    c.filled(),
-                ))
-                .map_err(err)?;
-            }
-        }
-    }
-    for (i, (s, px)) in chart.series.iter().zip(&pixels).enumerate() {
-        if !s.line || s.bar_width.is_some() {
-            continue;
-        }
-        let c = RGBColor(s.color.0, s.color.1, s.color.2);
-        // A point the axes cannot show breaks the line.
-        for run in px.split(Option::is_none) {
-            let run: Vec<(f64, f64)> = run.iter().flatten().copied().collect();
-            draw_polyline(area, &run, styles[i].0, c.stroke_width(sz.line)).map_err(err)?;
-        }
-    }
-    for (i, (s, px)) in chart.series.iter().zip(&pixels).enumerate() {
-        if s.marked() {
-            let c = RGBColor(s.color.0, s.color.1, s.color.2);
-            for p in px.iter().flatten() {
-                draw_marker(area, *p, styles[i].1, sz.marker, c).map_err(err)?;
-            }
-        }
-        if let Some(end) = px.iter().rev().flatten().next() {
-            ends.push((i, *end));
-        }
+    fn text_w(&self, s: &str, size: u32) -> f64 {
+        text_width(self.area, s, size)
     }
 
-    // The frame, ticks and their labels, the axis descriptions.
-    area.draw(&Rectangle::new(
-        [ipt((l, t)), ipt((r, b))],
-        BLACK.stroke_width(1),
-    ))
-    .map_err(err)?;
-    if let Some((_, decades_lo)) = frame.y.zero {
-        let edge = frame.py(decades_lo);
-        for x0 in [l, r] {
-            area.draw(&PathElement::new(
-                vec![ipt((x0 - 5.0, edge + 3.0)), ipt((x0 + 5.0, edge - 3.0))],
-                BLACK,
-            ))
-            .map_err(err)?;
-        }
+    /// The frame's edges: left, right, top, bottom.
+    fn edges(&self) -> (f64, f64, f64, f64) {
+        let f = &self.frame;
+        (f.left, f.right, f.top, f.bottom)
     }
-    if let Some((_, decades_lo)) = frame.x.zero {
-        let edge = frame.px(decades_lo);
-        for y0 in [t, b] {
-            area.draw(&PathElement::new(
-                vec![ipt((edge - 3.0, y0 + 5.0)), ipt((edge + 3.0, y0 - 5.0))],
-                BLACK,
-            ))
-            .map_err(err)?;
-        }
-    }
-    for tick in &frame.x.ticks {
-        let px = frame.px(tick.at);
-        let len = if tick.label.is_some() { 5.0 } else { 3.0 };
-        area.draw(&PathElement::new(
-            vec![ipt((px, b)), ipt((px, b + len))],
-            BLACK,
-        ))
-        .map_err(err)?;
-        if let Some(label) = &tick.label {
-            area.draw(&Text::new(
-                label.clone(),
-                ipt((px, b + 7.0)),
-                font(sz.label).pos(Pos::new(HPos::Center, VPos::Top)),
-            ))
-            .map_err(err)?;
-        }
-    }
-    for tick in &frame.y.ticks {
-        let py = frame.py(tick.at);
-        let len = if tick.label.is_some() { 5.0 } else { 3.0 };
-        area.draw(&PathElement::new(
-            vec![ipt((l - len, py)), ipt((l, py))],
-            BLACK,
-        ))
-        .map_err(err)?;
-        if let Some(label) = &tick.label {
-            area.draw(&Text::new(
-                label.clone(),
-                ipt((l - 7.0, py)),
-                font(sz.label).pos(Pos::new(HPos::Right, VPos::Center)),
-            ))
-            .map_err(err)?;
-        }
-    }
-    area.draw(&Text::new(
-        chart.x_label.clone(),
-        ipt((0.5 * (l + r), h - sz.margin)),
-        font(sz.desc).pos(Pos::new(HPos::Center, VPos::Bottom)),
-    ))
-    .map_err(err)?;
-    area.draw(&Text::new(
-        chart.y_label.clone(),
-        ipt((sz.margin, 0.5 * (t + b))),
-        font(sz.desc)
-            .transform(FontTransform::Rotate270)
-            .pos(Pos::new(HPos::Center, VPos::Top)),
-    ))
-    .map_err(err)?;
 
-    // What the axes could not show.
-    if hidden > 0 {
+    /// Draws the layers, each over the ones before.
+    fn draw(&self) -> Res<DB> {
+        self.background()?;
+        self.reference_lines()?;
+        let (hidden, ends) = self.series()?;
+        self.axes()?;
+        // What the axes could not show.
+        if hidden > 0 {
+            let (l, _, _, b) = self.edges();
+            self.area.draw(&Text::new(
+                format!("{hidden} points not shown (not finite, or negative on a log axis)"),
+                ipt((l + 6.0, b - 6.0)),
+                font(self.sz.label).pos(Pos::new(HPos::Left, VPos::Bottom)),
+            ))?;
+        }
+        self.labels(&ends)
+    }
+
+    /// The white page, the title, the band of exact zeros and the grid.
+    fn background(&self) -> Res<DB> {
+        let (area, frame) = (self.area, &self.frame);
+        let (l, r, t, b) = self.edges();
+        area.fill(&WHITE)?;
         area.draw(&Text::new(
-            format!("{hidden} points not shown (not finite, or negative on a log axis)"),
-            ipt((l + 6.0, b - 6.0)),
-            font(sz.label).pos(Pos::new(HPos::Left, VPos::Bottom)),
-        ))
-        .map_err(err)?;
+            self.chart.title.clone(),
+            ipt((0.5 * self.w, self.sz.margin)),
+            font(self.title_size).pos(Pos::new(HPos::Center, VPos::Top)),
+        ))?;
+        let grid = RGBColor(225, 225, 225);
+        let minor_grid = RGBColor(242, 242, 242);
+        let band = RGBColor(246, 246, 246);
+        if let Some((_, decades_lo)) = frame.y.zero {
+            let edge = frame.py(decades_lo);
+            area.draw(&Rectangle::new(
+                [ipt((l, edge)), ipt((r, b))],
+                band.filled(),
+            ))?;
+        }
+        if let Some((_, decades_lo)) = frame.x.zero {
+            let edge = frame.px(decades_lo);
+            area.draw(&Rectangle::new(
+                [ipt((l, t)), ipt((edge, b))],
+                band.filled(),
+            ))?;
+        }
+        for tick in &frame.x.ticks {
+            let px = frame.px(tick.at);
+            let c = if tick.label.is_some() {
+                grid
+            } else {
+                minor_grid
+            };
+            area.draw(&PathElement::new(vec![ipt((px, t)), ipt((px, b))], c))?;
+        }
+        for tick in &frame.y.ticks {
+            let py = frame.py(tick.at);
+            let c = if tick.label.is_some() {
+                grid
+            } else {
+                minor_grid
+            };
+            area.draw(&PathElement::new(vec![ipt((l, py)), ipt((r, py))], c))?;
+        }
+        Ok(())
     }
 
-    // Labels: beside each line's end (in the gutter) and each lone point, or a legend box.
-    let sample = |area: &DrawingArea<DB, Shift>, i: usize, at: (f64, f64)| -> Res<DB> {
-        let s = &chart.series[i];
+    /// The reference lines, dashed, with their labels.
+    fn reference_lines(&self) -> Res<DB> {
+        let (area, frame, sz) = (self.area, &self.frame, &self.sz);
+        let (l, r, t, b) = self.edges();
+        let ref_color = RGBColor(85, 85, 85);
+        for rl in &self.chart.x_ref_lines {
+            if let Some(at) = frame.x.map(rl.at) {
+                let px = frame.px(at);
+                draw_polyline(
+                    area,
+                    &[(px, t), (px, b)],
+                    Dash::Dashed,
+                    ref_color.stroke_width(1),
+                )?;
+                // Beside the line, on the side with room: left of a negative one, and left of
+                // any that would run past the frame.
+                let room = r - px > self.text_w(&rl.label, sz.label) + 8.0;
+                let (dx, h_pos) = if rl.at < 0.0 || !room {
+                    (-4.0, HPos::Right)
+                } else {
+                    (4.0, HPos::Left)
+                };
+                area.draw(&Text::new(
+                    rl.label.clone(),
+                    ipt((px + dx, t + 4.0)),
+                    font(sz.label)
+                        .color(&ref_color)
+                        .pos(Pos::new(h_pos, VPos::Top)),
+                ))?;
+            }
+        }
+        for rl in &self.chart.ref_lines {
+            if let Some(at) = frame.y.map(rl.at) {
+                let py = frame.py(at);
+                draw_polyline(
+                    area,
+                    &[(l, py), (r, py)],
+                    Dash::Dashed,
+                    ref_color.stroke_width(1),
+                )?;
+                // The label at the right end, above the line, on a white patch.
+                let tw = self.text_w(&rl.label, sz.label);
+                let th = f64::from(sz.label);
+                area.draw(&Rectangle::new(
+                    [
+                        ipt((r - tw - 10.0, py - th - 4.0)),
+                        ipt((r - 2.0, py - 2.0)),
+                    ],
+                    WHITE.filled(),
+                ))?;
+                area.draw(&Text::new(
+                    rl.label.clone(),
+                    ipt((r - 6.0, py - 3.0)),
+                    font(sz.label)
+                        .color(&ref_color)
+                        .pos(Pos::new(HPos::Right, VPos::Bottom)),
+                ))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The series: bars, then lines, then markers on top. Returns how many points the axes
+    /// cannot show, and where each series ends (its last shown point).
+    #[allow(clippy::type_complexity)]
+    fn series(
+        &self,
+    ) -> Result<(usize, Vec<(usize, (f64, f64))>), DrawingAreaErrorKind<DB::ErrorType>> {
+        let (area, frame, chart) = (self.area, &self.frame, self.chart);
+        let mut hidden = 0usize;
+        let mut ends: Vec<(usize, (f64, f64))> = Vec::new();
+        let pixels: Vec<Vec<Option<(f64, f64)>>> = chart
+            .series
+            .iter()
+            .map(|s| s.points.iter().map(|&p| frame.pixel(p)).collect())
+            .collect();
+        for (s, px) in chart.series.iter().zip(&pixels) {
+            hidden += px.iter().filter(|p| p.is_none()).count();
+            if let Some(bw) = s.bar_width {
+                let c = RGBColor(s.color.0, s.color.1, s.color.2);
+                let base = frame.py(frame.y.base());
+                for &(x, y) in &s.points {
+                    let (Some(x0), Some(x1), Some(y1)) = (
+                        frame.x.map(x - 0.5 * bw),
+                        frame.x.map(x + 0.5 * bw),
+                        frame.y.map(y),
+                    ) else {
+                        continue;
+                    };
+                    let (x0, x1) = (frame.px(x0), frame.px(x1));
+                    let y1 = frame.py(y1);
+                    area.draw(&Rectangle::new(
+                        [ipt((x0, y1)), ipt((x1.max(x0 + 1.0), base))],
+                        c.filled(),
+                    ))?;
+                }
+            }
+        }
+        for (i, (s, px)) in chart.series.iter().zip(&pixels).enumerate() {
+            if !s.line || s.bar_width.is_some() {
+                continue;
+            }
+            let c = RGBColor(s.color.0, s.color.1, s.color.2);
+            // A point the axes cannot show breaks the line.
+            for run in px.split(Option::is_none) {
+                let run: Vec<(f64, f64)> = run.iter().flatten().copied().collect();
+                draw_polyline(area, &run, self.styles[i].0, c.stroke_width(self.sz.line))?;
+            }
+        }
+        for (i, (s, px)) in chart.series.iter().zip(&pixels).enumerate() {
+            if s.marked() {
+                let c = RGBColor(s.color.0, s.color.1, s.color.2);
+                for p in px.iter().flatten() {
+                    draw_marker(area, *p, self.styles[i].1, self.sz.marker, c)?;
+                }
+            }
+            if let Some(end) = px.iter().rev().flatten().next() {
+                ends.push((i, *end));
+            }
+        }
+        Ok((hidden, ends))
+    }
+
+    /// The frame, the zero bands' breaks, ticks and their labels, the axis descriptions.
+    fn axes(&self) -> Res<DB> {
+        let (area, frame, sz) = (self.area, &self.frame, &self.sz);
+        let (l, r, t, b) = self.edges();
+        area.draw(&Rectangle::new(
+            [ipt((l, t)), ipt((r, b))],
+            BLACK.stroke_width(1),
+        ))?;
+        if let Some((_, decades_lo)) = frame.y.zero {
+            let edge = frame.py(decades_lo);
+            for x0 in [l, r] {
+                area.draw(&PathElement::new(
+                    vec![ipt((x0 - 5.0, edge + 3.0)), ipt((x0 + 5.0, edge - 3.0))],
+                    BLACK,
+                ))?;
+            }
+        }
+        if let Some((_, decades_lo)) = frame.x.zero {
+            let edge = frame.px(decades_lo);
+            for y0 in [t, b] {
+                area.draw(&PathElement::new(
+                    vec![ipt((edge - 3.0, y0 + 5.0)), ipt((edge + 3.0, y0 - 5.0))],
+                    BLACK,
+                ))?;
+            }
+        }
+        for tick in &frame.x.ticks {
+            let px = frame.px(tick.at);
+            let len = if tick.label.is_some() { 5.0 } else { 3.0 };
+            area.draw(&PathElement::new(
+                vec![ipt((px, b)), ipt((px, b + len))],
+                BLACK,
+            ))?;
+            if let Some(label) = &tick.label {
+                area.draw(&Text::new(
+                    label.clone(),
+                    ipt((px, b + 7.0)),
+                    font(sz.label).pos(Pos::new(HPos::Center, VPos::Top)),
+                ))?;
+            }
+        }
+        for tick in &frame.y.ticks {
+            let py = frame.py(tick.at);
+            let len = if tick.label.is_some() { 5.0 } else { 3.0 };
+            area.draw(&PathElement::new(
+                vec![ipt((l - len, py)), ipt((l, py))],
+                BLACK,
+            ))?;
+            if let Some(label) = &tick.label {
+                area.draw(&Text::new(
+                    label.clone(),
+                    ipt((l - 7.0, py)),
+                    font(sz.label).pos(Pos::new(HPos::Right, VPos::Center)),
+                ))?;
+            }
+        }
+        area.draw(&Text::new(
+            self.chart.x_label.clone(),
+            ipt((0.5 * (l + r), self.h - sz.margin)),
+            font(sz.desc).pos(Pos::new(HPos::Center, VPos::Bottom)),
+        ))?;
+        area.draw(&Text::new(
+            self.chart.y_label.clone(),
+            ipt((sz.margin, 0.5 * (t + b))),
+            font(sz.desc)
+                .transform(FontTransform::Rotate270)
+                .pos(Pos::new(HPos::Center, VPos::Top)),
+        ))?;
+        Ok(())
+    }
+
+    /// Series `i`'s look, 24 pixels wide from `at`, for a label.
+    fn sample(&self, i: usize, at: (f64, f64)) -> Res<DB> {
+        let s = &self.chart.series[i];
         let drawn = Series {
-            dash: styles[i].0,
-            marker: styles[i].1,
+            dash: self.styles[i].0,
+            marker: self.styles[i].1,
             points: Vec::new(),
             ..s.clone()
         };
-        sample_of(area, &drawn, s.marked(), at, sz.line, sz.marker)
-    };
-    if chart.direct_labels {
+        sample_of(
+            self.area,
+            &drawn,
+            s.marked(),
+            at,
+            self.sz.line,
+            self.sz.marker,
+        )
+    }
+
+    /// Labels: beside each line's end (in the gutter) and each lone point, or a legend box.
+    fn labels(&self, ends: &[(usize, (f64, f64))]) -> Res<DB> {
+        let chart = self.chart;
+        if chart.direct_labels {
+            self.direct_labels(ends)
+        } else if !self.compact && self.labelled.len() > 1 {
+            self.legend()
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Each labelled line's label in the gutter, joined to its end; each lone point's beside
+    /// it.
+    fn direct_labels(&self, ends: &[(usize, (f64, f64))]) -> Res<DB> {
+        let (area, chart, sz) = (self.area, self.chart, &self.sz);
+        let (_, r, t, b) = self.edges();
         let line_ends: Vec<(usize, (f64, f64))> = ends
             .iter()
             .copied()
@@ -1130,7 +1205,7 @@ pub fn draw_chart<DB: DrawingBackend>(
                 s.line && s.bar_width.is_none() && !s.label.is_empty()
             })
             .collect();
-        if gutter > 0.0 {
+        if self.gutter > 0.0 {
             let mut order = line_ends.clone();
             order.sort_by(|a, b| a.1 .1.total_cmp(&b.1 .1).then(a.0.cmp(&b.0)));
             let targets: Vec<f64> = order.iter().map(|e| e.1 .1).collect();
@@ -1141,18 +1216,16 @@ pub fn draw_chart<DB: DrawingBackend>(
                 area.draw(&PathElement::new(
                     vec![ipt((end.0.max(r - 2.0), end.1)), ipt((x0, ly))],
                     RGBColor(150, 150, 150),
-                ))
-                .map_err(err)?;
-                sample(area, *i, (x0, ly)).map_err(err)?;
+                ))?;
+                self.sample(*i, (x0, ly))?;
                 area.draw(&Text::new(
                     chart.series[*i].label.clone(),
                     ipt((x0 + 30.0, ly)),
                     font(sz.label).pos(Pos::new(HPos::Left, VPos::Center)),
-                ))
-                .map_err(err)?;
+                ))?;
             }
         }
-        for &(i, end) in &ends {
+        for &(i, end) in ends {
             let s = &chart.series[i];
             if s.line || s.bar_width.is_some() || s.label.is_empty() {
                 continue;
@@ -1161,39 +1234,48 @@ pub fn draw_chart<DB: DrawingBackend>(
                 s.label.clone(),
                 ipt((end.0 + 7.0, end.1 - 4.0)),
                 font(sz.label).pos(Pos::new(HPos::Left, VPos::Bottom)),
-            ))
-            .map_err(err)?;
+            ))?;
         }
-    } else if !compact && labelled.len() > 1 {
+        Ok(())
+    }
+
+    /// A legend box in the frame's top right corner.
+    fn legend(&self) -> Res<DB> {
+        let (area, chart, sz) = (self.area, self.chart, &self.sz);
+        let (_, r, t, _) = self.edges();
         let row = f64::from(sz.label) + 6.0;
-        let widest = labelled
+        let widest = self
+            .labelled
             .iter()
-            .map(|&i| text_w(&chart.series[i].label, sz.label))
+            .map(|&i| self.text_w(&chart.series[i].label, sz.label))
             .fold(0.0, f64::max);
-        let (bw, bh) = (widest + 46.0, row * labelled.len() as f64 + 8.0);
+        let (bw, bh) = (widest + 46.0, row * self.labelled.len() as f64 + 8.0);
         let (bx, by) = (r - bw - 10.0, t + 10.0);
         area.draw(&Rectangle::new(
             [ipt((bx, by)), ipt((bx + bw, by + bh))],
             WHITE.mix(0.9).filled(),
-        ))
-        .map_err(err)?;
+        ))?;
         area.draw(&Rectangle::new(
             [ipt((bx, by)), ipt((bx + bw, by + bh))],
             BLACK.stroke_width(1),
-        ))
-        .map_err(err)?;
-        for (k, &i) in labelled.iter().enumerate() {
+        ))?;
+        for (k, &i) in self.labelled.iter().enumerate() {
             let yk = by + 4.0 + row * (k as f64 + 0.5);
-            sample(area, i, (bx + 6.0, yk)).map_err(err)?;
+            self.sample(i, (bx + 6.0, yk))?;
             area.draw(&Text::new(
                 chart.series[i].label.clone(),
                 ipt((bx + 38.0, yk)),
                 font(sz.label).pos(Pos::new(HPos::Left, VPos::Center)),
-            ))
-            .map_err(err)?;
+            ))?;
         }
+        Ok(())
     }
-    Ok(())
+}
+
+/// The width of `s` in pixels at `size` in `area`'s font (0 when it cannot be measured).
+fn text_width<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, s: &str, size: u32) -> f64 {
+    area.estimate_text_size(s, &font(size))
+        .map_or(0.0, |(tw, _)| f64::from(tw))
 }
 
 /// A drawing library's complaint as the library's error.

@@ -134,6 +134,15 @@ pub struct Results<'a> {
     pub provenance: &'a crate::provenance::Provenance,
 }
 
+/// The index page's bytes ([`write_index`]), with numbers in the page's text that never
+/// break at their minus sign (U+2212 instead of -).
+pub fn index_html(files: &[String], results: &Results<'_>) -> Vec<u8> {
+    let page = crate::report::in_memory(|w| write_index(w, files, results));
+    let page = String::from_utf8(page).expect("the page is UTF-8");
+    let (head, body) = page.split_at(page.find("<body>").unwrap_or(0));
+    format!("{head}{}", crate::report::doc::number_minus(body)).into_bytes()
+}
+
 /// A self-contained index page linking (and showing) everything the report wrote: `files`
 /// are the report's files by their names relative to its directory (`a/b.png`).
 pub fn write_index(
