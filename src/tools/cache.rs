@@ -9,6 +9,11 @@
 //!
 //! Where: `$SPECFX_CACHE` (`off` or empty: no cache), else `$XDG_CACHE_HOME/specfx`, else
 //! `$HOME/.cache/specfx`. A cache that cannot be read or written is as if there were none.
+//!
+//! Two processes (or threads) that need the same entry at once run the tool once: the first
+//! claims the entry (a `<key>.claim` file naming its process) while it runs the tool, and the
+//! others wait for the entry it keeps ([`get_or_claim`]). A claim whose process is gone is
+//! taken over; a tool that fails keeps nothing, and the next in line runs it.
 
 use std::path::{Path, PathBuf};
 
@@ -50,7 +55,11 @@ fn entry(kind: &str, key: &str) -> Option<PathBuf> {
 /// The files `names` of the entry `kind`/`key`, when it is there and holds each of them
 /// (`None` for a name it lacks only when every other is there: optional outputs).
 pub fn get(kind: &str, key: &str, names: &[&str]) -> Option<Vec<Option<Vec<u8>>>> {
-    let dir = entry(kind, key)?;
+    get_at(&entry(kind, key)?, names)
+}
+
+/// [`get`] for the entry directory `dir`.
+fn get_at(dir: &Path, names: &[&str]) -> Option<Vec<Option<Vec<u8>>>> {
     if !dir.is_dir() {
         return None;
     }
@@ -63,13 +72,103 @@ pub fn get(kind: &str, key: &str, names: &[&str]) -> Option<Vec<Option<Vec<u8>>>
     Some(files)
 }
 
+/// The right to compute an entry, held while this process runs the tool: others asking for
+/// the same entry wait ([`get_or_claim`]). Released when dropped, after [`put`].
+#[derive(Debug)]
+pub struct Claim {
+    file: Option<PathBuf>,
+}
+
+impl Drop for Claim {
+    fn drop(&mut self) {
+        if let Some(f) = &self.file {
+            let _ = std::fs::remove_file(f);
+        }
+    }
+}
+
+/// How often a process waiting for another's entry looks again.
+const WAIT_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// The entry `kind`/`key` ([`get`]'s files) when it is there, or when another live process
+/// that claimed it keeps it meanwhile (waiting for it); else a [`Claim`] for this caller to
+/// run the tool and [`put`] the entry (without a cache, a claim that holds nothing).
+pub fn get_or_claim(kind: &str, key: &str, names: &[&str]) -> Result<Vec<Option<Vec<u8>>>, Claim> {
+    match entry(kind, key) {
+        Some(dest) => get_or_claim_at(&dest, names),
+        None => Err(Claim { file: None }),
+    }
+}
+
+/// [`get_or_claim`] for the entry directory `dest`.
+fn get_or_claim_at(dest: &Path, names: &[&str]) -> Result<Vec<Option<Vec<u8>>>, Claim> {
+    let claim_file = dest.with_extension("claim");
+    let mut said = false;
+    loop {
+        if let Some(files) = get_at(dest, names) {
+            return Ok(files);
+        }
+        if dest
+            .parent()
+            .is_none_or(|p| std::fs::create_dir_all(p).is_err())
+        {
+            return Err(Claim { file: None });
+        }
+        let created = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&claim_file);
+        match created {
+            Ok(mut f) => {
+                use std::io::Write as _;
+                let _ = write!(f, "{}", std::process::id());
+                // The entry may have been kept between the look above and the claim.
+                if let Some(files) = get_at(dest, names) {
+                    let _ = std::fs::remove_file(&claim_file);
+                    return Ok(files);
+                }
+                return Err(Claim {
+                    file: Some(claim_file),
+                });
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let owner = std::fs::read_to_string(&claim_file).ok();
+                let alive = owner
+                    .as_deref()
+                    .and_then(|t| t.trim().parse::<u32>().ok())
+                    .is_some_and(|pid| Path::new(&format!("/proc/{pid}")).exists());
+                // A claim being written has no number yet: it gets a few seconds.
+                let unwritten = owner.as_deref().is_none_or(str::is_empty);
+                let old = std::fs::metadata(&claim_file)
+                    .and_then(|m| m.modified())
+                    .is_ok_and(|t| t.elapsed().is_ok_and(|e| e.as_secs() > 10));
+                if (!unwritten && !alive) || (unwritten && old) {
+                    let _ = std::fs::remove_file(&claim_file);
+                    continue;
+                }
+                if !said {
+                    log::info!("waiting for another specfx run of the same synthesis");
+                    said = true;
+                }
+                std::thread::sleep(WAIT_POLL);
+            }
+            // A cache that cannot be written is as if there were none.
+            Err(_) => return Err(Claim { file: None }),
+        }
+    }
+}
+
 /// Keeps `files` (`(name, bytes)`) as the entry `kind`/`key`: written into a temporary
 /// directory of the cache, then renamed into place whole. An entry already there (another
 /// process's, for the same inputs) stays; any failure leaves the cache as it was.
 pub fn put(kind: &str, key: &str, files: &[(&str, &[u8])]) {
-    let Some(dest) = entry(kind, key) else {
-        return;
-    };
+    if let Some(dest) = entry(kind, key) {
+        put_at(&dest, files);
+    }
+}
+
+/// [`put`] for the entry directory `dest`.
+fn put_at(dest: &Path, files: &[(&str, &[u8])]) {
     let Some(parent) = dest.parent() else {
         return;
     };
@@ -82,7 +181,7 @@ pub fn put(kind: &str, key: &str, files: &[(&str, &[u8])]) {
     let written = files
         .iter()
         .all(|(name, bytes)| std::fs::write(tmp.path().join(name), bytes).is_ok());
-    if written && std::fs::rename(tmp.path(), &dest).is_ok() {
+    if written && std::fs::rename(tmp.path(), dest).is_ok() {
         // Renamed: nothing left for the temporary directory's drop to remove.
         let _ = tmp.keep();
     }
@@ -92,4 +191,55 @@ pub fn put(kind: &str, key: &str, files: &[(&str, &[u8])]) {
 /// would then fail, and a failure is never kept).
 pub fn file_bytes(path: &Path) -> Vec<u8> {
     std::fs::read(path).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_second_caller_waits_for_the_entry_the_first_keeps() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dest = tmp.path().join("yosys").join("k");
+        let claim = get_or_claim_at(&dest, &["a"]).expect_err("nothing there yet");
+        assert!(dest.with_extension("claim").is_file());
+        std::thread::scope(|s| {
+            let waiter = s.spawn(|| get_or_claim_at(&dest, &["a"]));
+            std::thread::sleep(5 * WAIT_POLL);
+            assert!(!waiter.is_finished(), "it waits while the claim is held");
+            put_at(&dest, &[("a", b"answer")]);
+            drop(claim);
+            let got = waiter.join().unwrap().expect("the kept entry");
+            assert_eq!(got, [Some(b"answer".to_vec())]);
+        });
+        assert!(!dest.with_extension("claim").exists());
+    }
+
+    #[test]
+    fn a_failed_run_lets_the_next_caller_run_the_tool() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dest = tmp.path().join("k");
+        let first = get_or_claim_at(&dest, &["a"]).expect_err("nothing there yet");
+        std::thread::scope(|s| {
+            let waiter = s.spawn(|| get_or_claim_at(&dest, &["a"]).is_err());
+            std::thread::sleep(5 * WAIT_POLL);
+            // The tool failed: no entry, the claim goes.
+            drop(first);
+            assert!(waiter.join().unwrap(), "the waiter claims it in turn");
+        });
+    }
+
+    #[test]
+    fn a_claim_whose_process_is_gone_is_taken_over() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dest = tmp.path().join("k");
+        // No process has this number (above the kernel's pid limit).
+        std::fs::write(dest.with_extension("claim"), "4194305").unwrap();
+        let claim = get_or_claim_at(&dest, &["a"]).expect_err("taken over");
+        assert_eq!(
+            std::fs::read_to_string(dest.with_extension("claim")).unwrap(),
+            std::process::id().to_string()
+        );
+        drop(claim);
+    }
 }

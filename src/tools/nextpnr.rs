@@ -75,19 +75,25 @@ pub fn place_and_route(
         }
         cache::key(&parts.iter().map(Vec::as_slice).collect::<Vec<_>>())
     };
-    if let Some(cached) = cache::get("nextpnr", &key, &["stat.json", "report.json"]) {
-        let text = |b: &Option<Vec<u8>>| b.clone().and_then(|b| String::from_utf8(b).ok());
-        let stat = text(&cached[0]).and_then(|t| parse_stat_json(&t, None).ok());
-        let report = text(&cached[1]).and_then(|t| parse_report(&t).ok());
-        if let (Some(stat), Some(report)) = (stat, report) {
-            let cells = SynthCells {
-                luts: stat.luts,
-                ffs: stat.ffs,
-                dsps: stat.dsps,
-            };
-            return Ok(Timing::new(dp, arch, device, Some(&report), cells));
+    // Held until the entry is kept (or place and route failed): a run that needs the same
+    // entry meanwhile waits for it.
+    let _claim = match cache::get_or_claim("nextpnr", &key, &["stat.json", "report.json"]) {
+        Ok(cached) => {
+            let text = |b: &Option<Vec<u8>>| b.clone().and_then(|b| String::from_utf8(b).ok());
+            let stat = text(&cached[0]).and_then(|t| parse_stat_json(&t, None).ok());
+            let report = text(&cached[1]).and_then(|t| parse_report(&t).ok());
+            if let (Some(stat), Some(report)) = (stat, report) {
+                let cells = SynthCells {
+                    luts: stat.luts,
+                    ffs: stat.ffs,
+                    dsps: stat.dsps,
+                };
+                return Ok(Timing::new(dp, arch, device, Some(&report), cells));
+            }
+            None
         }
-    }
+        Err(claim) => Some(claim),
+    };
     let yosys = run("yosys", &["-q".into(), "-s".into(), "pnr.ys".into()], dir)?;
     if !yosys.status.success() {
         return Err(error(

@@ -67,18 +67,24 @@ fn run_in(work: &Path, files: &[PathBuf], top: &str, target: Target) -> Result<S
     let script = yosys_script(target, &names, &work.display().to_string(), top);
     write("yosys", &work.join("cost.ys"), &script)?;
     let key = cache_key(work, files, &version, &script);
-    if let Some(cached) = cache::get("yosys", &key, &["stat.json", "stat_cmos.txt"]) {
-        let text = |b: &Option<Vec<u8>>| b.clone().and_then(|b| String::from_utf8(b).ok());
-        if let Some(cost) = text(&cached[0])
-            .and_then(|stat| parse_stat_json(&stat, text(&cached[1]).as_deref()).ok())
-        {
-            return Ok(Synthesis {
-                cost,
-                version,
-                script,
-            });
+    // Held until the entry is kept (or the synthesis failed): a run that needs the same
+    // entry meanwhile waits for it.
+    let _claim = match cache::get_or_claim("yosys", &key, &["stat.json", "stat_cmos.txt"]) {
+        Ok(cached) => {
+            let text = |b: &Option<Vec<u8>>| b.clone().and_then(|b| String::from_utf8(b).ok());
+            if let Some(cost) = text(&cached[0])
+                .and_then(|stat| parse_stat_json(&stat, text(&cached[1]).as_deref()).ok())
+            {
+                return Ok(Synthesis {
+                    cost,
+                    version,
+                    script,
+                });
+            }
+            None
         }
-    }
+        Err(claim) => Some(claim),
+    };
     let out = child::output(
         Command::new("yosys")
             .args(["-q", "-s", "cost.ys"])
