@@ -106,6 +106,12 @@ pub enum Error {
         /// What was given.
         got: String,
     },
+    /// Sweep shards that do not form one complete sweep.
+    #[error("{problem}")]
+    Merge {
+        /// What is wrong and what to pass instead.
+        problem: String,
+    },
     /// A chart or document that could not be drawn.
     #[error("{message}")]
     Render {

@@ -201,6 +201,22 @@ impl Provenance {
         ]
     }
 
+    /// The provenance of a single file as comment lines (TOML, shell): the line documents end
+    /// with, then the canonical inputs, each line behind `#| ` (the hash is of those lines
+    /// without the prefix, each ending in a newline: `grep '^#|' FILE | cut -c4- | sha256sum`).
+    pub fn comment(&self) -> String {
+        let mut s = format!(
+            "# specfx {} · specfx {} · inputs sha256 {}: the canonical inputs, on the lines starting with '#|'\n",
+            self.specfx_version, self.command, self.inputs_sha256
+        );
+        for line in self.canonical.lines() {
+            s.push_str(if line.is_empty() { "#|" } else { "#| " });
+            s.push_str(line);
+            s.push('\n');
+        }
+        s
+    }
+
     /// `provenance.json`'s text (pretty JSON and a newline).
     pub fn json(&self) -> String {
         let mut s = serde_json::to_string_pretty(self).expect("provenance serialises");

@@ -559,6 +559,94 @@ pub fn sweep_sha256(space: &Space, shard_count: u64) -> String {
     crate::provenance::sha256_hex(inputs.canonical().as_bytes())
 }
 
+/// A shard given to a merge: its directory as given, the same with links resolved, and its
+/// identity.
+#[derive(Debug, Clone)]
+pub struct GivenShard {
+    /// The directory as given, for messages.
+    pub dir: std::path::PathBuf,
+    /// The directory with links resolved: two names of one directory are one shard.
+    pub real: std::path::PathBuf,
+    /// The shard's identity.
+    pub info: SweepInfo,
+}
+
+/// Checks that `shards` form one complete sweep: each directory once, one design space, one
+/// shard count, each shard once, none missing ([`Error::Merge`] naming what is wrong).
+pub fn check_shards(shards: &[GivenShard]) -> Result<(), Error> {
+    let refuse = |problem: String| Err(Error::Merge { problem });
+    for (k, given) in shards.iter().enumerate() {
+        let (dir, info) = (given.dir.display(), &given.info);
+        for other in &shards[..k] {
+            let (other_dir, other_info) = (other.dir.display(), &other.info);
+            if other.real == given.real {
+                return refuse(format!(
+                    "{other_dir} and {dir} are the same directory: pass each shard once"
+                ));
+            }
+            if !same_space(&other_info.space, &info.space) {
+                return refuse(format!(
+                    "{dir}: a shard of another sweep (its design space differs from {other_dir}'s)"
+                ));
+            }
+            if other_info.sweep_sha256 != info.sweep_sha256 {
+                return refuse(format!(
+                    "{dir}: shard {} of a sweep in {} shards, but {other_dir} is shard {}: shards of one sweep share their count",
+                    info.shard(),
+                    info.shard_count,
+                    other_info.shard()
+                ));
+            }
+            if other_info.shard_index == info.shard_index {
+                return refuse(format!(
+                    "{other_dir} and {dir} are both shard {}: pass each shard once",
+                    info.shard()
+                ));
+            }
+        }
+    }
+    let Some(first) = shards.first() else {
+        return refuse("no shard to merge".to_string());
+    };
+    let count = first.info.shard_count;
+    let missing: Vec<String> = (0..count)
+        .filter(|i| !shards.iter().any(|s| s.info.shard_index == *i))
+        .take(8)
+        .map(|i| format!("{i}/{count}"))
+        .collect();
+    if !missing.is_empty() {
+        return refuse(format!(
+            "the shards given are {} of {count}: shard{} {} missing (pass every shard's directory)",
+            shards.len(),
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", ")
+        ));
+    }
+    Ok(())
+}
+
+/// Checks that the shard in `dir` holds all of its points (`held` of them).
+pub fn check_shard_complete(
+    dir: &std::path::Path,
+    info: &SweepInfo,
+    held: u64,
+) -> Result<(), Error> {
+    let expected = info.shard_points();
+    if held < expected {
+        return Err(Error::Merge {
+            problem: format!(
+                "{} (shard {}) holds {held} of its {expected} points, {} missing: resume it (specfx sweep --shard {} --out {}, with its space)",
+                dir.display(),
+                info.shard(),
+                expected - held,
+                info.shard(),
+                dir.display()
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Whether two spaces are the same, however they were written.
 pub fn same_space(a: &Space, b: &Space) -> bool {
     sweep_sha256(a, 1) == sweep_sha256(b, 1)

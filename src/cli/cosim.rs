@@ -95,29 +95,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     if args.lint && !tools::simulator::Simulator::Verilator.installed() {
         bail!("--lint: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator)");
     }
-    if let (Some(vcd), Some(v)) = (&args.vcd, &args.vectors) {
-        let vector_dir = super::vectordir::dir_of(v);
-        specfx::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
-    }
-    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
-        specfx::output::check_can_create(dir, "--vcd")?;
-    } else if let Some(dir) = &args.vcd {
-        // An earlier cosim's traces (model.vcd begins with the model's header) are replaced;
-        // other files of those names only with --force; never an input.
-        let mut inputs = super::output::inputs(&args.config, None);
-        if let Some(v) = &args.vectors {
-            inputs.extend(super::output::config_inputs_as(
-                "--vectors",
-                &v.to_string_lossy(),
-            ));
-        }
-        let model = dir.join("model.vcd");
-        let header = Some(specfx::cycle::vcd::VCD_HEADER);
-        specfx::output::check_file_output(&model, "--vcd", &inputs, header, args.force)?;
-        let earlier = model.is_file();
-        let rtl = dir.join("rtl.vcd");
-        specfx::output::check_file_output(&rtl, "--vcd", &inputs, None, args.force || earlier)?;
-    }
+    check_vcd_output(args)?;
     // Absolute: the simulator runs in the work directory.
     let hdl = super::hdl_ref::hdl_ref_dir(args.hdl_ref.as_deref());
     let hdl = std::path::absolute(&hdl)
@@ -129,34 +107,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     }
     let work = tools::child::work_dir("cosim").context("cannot create a work directory")?;
     let wd = work.path();
-
-    // The vectors: given, or written for --config.
-    let vectors = match &args.vectors {
-        Some(dir) => {
-            if !dir.join("manifest.json").is_file() {
-                bail!(
-                    "{}: no manifest.json (write a vector directory with specfx vectors --out {})",
-                    dir.display(),
-                    dir.display()
-                );
-            }
-            dir.clone()
-        }
-        None => {
-            let dp = super::datapath::load(&args.config, args.n.as_ref())?;
-            let dir = wd.join("vectors");
-            super::vectors::write_dir(
-                &dp,
-                &dir,
-                &args.cases,
-                args.order,
-                args.run.seed,
-                false,
-                &[],
-            )?;
-            dir
-        }
-    };
+    let vectors = vector_dir(args, wd)?;
     let opened = super::vectordir::open(&vectors)?;
     let dp = specfx::pipeline::Datapath::new(opened.config.clone())
         .context("the manifest's configuration")?;
@@ -176,35 +127,14 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         std::fs::copy(&from, wd.join(format!("{port}.hex")))
             .with_context(|| format!("cannot copy {}", from.display()))?;
     }
-
     let mut params = vec![
         ("NVEC".to_string(), stim.n_vectors as i64),
         ("NCYC".to_string(), stim.n_cycles as i64),
     ];
-    params.extend(
-        render_parameters(&dp, args.run.arch, args.reset_data, ParamsFormat::Json, "")
-            .parse::<serde_json::Value>()
-            .ok()
-            .and_then(|v| v.as_object().cloned())
-            .expect("render_parameters writes a JSON object of integers")
-            .into_iter()
-            .map(|(k, v)| (k, v.as_i64().expect("integer parameters"))),
-    );
-
-    if args.lint {
-        log::info!("cosim: verilator --lint-only -Wall (specfx_top + rtl)");
-        let top: Vec<(String, i64)> = params
-            .iter()
-            .filter(|(k, _)| k != "NVEC" && k != "NCYC")
-            .cloned()
-            .collect();
-        if let Some(complaints) = tools::simulator::lint(&rtl, &top)? {
-            log::error!("{complaints}");
-            log::error!("cosim: lint failed");
-            return Ok(Outcome::CheckFailed);
-        }
+    params.extend(top_parameters(&dp, args));
+    if args.lint && !lint_clean(&rtl, &params)? {
+        return Ok(Outcome::CheckFailed);
     }
-
     log::info!(
         "cosim: {}, {}, {} vectors ({}), {} stimulus cycles (seed {}, bubble {}, stall {}){}",
         sim.name(),
@@ -246,7 +176,111 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         let kept = work.keep();
         log::info!("cosim: work directory {}", kept.display());
     }
-    let failure = match &verdict {
+    let failure = print_verdict(&verdict)?;
+    let traces_differ = match &traces {
+        Some((model, rtl)) => compare_traces(model, rtl, failure.is_some())?,
+        None => None,
+    };
+    let at = format!("({}, {})", sim.name(), args.run.arch);
+    match (failure, traces_differ) {
+        (None, None) => Ok(Outcome::Ok),
+        (failure, differ) => {
+            let why: Vec<String> = failure.into_iter().chain(differ).collect();
+            log::error!("cosim: FAIL {at}: {}", why.join("; "));
+            Ok(Outcome::CheckFailed)
+        }
+    }
+}
+
+/// Checks `--vcd` before any work: never inside the input vector directory; created when
+/// missing; an earlier cosim's traces there (model.vcd begins with the model's header) are
+/// replaced, other files of those names only with --force, never an input.
+fn check_vcd_output(args: &CosimArgs) -> Result<()> {
+    if let (Some(vcd), Some(v)) = (&args.vcd, &args.vectors) {
+        let vector_dir = super::vectordir::dir_of(v);
+        specfx::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
+    }
+    if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
+        specfx::output::check_can_create(dir, "--vcd")?;
+    } else if let Some(dir) = &args.vcd {
+        let mut inputs = super::output::inputs(&args.config, None);
+        if let Some(v) = &args.vectors {
+            inputs.extend(super::output::config_inputs_as(
+                "--vectors",
+                &v.to_string_lossy(),
+            ));
+        }
+        let model = dir.join("model.vcd");
+        let header = Some(specfx::cycle::vcd::VCD_HEADER);
+        specfx::output::check_file_output(&model, "--vcd", &inputs, header, args.force)?;
+        let earlier = model.is_file();
+        let rtl = dir.join("rtl.vcd");
+        specfx::output::check_file_output(&rtl, "--vcd", &inputs, None, args.force || earlier)?;
+    }
+    Ok(())
+}
+
+/// The vectors: the `--vectors` directory, or written for `--config` into the work directory.
+fn vector_dir(args: &CosimArgs, wd: &std::path::Path) -> Result<PathBuf> {
+    if let Some(dir) = &args.vectors {
+        if !dir.join("manifest.json").is_file() {
+            bail!(
+                "{}: no manifest.json (write a vector directory with specfx vectors --out {})",
+                dir.display(),
+                dir.display()
+            );
+        }
+        return Ok(dir.clone());
+    }
+    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let dir = wd.join("vectors");
+    super::vectors::write_dir(
+        &dp,
+        &dir,
+        &args.cases,
+        args.order,
+        args.run.seed,
+        false,
+        &[],
+    )?;
+    Ok(dir)
+}
+
+/// `specfx_top`'s parameters for `dp` (as `specfx hdl params` gives them).
+fn top_parameters(dp: &specfx::pipeline::Datapath, args: &CosimArgs) -> Vec<(String, i64)> {
+    render_parameters(dp, args.run.arch, args.reset_data, ParamsFormat::Json, "")
+        .parse::<serde_json::Value>()
+        .ok()
+        .and_then(|v| v.as_object().cloned())
+        .expect("render_parameters writes a JSON object of integers")
+        .into_iter()
+        .map(|(k, v)| (k, v.as_i64().expect("integer parameters")))
+        .collect()
+}
+
+/// `verilator --lint-only -Wall` of `specfx_top` and the RTL with the top's parameters (the
+/// testbench's own are left out); logs the complaints and returns false when there are some.
+fn lint_clean(rtl: &[PathBuf], params: &[(String, i64)]) -> Result<bool> {
+    log::info!("cosim: verilator --lint-only -Wall (specfx_top + rtl)");
+    let top: Vec<(String, i64)> = params
+        .iter()
+        .filter(|(k, _)| k != "NVEC" && k != "NCYC")
+        .cloned()
+        .collect();
+    if let Some(complaints) = tools::simulator::lint(rtl, &top)? {
+        log::error!("{complaints}");
+        log::error!("cosim: lint failed");
+        return Ok(false);
+    }
+    Ok(true)
+}
+
+/// Prints the testbench's verdict (its problems, then `N passed, N failed`); returns why the
+/// run failed, if it did.
+fn print_verdict(
+    verdict: &std::result::Result<specfx::hdl::testbench::Tally, specfx::Error>,
+) -> Result<Option<String>> {
+    Ok(match verdict {
         Ok(v) => {
             for line in &v.problems {
                 super::output::outln!("{line}")?;
@@ -265,38 +299,32 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             }
         }
         Err(e) => Some(e.to_string()),
-    };
-    // The traces are compared whenever both exist: where a vector failed, the first
-    // differing register tells where the RTL went wrong. A trace that cannot be read then
-    // does not hide the failure.
-    let mut traces_differ = None;
-    if let Some((model, rtl)) = &traces {
-        let options = specfx::cycle::compare::Options::default();
-        match super::trace::compare_files(model, rtl, &options) {
-            Ok(c) if c.agrees() => {}
-            Ok(c) => {
-                traces_differ = Some(match &c.first_difference {
-                    Some(d) => format!(
-                        "the model's and the RTL's traces first differ at cycle {}, {}",
-                        d.cycle, d.signal
-                    ),
-                    None => "the model's and the RTL's traces differ".to_string(),
-                })
-            }
-            Err(e) if failure.is_some() => {
-                log::error!("cosim: the traces cannot be compared: {e:#}");
-            }
-            Err(e) => return Err(e),
+    })
+}
+
+/// Compares the model's and the RTL's traces: where a vector failed, the first differing
+/// register tells where the RTL went wrong. A trace that cannot be read does not hide a
+/// `failed` run (it is logged); otherwise it is the error.
+fn compare_traces(
+    model: &std::path::Path,
+    rtl: &std::path::Path,
+    failed: bool,
+) -> Result<Option<String>> {
+    let options = specfx::cycle::compare::Options::default();
+    match super::trace::compare_files(model, rtl, &options) {
+        Ok(c) if c.agrees() => Ok(None),
+        Ok(c) => Ok(Some(match &c.first_difference {
+            Some(d) => format!(
+                "the model's and the RTL's traces first differ at cycle {}, {}",
+                d.cycle, d.signal
+            ),
+            None => "the model's and the RTL's traces differ".to_string(),
+        })),
+        Err(e) if failed => {
+            log::error!("cosim: the traces cannot be compared: {e:#}");
+            Ok(None)
         }
-    }
-    let at = format!("({}, {})", sim.name(), args.run.arch);
-    match (failure, traces_differ) {
-        (None, None) => Ok(Outcome::Ok),
-        (failure, differ) => {
-            let why: Vec<String> = failure.into_iter().chain(differ).collect();
-            log::error!("cosim: FAIL {at}: {}", why.join("; "));
-            Ok(Outcome::CheckFailed)
-        }
+        Err(e) => Err(e),
     }
 }
 

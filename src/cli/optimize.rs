@@ -16,8 +16,7 @@ use specfx::hdl::cost::{analytic_cost, Target};
 use specfx::nset::NSet;
 use specfx::output::write_atomic;
 use specfx::pipeline::{Datapath, Variant};
-use specfx::report::optimize::write_no_answer;
-use specfx::report::table::{Align, TextTable};
+use specfx::report::optimize::{answer_header, write_answer, write_no_answer, Answer};
 
 /// The first bytes of the configuration `specfx optimize` writes: a file that begins with
 /// them is an earlier result, replaced without `--force`.
@@ -173,33 +172,30 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     {
         bail!("the configuration found does not meet the budget on re-check: this is a bug");
     }
+    let mut yosys = Vec::new();
     for b in r.budget.bounds.iter().filter(|b| b.metric.is_yosys()) {
         let (Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t)) = b.metric else {
             continue;
         };
-        let f = synth(&dp, arch, t)?;
-        super::output::outln!(
-            "yosys on {}: {} {}, {} DSPs, {} flip-flops (the budget's {} <= {})",
-            t.name(),
-            f.luts,
-            t.logic_unit(),
-            f.dsps,
-            f.ffs,
-            b.metric,
-            b.limit
-        )?;
+        yosys.push((b, synth(&dp, arch, t)?));
     }
-    let header = format!(
-        "{OUT_HEADER} cheapest configuration found for the budget '{}'\n# cost {:.0} {unit} ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
-        r.budget,
-        best.cost,
-        args.objective,
-        r.n_evaluations,
-        proof.shape_total_max_abs,
-        proof.shape_quant_max_abs,
-        proof.out_max_ulp,
-        100.0 * proof.stages[dp.stage_out()].correctly_rounded
-    );
+    // The answer's cost on every target, beside the paper's datapath (baseline: plain, k = 4)
+    // serving the same exponents.
+    let mut paper_cfg = specfx::pipeline::Config::baseline();
+    paper_cfg.n = config.n.clone();
+    let paper = Datapath::new(paper_cfg)?;
+    let paper_check = specfx::analysis::check::check_outputs(&paper)?;
+    let answer = Answer {
+        result: &r,
+        best,
+        dp: &dp,
+        proof: &proof,
+        objective: args.objective,
+        unit: &unit,
+        arch,
+        paper: (&paper, &paper_check),
+        yosys: &yosys,
+    };
     let mut variant_names: Vec<&str> = variants.iter().map(|v| v.name()).collect();
     variant_names.sort_unstable();
     variant_names.dedup();
@@ -214,105 +210,15 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             .option("start_frac", args.start_frac)
             .option("arch", arch.to_string()),
     );
-    write_atomic(
-        &args.out,
-        format!(
-            "{header}{}{}",
-            provenance_comment(&provenance),
-            config.to_toml()
-        )
-        .as_bytes(),
-    )?;
-    super::output::outln!(
-        "best: k = {}, {}, t {} b {} squares {} out {}: {:.0} {unit} ({})",
-        config.k,
-        config.variant.name(),
-        config.t.format,
-        config.b.format,
-        config
-            .square
-            .iter()
-            .map(|s| s.format.to_string())
-            .collect::<Vec<_>>()
-            .join("/"),
-        config.out.format,
-        best.cost,
-        args.objective
-    )?;
-    super::output::outln!(
-        "proved by an exhaustive check: shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded",
-        proof.shape_total_max_abs,
-        proof.shape_quant_max_abs,
-        proof.out_max_ulp,
-        100.0 * proof.stages[dp.stage_out()].correctly_rounded
-    )?;
-    // Overflow: a stage left to wrap must never overflow on any input (the exhaustive check
-    // counts every event).
-    let wrapping: Vec<String> = proof
-        .stages
-        .iter()
-        .filter(|s| s.wrapped > 0)
-        .map(|s| format!("{} ({} times)", s.stage, s.wrapped))
-        .collect();
-    if wrapping.is_empty() {
-        super::output::outln!("overflow: no stage wraps on any input (exhaustive)")?;
-    } else {
-        super::output::outln!(
-            "overflow: WARNING, these stages wrap on some inputs although the budget holds: {}",
-            wrapping.join(", ")
-        )?;
-    }
-    // The answer's cost on every target, beside the paper's datapath (baseline: plain, k = 4)
-    // serving the same exponents.
-    let mut paper_cfg = specfx::pipeline::Config::baseline();
-    paper_cfg.n = config.n.clone();
-    let paper = Datapath::new(paper_cfg)?;
-    let paper_check = specfx::analysis::check::check_outputs(&paper)?;
-    super::output::outln!(
-        "against the paper's datapath (baseline: plain, k = 4, same n): shape_total {:.3e} ({:.2} lsb8) against {:.3e} ({:.2} lsb8)",
-        proof.shape_total_max_abs,
-        proof.shape_total_max_abs / specfx::analysis::LSB8,
-        paper_check.shape_total_max_abs,
-        paper_check.shape_total_max_abs / specfx::analysis::LSB8
-    )?;
-    super::output::outln!(
-        "  analytic cost, {arch} (the model `specfx cost --analytic-only` prints):"
-    )?;
-    let mut table = TextTable::new(&[
-        ("target", Align::Left),
-        ("this", Align::Right),
-        ("paper's", Align::Right),
-    ])
-    .indent(4);
-    for target in specfx::hdl::cost::REPORTED_TARGETS {
-        let a = analytic_cost(&dp, arch, target);
-        let p = analytic_cost(&paper, arch, target);
-        let show = |c: &specfx::hdl::cost::AnalyticCost| {
-            format!("{} {} {} DSPs {} FFs", c.luts, c.logic_unit, c.dsps, c.ffs)
-        };
-        table.row([target.name().to_string(), show(&a), show(&p)]);
-    }
-    super::output::print_with(|w| table.write(w, super::terminal::table_width()))?;
-    super::output::outln!("why minimal (within this search, not over every possible datapath):")?;
-    for m in &r.minimality {
-        super::output::outln!("  {m}")?;
-    }
-    super::output::outln!("written to {}", args.out.display())?;
-    Ok(Outcome::Ok)
-}
-
-/// The provenance of a configuration file as TOML comments: the line documents end with, then
-/// the canonical inputs, each line behind `#| ` (the hash is of those lines without the
-/// prefix, each ending in a newline: `grep '^#|' FILE | cut -c4- | sha256sum`).
-fn provenance_comment(p: &Provenance) -> String {
-    let mut s = format!(
-        "# specfx {} · specfx {} · inputs sha256 {}: the canonical inputs, on the lines starting with '#|'\n",
-        p.specfx_version, p.command, p.inputs_sha256
+    let text = format!(
+        "{}{}{}",
+        answer_header(OUT_HEADER, &answer),
+        provenance.comment(),
+        config.to_toml()
     );
-    for line in p.canonical.lines() {
-        s.push_str(if line.is_empty() { "#|" } else { "#| " });
-        s.push_str(line);
-        s.push('\n');
-    }
-    s
+    write_atomic(&args.out, text.as_bytes())?;
+    super::output::print_with(|w| {
+        write_answer(w, &answer, &args.out, super::terminal::table_width())
+    })?;
+    Ok(Outcome::Ok)
 }

@@ -11,7 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use super::Outcome;
 use specfx::analysis::sweep::{
-    evaluate, mark_pareto, parse_shard, same_space, LogUse, PointResult, Space, SweepInfo,
+    check_shard_complete, check_shards, evaluate, mark_pareto, parse_shard, same_space, GivenShard,
+    LogUse, PointResult, Space, SweepInfo,
 };
 use specfx::output::OutDir;
 use specfx::provenance::{Inputs, Provenance};
@@ -326,64 +327,20 @@ const MERGE_MARKER: &str = "sweep-merge";
 fn merge(out: &Path, shards: &[PathBuf], force: bool) -> Result<Outcome> {
     // Every shard's identity first, then every point, then the output: nothing is written
     // until the inputs are known to form one complete sweep.
-    let mut seen: Vec<(PathBuf, &PathBuf, SweepInfo)> = Vec::new();
+    let mut given = Vec::new();
     for dir in shards {
         let info = read_info(dir)?;
-        let real = resolved(dir)?;
-        for (other_real, other, other_info) in &seen {
-            if *other_real == real {
-                bail!(
-                    "{} and {} are the same directory: pass each shard once",
-                    other.display(),
-                    dir.display()
-                );
-            }
-            if !same_space(&other_info.space, &info.space) {
-                bail!(
-                    "{}: a shard of another sweep (its design space differs from {}'s)",
-                    dir.display(),
-                    other.display()
-                );
-            }
-            if other_info.sweep_sha256 != info.sweep_sha256 {
-                bail!(
-                    "{}: shard {} of a sweep in {} shards, but {} is shard {}: shards of one sweep share their count",
-                    dir.display(),
-                    info.shard(),
-                    info.shard_count,
-                    other.display(),
-                    other_info.shard()
-                );
-            }
-            if other_info.shard_index == info.shard_index {
-                bail!(
-                    "{} and {} are both shard {}: pass each shard once",
-                    other.display(),
-                    dir.display(),
-                    info.shard()
-                );
-            }
-        }
-        seen.push((real, dir, info));
+        given.push(GivenShard {
+            dir: dir.clone(),
+            real: resolved(dir)?,
+            info,
+        });
     }
-    let first = seen[0].2.clone();
-    let missing: Vec<String> = (0..first.shard_count)
-        .filter(|i| !seen.iter().any(|(_, _, s)| s.shard_index == *i))
-        .take(8)
-        .map(|i| format!("{i}/{}", first.shard_count))
-        .collect();
-    if !missing.is_empty() {
-        bail!(
-            "the shards given are {} of {}: shard{} {} missing (pass every shard's directory)",
-            seen.len(),
-            first.shard_count,
-            if missing.len() > 1 { "s" } else { "" },
-            missing.join(", ")
-        );
-    }
+    check_shards(&given)?;
+    let first = given[0].info.clone();
     // The output is none of the inputs, inside none, and holds none.
     let out_real = resolved(out)?;
-    for (real, dir, _) in &seen {
+    for GivenShard { real, dir, .. } in &given {
         if out_real == *real || out_real.starts_with(real) || real.starts_with(&out_real) {
             let how = if out_real == *real {
                 "is"
@@ -400,20 +357,9 @@ fn merge(out: &Path, shards: &[PathBuf], force: bool) -> Result<Outcome> {
         }
     }
     let mut points = BTreeMap::new();
-    for (_, dir, info) in &seen {
+    for GivenShard { dir, info, .. } in &given {
         let mine = read_log(dir, info, LogUse::Merge)?;
-        let expected = info.shard_points();
-        if (mine.len() as u64) < expected {
-            bail!(
-                "{} (shard {}) holds {} of its {expected} points, {} missing: resume it (specfx sweep --shard {} --out {}, with its space)",
-                dir.display(),
-                info.shard(),
-                mine.len(),
-                expected - mine.len() as u64,
-                info.shard(),
-                dir.display()
-            );
-        }
+        check_shard_complete(dir, info, mine.len() as u64)?;
         points.extend(mine);
     }
     let merged = SweepInfo::new(first.space.clone(), 0, 1);

@@ -1,9 +1,15 @@
-//! The optimiser's text: why nothing meets a budget (every algorithm's floor, the closest
+//! The optimiser's text: its answer (the proof, the comparison with the paper's datapath, why
+//! it is minimal) or why nothing meets a budget (every algorithm's floor, the closest
 //! algorithm and configuration searched).
 
 use std::io::Write;
 
-use crate::analysis::optimize::{Closest, OptimizeAll};
+use crate::analysis::budget_expr::Bound;
+use crate::analysis::check::{CheckReport, OutputFigures};
+use crate::analysis::optimize::{Candidate, Closest, Objective, OptimizeAll};
+use crate::cycle::Arch;
+use crate::hdl::cost::{analytic_cost, AnalyticCost, CostFigures, REPORTED_TARGETS};
+use crate::pipeline::Datapath;
 use crate::report::table::{Align, TextTable};
 
 /// Why nothing meets the budget: every algorithm's f64 floor (a table fitted into `width`),
@@ -97,4 +103,153 @@ pub fn write_no_answer(
         }
     }
     Ok(())
+}
+
+/// What `optimize` found and proved, for [`write_answer`] and [`answer_header`].
+pub struct Answer<'a> {
+    /// The search.
+    pub result: &'a OptimizeAll,
+    /// Its cheapest feasible point.
+    pub best: &'a Candidate,
+    /// The answer's datapath (its configuration named `optimized`).
+    pub dp: &'a Datapath,
+    /// The answer's exhaustive check.
+    pub proof: &'a CheckReport,
+    /// What was minimised, and in which unit (`LUTs on ice40`).
+    pub objective: Objective,
+    /// The cost's unit (`LUTs on ice40`).
+    pub unit: &'a str,
+    /// The microarchitecture costed.
+    pub arch: Arch,
+    /// The paper's datapath serving the same exponents, and its output figures.
+    pub paper: (&'a Datapath, &'a OutputFigures),
+    /// Each yosys ceiling of the budget with the answer's yosys figures on its target.
+    pub yosys: &'a [(&'a Bound, CostFigures)],
+}
+
+/// The comment lines the configuration file `optimize` writes begins with: the budget, the
+/// cost and the proof, each line after `first` (the file's own header, `# specfx optimize:`).
+pub fn answer_header(first: &str, a: &Answer<'_>) -> String {
+    let (r, proof) = (a.result, a.proof);
+    format!(
+        "{first} cheapest configuration found for the budget '{}'\n# cost {:.0} {} ({}), {} exhaustive checks; proved by `specfx check`:\n# shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded\n",
+        r.budget,
+        a.best.cost,
+        a.unit,
+        a.objective,
+        r.n_evaluations,
+        proof.shape_total_max_abs,
+        proof.shape_quant_max_abs,
+        proof.out_max_ulp,
+        100.0 * proof.stages[a.dp.stage_out()].correctly_rounded
+    )
+}
+
+/// The answer on the terminal: its yosys figures, the configuration and its cost, the proof,
+/// overflow, the comparison with the paper's datapath (the analytic cost on every target, a
+/// table fitted into `width`), why it is minimal and where it was written (`out`).
+pub fn write_answer(
+    w: &mut impl Write,
+    a: &Answer<'_>,
+    out: &std::path::Path,
+    width: Option<u16>,
+) -> std::io::Result<()> {
+    let (proof, dp) = (a.proof, a.dp);
+    for (b, f) in a.yosys {
+        let t = f.target;
+        writeln!(
+            w,
+            "yosys on {}: {} {}, {} DSPs, {} flip-flops (the budget's {} <= {})",
+            t.name(),
+            f.luts,
+            t.logic_unit(),
+            f.dsps,
+            f.ffs,
+            b.metric,
+            b.limit
+        )?;
+    }
+    let config = dp.config();
+    writeln!(
+        w,
+        "best: k = {}, {}, t {} b {} squares {} out {}: {:.0} {} ({})",
+        config.k,
+        config.variant.name(),
+        config.t.format,
+        config.b.format,
+        config
+            .square
+            .iter()
+            .map(|s| s.format.to_string())
+            .collect::<Vec<_>>()
+            .join("/"),
+        config.out.format,
+        a.best.cost,
+        a.unit,
+        a.objective
+    )?;
+    writeln!(
+        w,
+        "proved by an exhaustive check: shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded",
+        proof.shape_total_max_abs,
+        proof.shape_quant_max_abs,
+        proof.out_max_ulp,
+        100.0 * proof.stages[dp.stage_out()].correctly_rounded
+    )?;
+    // Overflow: a stage left to wrap must never overflow on any input (the exhaustive check
+    // counts every event).
+    let wrapping: Vec<String> = proof
+        .stages
+        .iter()
+        .filter(|s| s.wrapped > 0)
+        .map(|s| format!("{} ({} times)", s.stage, s.wrapped))
+        .collect();
+    if wrapping.is_empty() {
+        writeln!(w, "overflow: no stage wraps on any input (exhaustive)")?;
+    } else {
+        writeln!(
+            w,
+            "overflow: WARNING, these stages wrap on some inputs although the budget holds: {}",
+            wrapping.join(", ")
+        )?;
+    }
+    let (paper, paper_check) = a.paper;
+    let lsb8 = crate::analysis::LSB8;
+    writeln!(
+        w,
+        "against the paper's datapath (baseline: plain, k = 4, same n): shape_total {:.3e} ({:.2} lsb8) against {:.3e} ({:.2} lsb8)",
+        proof.shape_total_max_abs,
+        proof.shape_total_max_abs / lsb8,
+        paper_check.shape_total_max_abs,
+        paper_check.shape_total_max_abs / lsb8
+    )?;
+    writeln!(
+        w,
+        "  analytic cost, {} (the model `specfx cost --analytic-only` prints):",
+        a.arch
+    )?;
+    let mut table = TextTable::new(&[
+        ("target", Align::Left),
+        ("this", Align::Right),
+        ("paper's", Align::Right),
+    ])
+    .indent(4);
+    for target in REPORTED_TARGETS {
+        let show =
+            |c: &AnalyticCost| format!("{} {} {} DSPs {} FFs", c.luts, c.logic_unit, c.dsps, c.ffs);
+        table.row([
+            target.name().to_string(),
+            show(&analytic_cost(dp, a.arch, target)),
+            show(&analytic_cost(paper, a.arch, target)),
+        ]);
+    }
+    table.write(w, width)?;
+    writeln!(
+        w,
+        "why minimal (within this search, not over every possible datapath):"
+    )?;
+    for m in &a.result.minimality {
+        writeln!(w, "  {m}")?;
+    }
+    writeln!(w, "written to {}", out.display())
 }

@@ -163,23 +163,19 @@ fn the_import_reader_sees_code_only() {
 /// External programs have one home: no file of `src/` outside `src/tools/` names
 /// `std::process::Command` (the library receives a tool as a closure; the CLI calls
 /// `specfx::tools`).
-#[test]
-fn only_tools_starts_a_process() {
+/// The code lines (`src/<file>:<line>`) of the files of `src/` outside `allowed` for which
+/// `pred` holds; comment lines are left out.
+fn lines_outside(allowed: &[&str], pred: impl Fn(&str) -> bool) -> Vec<String> {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let tools = src.join("tools");
     let mut found = Vec::new();
     for path in sources(&src) {
-        if path.starts_with(&tools) {
+        if allowed.iter().any(|a| path.starts_with(src.join(a))) {
             continue;
         }
         let text = std::fs::read_to_string(&path).unwrap();
         for (i, line) in text.lines().enumerate() {
             let code = line.trim_start();
-            if code.starts_with("//") {
-                continue;
-            }
-            let process = code.contains("process::") && code.contains("Command");
-            if process || (code.contains("Command::new(") && !code.contains("clap::")) {
+            if !code.starts_with("//") && pred(code) {
                 found.push(format!(
                     "src/{}:{}",
                     path.strip_prefix(&src).unwrap().display(),
@@ -188,8 +184,32 @@ fn only_tools_starts_a_process() {
             }
         }
     }
+    found
+}
+
+#[test]
+fn only_tools_starts_a_process() {
+    let found = lines_outside(&["tools"], |code| {
+        (code.contains("process::") && code.contains("Command"))
+            || (code.contains("Command::new(") && !code.contains("clap::"))
+    });
     assert!(
         found.is_empty(),
         "processes started outside src/tools/: {found:?}"
+    );
+}
+
+/// ARCHITECTURE.md's sixth invariant: in the library, only `tools/` (the programs' work
+/// directories, the synthesis cache) and `output.rs` (result files) touch the file system.
+#[test]
+fn only_tools_and_output_touch_files() {
+    let found = lines_outside(&["tools", "output.rs", "cli", "main.rs"], |code| {
+        ["fs::", "File::", "OpenOptions"]
+            .iter()
+            .any(|p| code.contains(p))
+    });
+    assert!(
+        found.is_empty(),
+        "file system calls outside src/tools/ and src/output.rs: {found:?}"
     );
 }
