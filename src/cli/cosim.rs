@@ -15,7 +15,7 @@ use super::hdl::{write_stimulus, RunOpts};
 use super::Outcome;
 use specfx::golden::{CaseSelection, Order};
 use specfx::hdl::testbench::parse_log;
-use specfx::hdl::{render_parameters, ParamsFormat};
+use specfx::hdl::top_parameters;
 use specfx::nset::NSet;
 use specfx::tools;
 
@@ -131,7 +131,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         ("NVEC".to_string(), stim.n_vectors as i64),
         ("NCYC".to_string(), stim.n_cycles as i64),
     ];
-    params.extend(top_parameters(&dp, args));
+    params.extend(top_parameters(&dp, args.run.arch, args.reset_data));
     if args.lint && !lint_clean(&rtl, &params)? {
         return Ok(Outcome::CheckFailed);
     }
@@ -244,18 +244,6 @@ fn vector_dir(args: &CosimArgs, wd: &std::path::Path) -> Result<PathBuf> {
         &[],
     )?;
     Ok(dir)
-}
-
-/// `specfx_top`'s parameters for `dp` (as `specfx hdl params` gives them).
-fn top_parameters(dp: &specfx::pipeline::Datapath, args: &CosimArgs) -> Vec<(String, i64)> {
-    render_parameters(dp, args.run.arch, args.reset_data, ParamsFormat::Json, "")
-        .parse::<serde_json::Value>()
-        .ok()
-        .and_then(|v| v.as_object().cloned())
-        .expect("render_parameters writes a JSON object of integers")
-        .into_iter()
-        .map(|(k, v)| (k, v.as_i64().expect("integer parameters")))
-        .collect()
 }
 
 /// `verilator --lint-only -Wall` of `specfx_top` and the RTL with the top's parameters (the
