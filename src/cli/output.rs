@@ -94,6 +94,7 @@ pub fn install_interrupt_handler() {
     let _ = ctrlc::set_handler(|| {
         specfx::tools::child::end_all();
         specfx::output::remove_uncommitted();
+        specfx::tools::cache::release_all();
         let hint = RESUME_HINT
             .lock()
             .ok()

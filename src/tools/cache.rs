@@ -83,6 +83,33 @@ impl Drop for Claim {
     fn drop(&mut self) {
         if let Some(f) = &self.file {
             let _ = std::fs::remove_file(f);
+            if let Ok(mut held) = HELD.lock() {
+                held.retain(|h| h != f);
+            }
+        }
+    }
+}
+
+/// A process as a claim names it: its number and its start time (in clock ticks since boot,
+/// from `/proc/<pid>/stat`), or None when there is no such process.
+fn owner_of(pid: u32) -> Option<String> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The command name (field 2) is in parentheses and may hold spaces: fields count from the
+    // last ')'; the start time is field 22.
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let start = rest.split_whitespace().nth(19)?;
+    Some(format!("{pid} {start}"))
+}
+
+/// The claims this process holds, removed by [`release_all`] (an interrupt handler's work).
+static HELD: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Removes every claim this process holds: for an interrupt handler, since the process then
+/// exits without dropping them. (A claim left by a killed process is taken over anyway.)
+pub fn release_all() {
+    if let Ok(held) = HELD.lock() {
+        for f in held.iter() {
+            let _ = std::fs::remove_file(f);
         }
     }
 }
@@ -121,11 +148,14 @@ fn get_or_claim_at(dest: &Path, names: &[&str]) -> Result<Vec<Option<Vec<u8>>>, 
         match created {
             Ok(mut f) => {
                 use std::io::Write as _;
-                let _ = write!(f, "{}", std::process::id());
+                let _ = write!(f, "{}", owner_of(std::process::id()).unwrap_or_default());
                 // The entry may have been kept between the look above and the claim.
                 if let Some(files) = get_at(dest, names) {
                     let _ = std::fs::remove_file(&claim_file);
                     return Ok(files);
+                }
+                if let Ok(mut held) = HELD.lock() {
+                    held.push(claim_file.clone());
                 }
                 return Err(Claim {
                     file: Some(claim_file),
@@ -133,10 +163,14 @@ fn get_or_claim_at(dest: &Path, names: &[&str]) -> Result<Vec<Option<Vec<u8>>>, 
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                 let owner = std::fs::read_to_string(&claim_file).ok();
-                let alive = owner
-                    .as_deref()
-                    .and_then(|t| t.trim().parse::<u32>().ok())
-                    .is_some_and(|pid| Path::new(&format!("/proc/{pid}")).exists());
+                // The claim names its process by number and start time, so a number the
+                // system gave to another process since is not taken for the claimant.
+                let alive = owner.as_deref().is_some_and(|t| {
+                    t.trim()
+                        .split_once(' ')
+                        .and_then(|(pid, _)| pid.parse::<u32>().ok())
+                        .is_some_and(|pid| owner_of(pid).as_deref() == Some(t.trim()))
+                });
                 // A claim being written has no number yet: it gets a few seconds.
                 let unwritten = owner.as_deref().is_none_or(str::is_empty);
                 let old = std::fs::metadata(&claim_file)
@@ -234,11 +268,17 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let dest = tmp.path().join("k");
         // No process has this number (above the kernel's pid limit).
-        std::fs::write(dest.with_extension("claim"), "4194305").unwrap();
+        std::fs::write(dest.with_extension("claim"), "4194305 1").unwrap();
+        let claim = get_or_claim_at(&dest, &["a"]).expect_err("taken over");
+        drop(claim);
+        // This process's number with another start time: the number was given again.
+        let mine = owner_of(std::process::id()).unwrap();
+        let pid = mine.split(' ').next().unwrap();
+        std::fs::write(dest.with_extension("claim"), format!("{pid} 1")).unwrap();
         let claim = get_or_claim_at(&dest, &["a"]).expect_err("taken over");
         assert_eq!(
             std::fs::read_to_string(dest.with_extension("claim")).unwrap(),
-            std::process::id().to_string()
+            owner_of(std::process::id()).unwrap()
         );
         drop(claim);
     }

@@ -166,14 +166,14 @@ fn checkpoints(staging: &Path) -> Vec<String> {
     v
 }
 
-/// The report on two threads, interrupted by SIGTERM while the trade-off is measured, then by
+/// The report on two threads, interrupted by SIGTERM as the error budget starts, then by
 /// SIGKILL while the failures are mapped, and finished by a third run, each run checked on the
 /// way: what it keeps, what it reuses, what it says.
 fn resumed_report() -> Run {
     let dir = tempfile::tempdir().expect("a temporary directory");
     let out = dir.path().join("out");
-    // SIGTERM while the trade-off is measured: the synthesis is finished and kept.
-    let first = interrupt_at(&out, "speed against accuracy", libc::SIGTERM);
+    // SIGTERM as the error budget starts: the synthesis is finished and kept.
+    let first = interrupt_at(&out, "error budget of baseline", libc::SIGTERM);
     assert!(
         first.contains("run `specfx report --out") && first.contains("again to resume"),
         "{first}"
