@@ -12,7 +12,7 @@ use specfx::nset::NSet;
 use specfx::output::write_all_in;
 use specfx::pipeline::Datapath;
 use specfx::provenance::Provenance;
-use specfx::report::scene::{material_rows, render_files, write_table, MaterialRow};
+use specfx::report::scene::{material_rows, render_files, write_table, Flips, MaterialRow};
 use specfx::scene::render::{inputs, render_fragments, trace, Fragments};
 use specfx::scene::Scene;
 
@@ -78,9 +78,13 @@ pub fn render_scene(
     );
     let frags = trace_with_progress(scene);
     let r = render_fragments(scene, &frags, dp);
-    let rows = material_rows(scene, &r);
+    let flips = Flips::of(&r);
+    let rows = material_rows(scene, &r, &flips);
     let provenance = Provenance::new(&inputs(scene, dp));
-    write_all_in(out, &render_files(&r, &rows, label, dp, &provenance)?)?;
+    write_all_in(
+        out,
+        &render_files(&r, &flips, &rows, label, dp, &provenance)?,
+    )?;
     Ok(rows)
 }
 

@@ -282,6 +282,7 @@ pub fn table_markdown(rows: &[MaterialRow], bits: u32) -> String {
     s.push_str(&format!("\n{}\n", table_legend(bits)));
     s
 }
+
 /// The files [`render_files`] renders, in its order.
 pub const RENDER_FILES: [&str; 10] = [
     "f64_cos_n.png",
@@ -296,12 +297,30 @@ pub const RENDER_FILES: [&str; 10] = [
     "inputs.csv",
 ];
 
+/// The per-pixel FLIP of a render's datapath image against f64 cos^n (the total error) and
+/// against the f64 model (the quantization), computed once for the table and the maps.
+pub struct Flips {
+    /// Against f64 cos^n.
+    pub total: Vec<f32>,
+    /// Against the f64 model.
+    pub quant: Vec<f32>,
+}
+
+impl Flips {
+    /// The FLIP maps of `r`'s datapath image.
+    pub fn of(r: &Rendered) -> Flips {
+        Flips {
+            total: flip_errors(r, 2, 0),
+            quant: flip_errors(r, 2, 1),
+        }
+    }
+}
+
 /// The error table of a render of `scene` through a datapath: a row per material and one for
 /// the whole image.
-pub fn material_rows(scene: &Scene, r: &Rendered) -> Vec<MaterialRow> {
+pub fn material_rows(scene: &Scene, r: &Rendered, flips: &Flips) -> Vec<MaterialRow> {
     let datapath = 2;
-    let flip_total = flip_errors(r, datapath, 0);
-    let flip_quant = flip_errors(r, datapath, 1);
+    let (flip_total, flip_quant) = (&flips.total, &flips.quant);
     let mut rows: Vec<MaterialRow> = scene
         .materials
         .iter()
@@ -309,15 +328,15 @@ pub fn material_rows(scene: &Scene, r: &Rendered) -> Vec<MaterialRow> {
         .map(|(i, m)| MaterialRow {
             material: m.name.clone(),
             n: m.n,
-            total: image_error(r, datapath, 0, Some(i as u16), &flip_total),
-            quant: image_error(r, datapath, 1, Some(i as u16), &flip_quant),
+            total: image_error(r, datapath, 0, Some(i as u16), flip_total),
+            quant: image_error(r, datapath, 1, Some(i as u16), flip_quant),
         })
         .collect();
     rows.push(MaterialRow {
         material: "all".into(),
         n: 0,
-        total: image_error(r, datapath, 0, None, &flip_total),
-        quant: image_error(r, datapath, 1, None, &flip_quant),
+        total: image_error(r, datapath, 0, None, flip_total),
+        quant: image_error(r, datapath, 1, None, flip_quant),
     });
     rows
 }
@@ -327,6 +346,7 @@ pub fn material_rows(scene: &Scene, r: &Rendered) -> Vec<MaterialRow> {
 /// document (naming the scene `label`), the table's JSON and the datapath's inputs.
 pub fn render_files(
     r: &Rendered,
+    flips: &Flips,
     rows: &[MaterialRow],
     label: &str,
     dp: &Datapath,
@@ -346,14 +366,13 @@ pub fn render_files(
         "diff_vs_f64_model.png".into(),
         heatmap_png(r, &quant, "vs f64 model")?,
     ));
-    let (flip_total, flip_quant) = (flip_errors(r, datapath, 0), flip_errors(r, datapath, 1));
     files.push((
         "flip_vs_cos_n.png".into(),
-        flip_png(r, &flip_total, "vs cos^n")?,
+        flip_png(r, &flips.total, "vs cos^n")?,
     ));
     files.push((
         "flip_vs_f64_model.png".into(),
-        flip_png(r, &flip_quant, "vs f64 model")?,
+        flip_png(r, &flips.quant, "vs f64 model")?,
     ));
     let md = format!(
         "# Render of {} through {}\n\nImages: `f64_cos_n.png` (f64 cos^n, classic coefficient), `f64_model.png` (the f64 model of the datapath's algorithm and coefficient), `datapath.png` (bit-accurate, the fragment's cosine quantized to {}); differences in display LSBs `diff_vs_cos_n.png`, `diff_vs_f64_model.png`, and FLIP maps `flip_vs_cos_n.png`, `flip_vs_f64_model.png`.\n\n\"vs cos^n\" is the total error the viewer sees: the approximation of cos^n by the datapath's algorithm (large near highlights of high n) plus its quantization; \"vs f64 model\" is the quantization alone.\n\n{}\n{}\n",
