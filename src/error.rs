@@ -141,6 +141,13 @@ pub enum Error {
         /// What went wrong, with the operating system's reason.
         message: String,
     },
+    /// An input file or directory that cannot be read or is refused (not a regular file, too
+    /// large, not UTF-8, a vector directory that does not verify), named by its argument.
+    #[error("{message}")]
+    Input {
+        /// Which input, what is wrong, with the operating system's reason.
+        message: String,
+    },
     /// A VCD trace that cannot be read, or lacks what a comparison needs.
     #[error("{problem}")]
     Trace {

@@ -26,6 +26,7 @@ pub mod error;
 pub mod fixed;
 pub mod golden;
 pub mod hdl;
+pub mod input;
 mod names;
 pub mod nset;
 pub mod output;

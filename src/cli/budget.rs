@@ -104,7 +104,7 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
             b.metric
         ));
     }
-    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
     let ns: Vec<u32> = dp.constants().iter().map(|c| c.n).collect();
     let gappa_n = match &args.gappa_n {
         _ if args.no_gappa => None,

@@ -63,7 +63,7 @@ pub fn load_records(path: &Path) -> Result<Vec<Record>> {
     }
     let shown = path.display().to_string();
     // A record is about a kilobyte: --count's largest sample is about 110 MB.
-    let bytes = super::input::read_bytes(path, &shown, super::input::MAX_BINARY_BYTES)?;
+    let bytes = specfx::input::read_bytes(path, &shown, specfx::input::MAX_BINARY_BYTES)?;
     let text = String::from_utf8(bytes).map_err(|e| {
         anyhow::anyhow!(
             "{shown}: expected UTF-8 text, got an invalid byte at offset {}",

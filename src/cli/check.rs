@@ -25,7 +25,7 @@ pub struct CheckArgs {
 
 /// Runs `specfx check`.
 pub fn run(args: &CheckArgs) -> Result<Outcome> {
-    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
     let report = check(&dp).map_err(|e| anyhow!("config {}: {e}", args.config))?;
     if args.json {
         print_json(&report)?;

@@ -108,7 +108,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     let work = tools::child::work_dir("cosim").context("cannot create a work directory")?;
     let wd = work.path();
     let vectors = vector_dir(args, wd)?;
-    let opened = super::vectordir::open(&vectors)?;
+    let opened = specfx::input::open_vectors(&vectors)?;
     let dp = specfx::pipeline::Datapath::new(opened.config.clone())
         .context("the manifest's configuration")?;
     // The --vcd directory is made with the model's trace, once the stimulus is known to fit.
@@ -197,7 +197,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
 /// replaced, other files of those names only with --force, never an input.
 fn check_vcd_output(args: &CosimArgs) -> Result<()> {
     if let (Some(vcd), Some(v)) = (&args.vcd, &args.vectors) {
-        let vector_dir = super::vectordir::dir_of(v);
+        let vector_dir = specfx::input::dir_of(v);
         specfx::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
     }
     if let Some(dir) = args.vcd.as_ref().filter(|d| !d.is_dir()) {
@@ -232,7 +232,7 @@ fn vector_dir(args: &CosimArgs, wd: &std::path::Path) -> Result<PathBuf> {
         }
         return Ok(dir.clone());
     }
-    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
     let dir = wd.join("vectors");
     super::vectors::write_dir(
         &dp,

@@ -64,7 +64,7 @@ pub fn run(args: &CostArgs) -> Result<Outcome> {
         }
     }
     let device = args.device.unwrap_or(specfx::hdl::pnr::Device::Up5k);
-    let dp = super::datapath::load(&args.config, None)?;
+    let dp = specfx::input::load_datapath(&args.config, None)?;
     let dir = if args.analytic_only {
         hdl_ref_dir(args.hdl_ref.as_deref())
     } else {

@@ -109,7 +109,7 @@ pub fn run(args: &FitArgs) -> Result<Outcome> {
 
 /// The generic datapath: `config`, its n set widened to hold the scene's exponents.
 fn generic_datapath(config: &str, scene: &Scene) -> Result<Datapath> {
-    let dp = super::datapath::load(config, None)?;
+    let dp = specfx::input::load_datapath(config, None)?;
     let ns = scene.exponents();
     if ns.iter().all(|n| dp.config().n.values().contains(n)) {
         return Ok(dp);
@@ -120,7 +120,10 @@ fn generic_datapath(config: &str, scene: &Scene) -> Result<Datapath> {
         .n
         .max()
         .max(*ns.last().expect("a scene has materials"));
-    super::datapath::load(config, Some(&NSet::range(lo, hi)?))
+    Ok(specfx::input::load_datapath(
+        config,
+        Some(&NSet::range(lo, hi)?),
+    )?)
 }
 
 /// Costs a datapath and its ROM on a target, with yosys unless `analytic_only`.

@@ -45,7 +45,7 @@ pub struct FurnaceArgs {
 /// Runs `specfx furnace`.
 pub fn run(args: &FurnaceArgs) -> Result<Outcome> {
     let angles = parse_angles(&args.angles).context("--angles")?;
-    let dp = super::datapath::load(&args.config, None)?;
+    let dp = specfx::input::load_datapath(&args.config, None)?;
     let settings = FurnaceSettings::new(&dp, args.n.as_ref(), angles)
         .with_context(|| format!("config {}", args.config))?;
     let out_dir = specfx::output::OutDir::begin(

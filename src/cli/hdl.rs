@@ -152,7 +152,7 @@ pub fn run(args: &HdlArgs) -> Result<Outcome> {
 }
 
 fn rom(args: &RomArgs) -> Result<Outcome> {
-    let dp = super::datapath::load(&args.config, None)?;
+    let dp = specfx::input::load_datapath(&args.config, None)?;
     let out = Output {
         path: args.out.as_deref(),
         inputs: super::output::inputs(&args.config, None),
@@ -194,8 +194,8 @@ fn print_or_write(out: Output, text: &str) -> Result<Outcome> {
 
 fn params(args: &ParamsArgs) -> Result<Outcome> {
     let dp = match &args.vectors {
-        Some(dir) => super::datapath::load_vectors(dir)?,
-        None => super::datapath::load(&args.config, None)?,
+        Some(dir) => specfx::input::load_vectors(dir)?,
+        None => specfx::input::load_datapath(&args.config, None)?,
     };
     let text = render_parameters(
         &dp,
@@ -254,7 +254,7 @@ pub struct StimulusInfo {
 /// ([`cosim_stimulus`]), all files or none; with `vcd`, also the model's trace of that run to
 /// that file.
 pub fn write_stimulus(
-    vectors: &super::vectordir::VectorDir,
+    vectors: &specfx::input::VectorDir,
     run: RunOpts,
     out: &Path,
     vcd: Option<&Path>,
@@ -304,7 +304,7 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
     // The stimulus goes into a directory of its own, never into the vector directory it
     // reads; an earlier stimulus there (its stim.json) is replaced, other files of the same
     // names only with --force. The outputs are checked before the vectors are read.
-    let vector_dir = super::vectordir::dir_of(&args.vectors);
+    let vector_dir = specfx::input::dir_of(&args.vectors);
     specfx::output::refuse_inside_input_dir(&args.out, "--out", &vector_dir, "--vectors")?;
     if let Some(vcd) = &args.vcd {
         specfx::output::refuse_inside_input_dir(vcd, "--vcd", &vector_dir, "--vectors")?;
@@ -330,7 +330,7 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
             args.force,
         )?;
     }
-    let vectors = super::vectordir::open(&args.vectors)?;
+    let vectors = specfx::input::open_vectors(&args.vectors)?;
     let s = write_stimulus(&vectors, args.run, &args.out, args.vcd.as_deref())?;
     super::output::outln!(
         "{} vectors over {} cycles ({}, latency {}..{})",

@@ -13,7 +13,6 @@ pub mod fit;
 pub mod furnace;
 mod hdl;
 mod hdl_ref;
-mod input;
 mod logging;
 mod optimize;
 mod output;
@@ -31,7 +30,6 @@ mod terminal;
 mod throughput;
 mod trace;
 pub mod tradeoff;
-mod vectordir;
 pub mod vectors;
 
 use std::process::ExitCode;

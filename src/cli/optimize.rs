@@ -67,7 +67,7 @@ pub struct OptimizeArgs {
 
 /// Runs `specfx optimize`. Exit code 1 when no configuration meets the budget.
 pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
-    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
     specfx::output::check_file_output(
         &args.out,
         "--out",

@@ -119,7 +119,7 @@ pub fn config_input(arg: &str) -> Vec<PathBuf> {
     if !is_vectors {
         return vec![path.to_path_buf()];
     }
-    let dir = super::vectordir::dir_of(path);
+    let dir = specfx::input::dir_of(path);
     let manifest = dir.join("manifest.json");
     let listed: Vec<PathBuf> = fs::read_to_string(&manifest)
         .ok()

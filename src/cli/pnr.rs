@@ -37,7 +37,7 @@ pub struct TimingArgs {
 
 /// Runs `specfx timing`.
 pub fn run(args: &TimingArgs) -> Result<Outcome> {
-    let dp = super::datapath::load(&args.config, None)?;
+    let dp = specfx::input::load_datapath(&args.config, None)?;
     let dir = hdl_ref(args.hdl_ref.as_deref())?;
     tools::yosys::check()?;
     let t = tools::nextpnr::place_and_route(&dp, args.arch, args.device, &dir)?;

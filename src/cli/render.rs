@@ -41,7 +41,7 @@ pub struct RenderArgs {
 pub fn run(args: &RenderArgs) -> Result<Outcome> {
     let (scene, label) = load_scene(args.scene.as_deref())?;
     let ns = NSet::from_values(&scene.exponents())?;
-    let dp: Datapath = super::datapath::load(&args.config, Some(&ns))?;
+    let dp: Datapath = specfx::input::load_datapath(&args.config, Some(&ns))?;
     let out_dir = specfx::output::OutDir::begin(
         &args.out,
         "render",
@@ -107,15 +107,15 @@ pub fn load_scene(path: Option<&Path>) -> Result<(Scene, String)> {
     let scene = match path {
         None => Scene::default_scene(),
         Some(path) => {
-            let text = super::input::read_text(path, &format!("scene {}", path.display()))?;
+            let text = specfx::input::read_text(path, &format!("scene {}", path.display()))?;
             // Mesh files are named relative to the scene file.
             let dir = path.parent().map(|d| d.to_path_buf()).unwrap_or_default();
             let load = |file: &str| {
                 let p = dir.join(file);
-                super::input::read_bytes(
+                specfx::input::read_bytes(
                     &p,
                     &p.display().to_string(),
-                    super::input::MAX_BINARY_BYTES,
+                    specfx::input::MAX_BINARY_BYTES,
                 )
                 .map_err(|e| std::io::Error::other(format!("{e:#}")))
             };

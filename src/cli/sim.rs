@@ -72,7 +72,7 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
     if !(1..=MAX_CYCLES).contains(&args.cycles) {
         bail!("--cycles: expected 1..={MAX_CYCLES}, got {}", args.cycles);
     }
-    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
     if let Some(path) = &args.vcd {
         specfx::output::check_file_output(
             path,

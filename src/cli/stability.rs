@@ -100,7 +100,7 @@ fn select_paths(args: &StabilityArgs) -> Result<Vec<MapPath>> {
         );
     } else {
         for arg in &args.config {
-            let dp = super::datapath::load(arg, None)?;
+            let dp = specfx::input::load_datapath(arg, None)?;
             let mut config = dp.config().clone();
             let name = unique_name(&config.name, &paths);
             if name != config.name {

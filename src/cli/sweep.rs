@@ -61,7 +61,7 @@ fn read_info(dir: &Path) -> Result<SweepInfo> {
     if !path.exists() && !path.is_symlink() {
         bail!("{}: not a sweep directory (no space.json)", dir.display());
     }
-    let text = super::input::read_text(&path, &path.display().to_string())?;
+    let text = specfx::input::read_text(&path, &path.display().to_string())?;
     Ok(SweepInfo::from_json(
         &text,
         &path.display().to_string(),
@@ -79,7 +79,7 @@ fn read_log(dir: &Path, info: &SweepInfo, how: LogUse) -> Result<BTreeMap<u64, P
     if !path.exists() && !path.is_symlink() {
         return Ok(BTreeMap::new());
     }
-    let bytes = super::input::read_bytes(&path, &path.display().to_string(), MAX_LOG_BYTES)?;
+    let bytes = specfx::input::read_bytes(&path, &path.display().to_string(), MAX_LOG_BYTES)?;
     let text = String::from_utf8_lossy(&bytes);
     let (map, good) = info.read_points(&text, &path.display().to_string(), how)?;
     if how == LogUse::Resume && good.len() != text.len() {
@@ -101,7 +101,7 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
         None => Space::builtin(),
         Some(space_path) => {
             let text =
-                super::input::read_text(space_path, &format!("space {}", space_path.display()))?;
+                specfx::input::read_text(space_path, &format!("space {}", space_path.display()))?;
             Space::from_toml(&text).with_context(|| format!("space {}", space_path.display()))?
         }
     };
@@ -221,7 +221,7 @@ fn synthesise_front(
     }
     let path = dir.join(format!("yosys-{target}.jsonl"));
     let text = if path.exists() || path.is_symlink() {
-        super::input::read_text(&path, &path.display().to_string())?
+        specfx::input::read_text(&path, &path.display().to_string())?
     } else {
         String::new()
     };

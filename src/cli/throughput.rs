@@ -45,7 +45,7 @@ struct Measured {
 
 /// Runs `specfx throughput`.
 pub fn run(args: &ThroughputArgs) -> Result<Outcome> {
-    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = args.threads {
         pool = pool.num_threads(t as usize);

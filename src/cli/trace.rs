@@ -83,7 +83,7 @@ pub fn compare_files(first: &Path, second: &Path, options: &Options) -> Result<C
     let paths = [first, second];
     let open = |p: &Path| -> Result<BufReader<File>> {
         let what = format!("trace {}", p.display());
-        super::input::check_regular_file(p, &what)?;
+        specfx::input::check_regular_file(p, &what)?;
         Ok(BufReader::new(
             File::open(p).with_context(|| format!("{what}: cannot open it"))?,
         ))

@@ -53,7 +53,7 @@ pub struct VectorsArgs {
 
 /// Runs `specfx vectors`.
 pub fn run(args: &VectorsArgs) -> Result<Outcome> {
-    let dp = super::datapath::load(&args.config, args.n.as_ref())?;
+    let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
     let (n, coverage) = write_dir(
         &dp,
         &args.out,
