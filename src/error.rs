@@ -148,6 +148,13 @@ pub enum Error {
         /// Which input, what is wrong, with the operating system's reason.
         message: String,
     },
+    /// An evaluation asked outside the datapath's domain: an n not in the configuration's set,
+    /// a code outside the input format, arrays of different lengths.
+    #[error("{message}")]
+    Domain {
+        /// Which input and what was expected.
+        message: String,
+    },
     /// A VCD trace that cannot be read, or lacks what a comparison needs.
     #[error("{problem}")]
     Trace {

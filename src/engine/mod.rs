@@ -9,6 +9,8 @@
 //! **Invariant:** no I/O and no wall-clock time here: the same datapath gives the same values
 //! on any machine and with any number of threads.
 
+pub mod pairs;
+
 use std::ops::Range;
 
 use rayon::prelude::*;

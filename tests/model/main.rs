@@ -16,5 +16,6 @@ mod furnace;
 mod layers;
 mod minimax;
 mod oracle;
+mod pairs;
 mod paper;
 mod properties;
