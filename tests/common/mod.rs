@@ -155,3 +155,27 @@ radius = 1.0
 "#
     )
 }
+
+/// The directory holding the C library `libspecfx_c.a`/`.so` (capi/) of this build profile:
+/// the test binary's `target/<profile>/`. `cargo test` and `./scripts/test` build it with the
+/// tests; a test needing it fails with one clear line when it is missing.
+#[allow(dead_code)]
+pub fn capi_dir() -> std::path::PathBuf {
+    let exe = std::env::current_exe().expect("the test binary's path");
+    let dir = exe
+        .parent()
+        .and_then(|deps| deps.parent())
+        .expect("target/<profile>/deps/<test>")
+        .to_path_buf();
+    assert!(
+        dir.join("libspecfx_c.a").is_file(),
+        "{}: no libspecfx_c.a; build the C library with `cargo build -p specfx-capi --profile test` (a plain `cargo test` builds it)",
+        dir.display()
+    );
+    dir
+}
+
+/// The flags that link a program against `libspecfx_c.a` (rustc's native-static-libs: the
+/// C++ of nv-flip needs libstdc++).
+#[allow(dead_code)]
+pub const CAPI_LINK_FLAGS: &[&str] = &["-lstdc++", "-lpthread", "-lm", "-ldl"];

@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod c_abi;
 mod calibration;
 mod cli_hw;
 mod cocotb;
