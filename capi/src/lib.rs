@@ -17,7 +17,10 @@
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, c_longlong, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Arc;
 
+use specfx::cycle::lockstep::Lockstep;
+use specfx::cycle::Arch;
 use specfx::engine::pairs::{self, Ns};
 use specfx::pipeline::{Datapath, MAX_STAGES};
 
@@ -42,7 +45,7 @@ pub const SPECFX_COEF: c_int = 3;
 /// A validated datapath: made by `specfx_open` or `specfx_from_toml`, freed by
 /// `specfx_free`.
 pub struct specfx_model {
-    dp: Datapath,
+    dp: Arc<Datapath>,
     /// The stages' names, for `specfx_stage_name`.
     names: Vec<CString>,
 }
@@ -136,7 +139,10 @@ fn boxed(dp: Datapath) -> *mut specfx_model {
         .iter()
         .map(|s| CString::new(s.name.as_str()).unwrap_or_default())
         .collect();
-    Box::into_raw(Box::new(specfx_model { dp, names }))
+    Box::into_raw(Box::new(specfx_model {
+        dp: Arc::new(dp),
+        names,
+    }))
 }
 
 fn n_of(n: c_int) -> Result<u32, String> {
@@ -285,7 +291,10 @@ pub extern "C" fn specfx_constants_of(
     out: *mut specfx_constants,
 ) -> c_int {
     guard(SPECFX_ERROR, || {
-        let nc = pairs::constants_of(&deref(model)?.dp, n, "n").map_err(|e| e.to_string())?;
+        let nc = deref(model)?
+            .dp
+            .constants_checked(n, "n")
+            .map_err(|e| e.to_string())?;
         let c = specfx_constants {
             n: nc.n,
             slope: nc.slope_raw,
@@ -450,18 +459,21 @@ pub extern "C" fn specfx_dpi_constant(
     value: *mut c_longlong,
 ) -> c_int {
     guard(SPECFX_ERROR, || {
-        let nc =
-            pairs::constants_of(&dpi_model(model)?.dp, n_of(n)?, "n").map_err(|e| e.to_string())?;
-        let v =
-            match which {
-                SPECFX_SLOPE => nc.slope_raw,
-                SPECFX_OFFSET => nc.offset_raw,
-                SPECFX_THRESHOLD => nc.threshold.unwrap_or(0),
-                SPECFX_COEF => nc.coef_raw,
-                _ => return Err(format!(
+        let nc = dpi_model(model)?
+            .dp
+            .constants_checked(n_of(n)?, "n")
+            .map_err(|e| e.to_string())?;
+        let v = match which {
+            SPECFX_SLOPE => nc.slope_raw,
+            SPECFX_OFFSET => nc.offset_raw,
+            SPECFX_THRESHOLD => nc.threshold.unwrap_or(0),
+            SPECFX_COEF => nc.coef_raw,
+            _ => {
+                return Err(format!(
                     "which = {which}: expected 0 (slope), 1 (offset), 2 (threshold) or 3 (coef)"
-                )),
-            };
+                ))
+            }
+        };
         put(value, v, "value")?;
         Ok(SPECFX_OK)
     })
@@ -498,6 +510,106 @@ pub extern "C" fn specfx_dpi_probe(
         let p = pairs::eval_one(&m.dp, c, n_of(n)?).map_err(|e| e.to_string())?;
         put(value, p.values[s], "value")?;
         put(event, c_int::from(pairs::event_code(p.events[s])), "event")?;
+        Ok(SPECFX_OK)
+    })
+}
+
+/// DPI: the first input code of `n` the cutoff does not force to zero, where the
+/// configuration proves the cut codes are a prefix (else the smallest code): a boundary a
+/// constrained-random testbench aims at.
+#[unsafe(no_mangle)]
+pub extern "C" fn specfx_dpi_first_live(
+    model: *mut c_void,
+    n: c_int,
+    code: *mut c_longlong,
+) -> c_int {
+    guard(SPECFX_ERROR, || {
+        let dp = &dpi_model(model)?.dp;
+        let nc = dp
+            .constants_checked(n_of(n)?, "n")
+            .map_err(|e| e.to_string())?;
+        let codes = dp.input_codes();
+        put(
+            code,
+            dp.first_live_code(nc, *codes.start()..*codes.end() + 1),
+            "code",
+        )?;
+        Ok(SPECFX_OK)
+    })
+}
+
+/// The cycle model of one architecture, stepped in lockstep with a simulation of
+/// `specfx_top` (made by `specfx_dpi_machine_new`, freed by `specfx_dpi_machine_free`).
+pub struct specfx_machine {
+    dp: Arc<Datapath>,
+    lockstep: Lockstep,
+}
+
+/// DPI: a cycle model of `arch` (0 pipelined, 1 folded, as `specfx_top`'s `ARCH`) for the
+/// model, empty as after reset; null on failure. It keeps the model's datapath alive.
+#[unsafe(no_mangle)]
+pub extern "C" fn specfx_dpi_machine_new(model: *mut c_void, arch: c_int) -> *mut c_void {
+    guard(std::ptr::null_mut(), || {
+        let dp = dpi_model(model)?.dp.clone();
+        let arch = match arch {
+            0 => Arch::Pipelined,
+            1 => Arch::Folded,
+            _ => {
+                return Err(format!(
+                    "arch = {arch}: expected 0 (pipelined) or 1 (folded)"
+                ))
+            }
+        };
+        let lockstep = Lockstep::new(&dp, arch);
+        Ok(Box::into_raw(Box::new(specfx_machine { dp, lockstep })) as *mut c_void)
+    })
+}
+
+/// DPI: frees a cycle model (null is ignored).
+#[unsafe(no_mangle)]
+pub extern "C" fn specfx_dpi_machine_free(machine: *mut c_void) {
+    if !machine.is_null() {
+        // SAFETY: made by Box::into_raw in specfx_dpi_machine_new, freed once.
+        drop(unsafe { Box::from_raw(machine as *mut specfx_machine) });
+    }
+}
+
+/// DPI: one clock cycle of the cycle model. Given this cycle's `in_valid` (with the input
+/// `c`, `n` it offers) and `out_ready`, writes what `specfx_top`'s ports must show during the
+/// cycle (`in_ready`, `out_valid`, `out_data`, and `out_tag`, the 0-based number of the input
+/// the output belongs to), then takes the clock edge.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub extern "C" fn specfx_dpi_machine_cycle(
+    machine: *mut c_void,
+    in_valid: c_int,
+    c: c_longlong,
+    n: c_int,
+    out_ready: c_int,
+    in_ready: *mut c_int,
+    out_valid: *mut c_int,
+    out_data: *mut c_longlong,
+    out_tag: *mut c_longlong,
+) -> c_int {
+    guard(SPECFX_ERROR, || {
+        // SAFETY: a non-null pointer from specfx_dpi_machine_new, not freed, used by one
+        // thread at a time (the caller's contract).
+        let m = unsafe { (machine as *mut specfx_machine).as_mut() }
+            .ok_or("machine: a null pointer, expected a cycle model")?;
+        let input = if in_valid != 0 {
+            Some((c, n_of(n)?))
+        } else {
+            None
+        };
+        let ports = m
+            .lockstep
+            .cycle(&m.dp, input, out_ready != 0)
+            .map_err(|e| e.to_string())?;
+        put(in_ready, c_int::from(ports.in_ready), "in_ready")?;
+        put(out_valid, c_int::from(ports.out.is_some()), "out_valid")?;
+        let (tag, data) = ports.out.unwrap_or((0, 0));
+        put(out_data, data, "out_data")?;
+        put(out_tag, tag as c_longlong, "out_tag")?;
         Ok(SPECFX_OK)
     })
 }

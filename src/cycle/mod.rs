@@ -24,6 +24,7 @@
 //! **Invariant:** no I/O here; the VCD writer renders into any `io::Write`.
 
 pub mod compare;
+pub mod lockstep;
 pub mod rtl;
 pub mod sim;
 pub mod stimulus;

@@ -29,31 +29,6 @@ fn domain(message: String) -> Error {
     Error::Domain { message }
 }
 
-/// The constants of `n`, or the error naming the input (`what`, e.g. `n` or `n[3]`).
-pub fn constants_of<'a>(dp: &'a Datapath, n: u32, what: &str) -> Result<&'a NConstants, Error> {
-    dp.constants_for(n).ok_or_else(|| {
-        domain(format!(
-            "{what} = {n} is not in the configuration's exponent set {}",
-            dp.config().n
-        ))
-    })
-}
-
-/// Refuses a code outside the input format (`what` names it, e.g. `c` or `c[3]`).
-pub fn check_code(dp: &Datapath, c_raw: i64, what: &str) -> Result<(), Error> {
-    let codes = dp.input_codes();
-    if codes.contains(&c_raw) {
-        Ok(())
-    } else {
-        Err(domain(format!(
-            "{what} = {c_raw} is not a code of the input format {} (expected {}..={})",
-            dp.config().c.format,
-            codes.start(),
-            codes.end()
-        )))
-    }
-}
-
 /// Every stage's probe and event for one pair, the pair checked first.
 ///
 /// # Examples
@@ -68,8 +43,8 @@ pub fn check_code(dp: &Datapath, c_raw: i64, what: &str) -> Result<(), Error> {
 /// );
 /// ```
 pub fn eval_one(dp: &Datapath, c_raw: i64, n: u32) -> Result<Probes, Error> {
-    let nc = constants_of(dp, n, "n")?;
-    check_code(dp, c_raw, "c")?;
+    let nc = dp.constants_checked(n, "n")?;
+    dp.check_code(c_raw, "c")?;
     Ok(dp.eval(c_raw, nc))
 }
 
@@ -78,10 +53,10 @@ pub fn eval_one(dp: &Datapath, c_raw: i64, n: u32) -> Result<Probes, Error> {
 fn check_pairs(dp: &Datapath, cs: &[i64], ns: Ns) -> Result<(Vec<u32>, u32), Error> {
     let codes = dp.input_codes();
     if let Some(i) = cs.iter().position(|c| !codes.contains(c)) {
-        check_code(dp, cs[i], &format!("c[{i}]"))?;
+        dp.check_code(cs[i], &format!("c[{i}]"))?;
     }
     let index = |n: u32, what: &str| -> Result<u32, Error> {
-        constants_of(dp, n, what)?;
+        dp.constants_checked(n, what)?;
         Ok(dp.config().n.values().binary_search(&n).unwrap_or(0) as u32)
     };
     match ns {

@@ -572,6 +572,35 @@ impl Datapath {
             .map(|i| &self.constants[i])
     }
 
+    /// The constants of `n`, or [`Error::Domain`] naming the input (`what`, e.g. `n` or
+    /// `n[3]`) when `n` is not in the configuration's set: what a testbench's call is checked
+    /// with.
+    pub fn constants_checked(&self, n: u32, what: &str) -> Result<&NConstants, Error> {
+        self.constants_for(n).ok_or_else(|| Error::Domain {
+            message: format!(
+                "{what} = {n} is not in the configuration's exponent set {}",
+                self.config.n
+            ),
+        })
+    }
+
+    /// Refuses, with [`Error::Domain`], a code outside the input format (`what` names it,
+    /// e.g. `c` or `c[3]`).
+    pub fn check_code(&self, c_raw: i64, what: &str) -> Result<(), Error> {
+        let codes = self.input_codes();
+        if codes.contains(&c_raw) {
+            return Ok(());
+        }
+        Err(Error::Domain {
+            message: format!(
+                "{what} = {c_raw} is not a code of the input format {} (expected {}..={})",
+                self.config.c.format,
+                codes.start(),
+                codes.end()
+            ),
+        })
+    }
+
     /// The raw input code of 1.0.
     pub fn one_code(&self) -> i64 {
         self.one_raw
