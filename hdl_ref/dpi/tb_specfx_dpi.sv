@@ -270,6 +270,7 @@ module tb_specfx_dpi #(
 
     int m_in_ready, m_out_valid;
     longint m_out_data, m_out_tag, want;
+    string how;
     always @(posedge clk) begin
         if (!rst) begin
             // What the ports must show during this cycle, by the cycle model.
@@ -277,10 +278,10 @@ module tb_specfx_dpi #(
                                          m_in_ready, m_out_valid, m_out_data, m_out_tag) != 0)
                 die("the cycle model");
             if (in_ready !== m_in_ready[0])
-                fail($sformatf("cycle %0d: in_ready=%b, the cycle model says %0d", cycle,
+                fail($sformatf("protocol: cycle %0d: in_ready=%b, the cycle model says %0d", cycle,
                                in_ready, m_in_ready));
             if (out_valid !== m_out_valid[0])
-                fail($sformatf("cycle %0d: out_valid=%b, the cycle model says %0d", cycle,
+                fail($sformatf("protocol: cycle %0d: out_valid=%b, the cycle model says %0d", cycle,
                                out_valid, m_out_valid));
             if (held && (!out_valid || out_data !== held_data))
                 fail($sformatf("protocol: out_valid/out_data changed while stalled, cycle=%0d",
@@ -300,17 +301,17 @@ module tb_specfx_dpi #(
             // An output transfer: checked against the head of the queue, and on its cycle.
             if (out_valid && out_ready) begin
                 if (expected.size() == 0) begin
-                    fail($sformatf("cycle %0d: an output with no input left", cycle));
+                    fail($sformatf("unexpected output at cycle %0d: no input is left", cycle));
                 end else begin
                     want = expected.pop_front();
                     if (out_data === want[OUT_W-1:0] && m_out_valid != 0 && m_out_tag == n_out) begin
                         n_passed = n_passed + 1;
                         if (want != 0) n_nonzero = n_nonzero + 1;
                     end else begin
+                        how = (m_out_valid != 0 && m_out_tag == n_out)
+                            ? "agrees on the cycle" : "expects it on another cycle";
                         fail($sformatf("mismatch i=%0d got=%h want=%h cycle=%0d (the cycle model %s)",
-                                       n_out, out_data, want[OUT_W-1:0], cycle,
-                                       (m_out_valid != 0 && m_out_tag == n_out)
-                                           ? "agrees on the cycle" : "expects it on another cycle"));
+                                       n_out, out_data, want[OUT_W-1:0], cycle, how));
                     end
                 end
                 n_out = n_out + 1;

@@ -43,54 +43,68 @@ pub struct CosimArgs {
     /// A vector directory (`specfx vectors --out DIR`). Without it, vectors are written for
     /// --config into the work directory.
     #[arg(long, conflicts_with_all = ["config", "n", "cases"])]
-    vectors: Option<PathBuf>,
+    pub(super) vectors: Option<PathBuf>,
     /// A TOML configuration file or a built-in name (baseline), when no --vectors is given.
     #[arg(long, default_value = "baseline")]
-    config: String,
+    pub(super) config: String,
     /// Exponents, replacing the configuration's set (with --config).
     #[arg(long)]
-    n: Option<NSet>,
+    pub(super) n: Option<NSet>,
     /// Which cases to write (with --config): corner, exhaustive, random:N, comma-separated.
     #[arg(long, default_value = "corner,random:1000")]
-    cases: CaseSelection,
+    pub(super) cases: CaseSelection,
     /// Row order of the vectors written for --config: interleaved (n changes almost every
     /// vector, seeded) or sorted by n then c.
     #[arg(long, default_value = "interleaved", conflicts_with = "vectors")]
-    order: Order,
+    pub(super) order: Order,
     /// The simulator: icarus or verilator. Default: icarus when installed, else verilator.
     #[arg(long)]
-    sim: Option<Simulator>,
+    pub(super) sim: Option<Simulator>,
     #[command(flatten)]
-    run: RunOpts,
+    pub(super) run: RunOpts,
     /// Build the DUT with RESET_DATA = 1 (data registers cleared on reset; the testbench then
     /// also checks that out_data is 0 in the first cycle).
     #[arg(long)]
-    reset_data: bool,
+    pub(super) reset_data: bool,
     /// First lint the DUT with `verilator --lint-only -Wall` (a warning fails the run).
     #[arg(long)]
-    lint: bool,
+    pub(super) lint: bool,
     /// The reference Verilog directory (`rtl/*.v` and `tb/tb_specfx.v`); default: this
     /// repository's hdl_ref/ (or $SPECFX_HDL_REF). Point it at a modified copy to co-simulate
     /// your own RTL behind the same ports.
     #[arg(long)]
-    hdl_ref: Option<PathBuf>,
+    pub(super) hdl_ref: Option<PathBuf>,
     /// Write both traces of the run into this directory, the RTL's (every signal of the
     /// testbench) as rtl.vcd and the model's (under the RTL's names) as model.vcd, and compare
     /// them signal by signal (`specfx trace compare`; exit code 1 when they differ), also
     /// when a vector failed: the first differing cycle and register are printed beside it.
     #[arg(long)]
-    vcd: Option<PathBuf>,
+    pub(super) vcd: Option<PathBuf>,
     /// Replace rtl.vcd and model.vcd in the --vcd directory when they are not an earlier
     /// result of this command.
     #[arg(long)]
-    force: bool,
+    pub(super) force: bool,
     /// Keep the work directory (its path is printed) instead of deleting it.
     #[arg(long)]
-    keep: bool,
+    pub(super) keep: bool,
+    /// Check with the constrained-random testbench `hdl_ref/dpi/tb_specfx_dpi.sv` instead of
+    /// vectors: its scoreboard calls specfx's model through DPI-C for the expected output of
+    /// every input as it is accepted, and the cycle model for its cycle (Verilator only;
+    /// Icarus Verilog has no DPI-C). `--cases random:N` drives N random vectors;
+    /// `--cases exhaustive` every input code of every n, one per cycle.
+    #[arg(long, conflicts_with_all = ["vcd", "lint", "reset_data", "order"])]
+    pub(super) dpi: bool,
+    /// The C library the DPI testbench links (`libspecfx_c.a`); default: $SPECFX_DPI_LIB, or
+    /// the one beside the specfx executable (`cargo build --release` builds it).
+    #[arg(long, requires = "dpi")]
+    pub(super) dpi_lib: Option<PathBuf>,
 }
 
 /// Runs `specfx cosim`. Exit code 1 when a vector failed or nothing was checked.
 pub fn run(args: &CosimArgs) -> Result<Outcome> {
+    if args.dpi {
+        return super::cosim_dpi::run(args);
+    }
     let sim = choose_simulator(args.sim.map(Into::into))?;
     if args.lint && !tools::simulator::Simulator::Verilator.installed() {
         bail!("--lint: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator)");
@@ -265,7 +279,7 @@ fn lint_clean(rtl: &[PathBuf], params: &[(String, i64)]) -> Result<bool> {
 
 /// Prints the testbench's verdict (its problems, then `N passed, N failed`); returns why the
 /// run failed, if it did.
-fn print_verdict(
+pub(super) fn print_verdict(
     verdict: &std::result::Result<specfx::hdl::testbench::Tally, specfx::Error>,
 ) -> Result<Option<String>> {
     Ok(match verdict {
@@ -344,7 +358,7 @@ fn choose_simulator(
 }
 
 /// Every `rtl/*.v` of a reference Verilog directory, sorted.
-fn rtl_sources(hdl: &Path) -> Result<Vec<PathBuf>> {
+pub(super) fn rtl_sources(hdl: &Path) -> Result<Vec<PathBuf>> {
     let mut files = tools::rtl_files(hdl)?;
     // rtl_files ends with specfx_dut.v, the `define top; the co-simulation uses specfx_top.
     files.retain(|f| f.parent().is_some_and(|p| p.ends_with("rtl")));

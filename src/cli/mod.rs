@@ -7,6 +7,7 @@ pub mod budget;
 mod calibrate;
 mod check;
 mod cosim;
+mod cosim_dpi;
 pub mod cost;
 mod datapath;
 pub mod fit;

@@ -1,5 +1,6 @@
-//! The reference testbench's log (`hdl_ref/tb/tb_specfx.v`, in any simulator): its problem
-//! lines and its `N passed, N failed` summary. Fuzzed (`fuzz/fuzz_targets/testbench_log.rs`).
+//! The reference testbenches' log (`hdl_ref/tb/tb_specfx.v` in any simulator, and
+//! `hdl_ref/dpi/tb_specfx_dpi.sv` in Verilator): its problem and coverage lines and its
+//! `N passed, N failed` summary. Fuzzed (`fuzz/fuzz_targets/testbench_log.rs`).
 
 use crate::error::{Error, OneLine};
 
@@ -10,7 +11,8 @@ pub struct Tally {
     pub passed: u64,
     /// Vectors that did not, plus protocol failures.
     pub failed: u64,
-    /// The testbench's problem lines (mismatch, protocol, unexpected, timeout).
+    /// The testbench's problem lines (mismatch, protocol, unexpected, timeout) and its
+    /// coverage line (the DPI testbench's), in log order.
     pub problems: Vec<String>,
 }
 
@@ -23,7 +25,7 @@ pub fn parse_log(log: &str) -> Result<Tally, Error> {
     let problems: Vec<String> = log
         .lines()
         .filter(|l| {
-            ["mismatch", "protocol", "unexpected", "timeout"]
+            ["mismatch", "protocol", "unexpected", "timeout", "coverage:"]
                 .iter()
                 .any(|p| l.starts_with(p))
         })

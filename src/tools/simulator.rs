@@ -71,6 +71,109 @@ pub fn lint(rtl: &[PathBuf], params: &[(String, i64)]) -> Result<Option<String>,
         .then(|| String::from_utf8_lossy(&o.stderr).trim_end().to_string()))
 }
 
+/// Builds a Verilator model of `top` in `wd/obj` (`--binary`'s steps: verilate with a `main`
+/// and timing, then make), `args` being the rest of verilator's command line. Verilator's own
+/// runtime (`verilated*.cpp`, most of a small model's compile time) is compiled once per set
+/// of flags and kept in the synthesis cache (`verilator/<key>`: the objects the makefile
+/// would compile, identical for identical flags, so a build with them is the build without).
+fn verilator_build(wd: &Path, top: &str, args: &[String], makeflags: &[&str]) -> Result<(), Error> {
+    let failed = |o: &Output| {
+        let err = String::from_utf8_lossy(&o.stderr);
+        let first = err
+            .lines()
+            .find(|l| l.contains("%Error") || l.contains("error:"))
+            .unwrap_or("see its output");
+        error("verilator", format!("verilator failed: {}", first.trim()))
+    };
+    let mut cmd = Command::new("verilator");
+    cmd.args([
+        "--cc",
+        "--exe",
+        "--main",
+        "--timing",
+        "--top-module",
+        top,
+        "-Mdir",
+        "obj",
+    ])
+    .args(args);
+    let o = run(&mut cmd, wd, "verilator", "verilator")?;
+    if !o.status.success() {
+        return Err(failed(&o));
+    }
+    let obj = wd.join("obj");
+    let classes =
+        std::fs::read_to_string(obj.join(format!("V{top}_classes.mk"))).unwrap_or_default();
+    // The makefile's settings (VM_TRACE = 0, ...) and the runtime files it compiles.
+    let settings: Vec<&str> = classes
+        .lines()
+        .filter(|l| l.starts_with("VM_") && l.contains(" = "))
+        .collect();
+    let mut globals = Vec::new();
+    let mut in_globals = false;
+    for line in classes.lines() {
+        if line.starts_with("VM_GLOBAL_") {
+            in_globals = true;
+        } else if in_globals && line.starts_with('\t') {
+            globals.push(line.trim().trim_end_matches('\\').trim().to_string());
+        } else {
+            in_globals = false;
+        }
+    }
+    let version = |program: &str| {
+        Command::new(program)
+            .arg("--version")
+            .output()
+            .map(|o| o.stdout)
+            .unwrap_or_default()
+    };
+    let files: Vec<String> = globals
+        .iter()
+        .flat_map(|g| [format!("{g}.o"), format!("{g}.d")])
+        .collect();
+    let names: Vec<&str> = files.iter().map(String::as_str).collect();
+    let key = super::cache::key(&[
+        &version("verilator"),
+        &version("g++"),
+        settings.join("\n").as_bytes(),
+        names.join(" ").as_bytes(),
+        makeflags.join(" ").as_bytes(),
+    ]);
+    let claim = if globals.is_empty() {
+        None
+    } else {
+        match super::cache::get_or_claim("verilator", &key, &names) {
+            Ok(kept) => {
+                for (name, bytes) in names.iter().zip(kept) {
+                    if let Some(bytes) = bytes {
+                        let _ = std::fs::write(obj.join(name), bytes);
+                    }
+                }
+                None
+            }
+            Err(claim) => Some(claim),
+        }
+    };
+    let mut make = Command::new("make");
+    make.args(["-C", "obj", "-f", &format!("V{top}.mk"), "-j", "2"])
+        .args(makeflags);
+    let o = run(&mut make, wd, "verilator", "make")?;
+    if !o.status.success() {
+        return Err(failed(&o));
+    }
+    if let Some(_claim) = claim {
+        let kept: Vec<(&str, Vec<u8>)> = names
+            .iter()
+            .filter_map(|n| std::fs::read(obj.join(n)).ok().map(|b| (*n, b)))
+            .collect();
+        if kept.len() == names.len() {
+            let files: Vec<(&str, &[u8])> = kept.iter().map(|(n, b)| (*n, b.as_slice())).collect();
+            super::cache::put("verilator", &key, &files);
+        }
+    }
+    Ok(())
+}
+
 /// Compiles the testbench `tb` with the `rtl` files and runs it in `wd` (which holds its hex
 /// files) with the testbench's parameters `params` (`-P` for Icarus, `-G` for Verilator),
 /// defining `SPECFX_VCD` when `vcd`; returns the simulation's output (stdout, then stderr).
@@ -107,35 +210,17 @@ pub fn simulate(
             Ok(text(&o))
         }
         Simulator::Verilator => {
-            let mut cmd = Command::new("verilator");
-            cmd.args([
-                "--binary",
-                "-j",
-                "0",
-                "-Wno-fatal",
-                "-Wno-lint",
-                "-Wno-style",
-                "--top-module",
-                "tb_specfx",
-                "-Mdir",
-                "obj",
-            ])
-            .args(params.iter().map(|(k, v)| format!("-G{k}={v}")));
+            let mut args: Vec<String> = ["-Wno-fatal", "-Wno-lint", "-Wno-style"]
+                .iter()
+                .map(|a| a.to_string())
+                .collect();
+            args.extend(params.iter().map(|(k, v)| format!("-G{k}={v}")));
             if vcd {
-                cmd.args(["--trace", "-DSPECFX_VCD"]);
+                args.extend(["--trace".to_string(), "-DSPECFX_VCD".to_string()]);
             }
-            let o = run(cmd.arg(tb).args(rtl), wd, "verilator", "verilator")?;
-            if !o.status.success() {
-                let err = String::from_utf8_lossy(&o.stderr);
-                let first = err
-                    .lines()
-                    .find(|l| l.contains("%Error"))
-                    .unwrap_or("see its output");
-                return Err(error(
-                    "verilator",
-                    format!("verilator failed: {}", first.trim()),
-                ));
-            }
+            args.push(tb.display().to_string());
+            args.extend(rtl.iter().map(|f| f.display().to_string()));
+            verilator_build(wd, "tb_specfx", &args, &[])?;
             let o = run(
                 &mut Command::new(wd.join("obj/Vtb_specfx")),
                 wd,
@@ -145,4 +230,62 @@ pub fn simulate(
             Ok(text(&o))
         }
     }
+}
+
+/// What a DPI-C simulation builds and runs: the testbench `tb_specfx_dpi` (its files, the
+/// package first), the RTL, the C library it links, its parameters and plusargs.
+pub struct DpiRun<'a> {
+    /// `specfx_dpi.sv` and `tb_specfx_dpi.sv`, in that order.
+    pub testbench: &'a [PathBuf],
+    /// `rtl/*.v`.
+    pub rtl: &'a [PathBuf],
+    /// `libspecfx_c.a`.
+    pub library: &'a Path,
+    /// The testbench's parameters (`-G`).
+    pub params: &'a [(String, i64)],
+    /// Its plusargs (`+config=...`, `+seed=...`), without the `+`.
+    pub plusargs: &'a [String],
+    /// Optimize the C++ of the model (`-O2`, slower to build) for a long run; `-O0` otherwise.
+    pub optimize: bool,
+}
+
+/// Builds `tb_specfx_dpi` with Verilator (`--binary`, the C library linked) in `wd` and runs it;
+/// returns its output (stdout, then stderr). Icarus Verilog has no DPI-C support.
+pub fn simulate_dpi(wd: &Path, run_spec: &DpiRun) -> Result<String, Error> {
+    let opt = [
+        if run_spec.optimize {
+            "OPT_FAST=-O2"
+        } else {
+            "OPT_FAST=-O0"
+        },
+        "OPT_SLOW=-O0",
+    ];
+    let mut args: Vec<String> = [
+        "-O3",
+        "--x-assign",
+        "fast",
+        "--x-initial",
+        "fast",
+        "-Wno-fatal",
+        "-Wno-lint",
+        "-Wno-style",
+        "-LDFLAGS",
+        "-lstdc++ -lpthread -ldl -lm",
+    ]
+    .iter()
+    .map(|a| a.to_string())
+    .collect();
+    args.extend(run_spec.params.iter().map(|(k, v)| format!("-G{k}={v}")));
+    args.extend(run_spec.testbench.iter().map(|f| f.display().to_string()));
+    args.extend(run_spec.rtl.iter().map(|f| f.display().to_string()));
+    args.push(run_spec.library.display().to_string());
+    verilator_build(wd, "tb_specfx_dpi", &args, &opt)?;
+    let o = run(
+        Command::new(wd.join("obj/Vtb_specfx_dpi"))
+            .args(run_spec.plusargs.iter().map(|p| format!("+{p}"))),
+        wd,
+        "verilator",
+        "the model",
+    )?;
+    Ok(String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr))
 }
