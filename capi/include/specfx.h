@@ -154,6 +154,40 @@ int specfx_dpi_eval(void *model, long long c, int n, long long *out);
 // one evaluation, the stage indexed like `specfx_stage_name`.
 int specfx_dpi_probe(void *model, long long c, int n, int stage, long long *value, int *event);
 
+// DPI: the first input code of `n` the cutoff does not force to zero, where the
+// configuration proves the cut codes are a prefix (else the smallest code): a boundary a
+// constrained-random testbench aims at.
+int specfx_dpi_first_live(void *model, int n, long long *code);
+
+// DPI: a cycle model of `arch` (0 pipelined, 1 folded, as `specfx_top`'s `ARCH`) for the
+// model, empty as after reset; null on failure. It keeps the model's datapath alive.
+void *specfx_dpi_machine_new(void *model, int arch);
+
+// DPI: frees a cycle model (null is ignored).
+void specfx_dpi_machine_free(void *machine);
+
+// DPI: one clock cycle of the cycle model. Given this cycle's `in_valid` (with the input
+// `c`, `n` it offers) and `out_ready`, writes what `specfx_top`'s ports must show during the
+// cycle (`in_ready`, `out_valid`, `out_data`, and `out_tag`, the 0-based number of the input
+// the output belongs to), then takes the clock edge.
+int specfx_dpi_machine_cycle(void *machine,
+                             int in_valid,
+                             long long c,
+                             int n,
+                             int out_ready,
+                             int *in_ready,
+                             int *out_valid,
+                             long long *out_data,
+                             long long *out_tag);
+
+// DPI: how many directed cases the model has (see `specfx_dpi_directed_at`); -1 on failure.
+// The first call computes them (a search of every stage's rounding boundaries).
+int specfx_dpi_directed_count(void *model);
+
+// DPI: directed case `i`: the cases `specfx vectors` always writes (corners, codes with a
+// non-zero output, every stage's rounding boundaries), interleaved.
+int specfx_dpi_directed_at(void *model, int i, int *n, long long *c);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

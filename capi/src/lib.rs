@@ -48,6 +48,8 @@ pub struct specfx_model {
     dp: Arc<Datapath>,
     /// The stages' names, for `specfx_stage_name`.
     names: Vec<CString>,
+    /// The directed cases, computed on first use.
+    directed: std::sync::OnceLock<Result<Vec<(u32, i64)>, String>>,
 }
 
 /// The constants of one exponent as the datapath stores them.
@@ -142,6 +144,7 @@ fn boxed(dp: Datapath) -> *mut specfx_model {
     Box::into_raw(Box::new(specfx_model {
         dp: Arc::new(dp),
         names,
+        directed: std::sync::OnceLock::new(),
     }))
 }
 
@@ -610,6 +613,58 @@ pub extern "C" fn specfx_dpi_machine_cycle(
         let (tag, data) = ports.out.unwrap_or((0, 0));
         put(out_data, data, "out_data")?;
         put(out_tag, tag as c_longlong, "out_tag")?;
+        Ok(SPECFX_OK)
+    })
+}
+
+/// The directed cases of `specfx vectors` for the model (every n's corner cases: the ends of
+/// the code range, 1.0 and above, every cutoff switch +-1 code; codes with a non-zero output;
+/// the inputs on and next to every stage's rounding boundary), interleaved (seed 1).
+fn directed(m: &specfx_model) -> Result<&[(u32, i64)], String> {
+    m.directed
+        .get_or_init(|| {
+            let sel = specfx::golden::CaseSelection {
+                corner: true,
+                exhaustive: false,
+                random: 0,
+            };
+            let mut cases = specfx::golden::cases::select(&m.dp, &sel, 1)
+                .map_err(|e| e.to_string())?
+                .cases;
+            specfx::golden::cases::order(&mut cases, specfx::golden::Order::Interleaved, 1);
+            Ok(cases)
+        })
+        .as_ref()
+        .map(Vec::as_slice)
+        .map_err(Clone::clone)
+}
+
+/// DPI: how many directed cases the model has (see `specfx_dpi_directed_at`); -1 on failure.
+/// The first call computes them (a search of every stage's rounding boundaries).
+#[unsafe(no_mangle)]
+pub extern "C" fn specfx_dpi_directed_count(model: *mut c_void) -> c_int {
+    guard(SPECFX_ERROR, || {
+        Ok(c_int::try_from(directed(dpi_model(model)?)?.len()).unwrap_or(c_int::MAX))
+    })
+}
+
+/// DPI: directed case `i`: the cases `specfx vectors` always writes (corners, codes with a
+/// non-zero output, every stage's rounding boundaries), interleaved.
+#[unsafe(no_mangle)]
+pub extern "C" fn specfx_dpi_directed_at(
+    model: *mut c_void,
+    i: c_int,
+    n: *mut c_int,
+    c: *mut c_longlong,
+) -> c_int {
+    guard(SPECFX_ERROR, || {
+        let all = directed(dpi_model(model)?)?;
+        let &(nv, cv) = usize::try_from(i)
+            .ok()
+            .and_then(|i| all.get(i))
+            .ok_or_else(|| format!("i = {i} is not a directed case (expected 0..{})", all.len()))?;
+        put(n, nv as c_int, "n")?;
+        put(c, cv, "c")?;
         Ok(SPECFX_OK)
     })
 }

@@ -28,6 +28,11 @@ package specfx_dpi;
     // The first code of n the cutoff does not force to zero (a boundary worth aiming at).
     import "DPI-C" function int specfx_dpi_first_live(input chandle model, input int n,
                                                       output longint code);
+    // The directed cases specfx vectors always writes (corners, codes with a non-zero output,
+    // inputs on and next to every stage's rounding boundary), interleaved: how many, the i-th.
+    import "DPI-C" function int specfx_dpi_directed_count(input chandle model);
+    import "DPI-C" function int specfx_dpi_directed_at(input chandle model, input int i,
+                                                       output int n, output longint c);
     // The output code of input code c and exponent n.
     import "DPI-C" function int specfx_dpi_eval(input chandle model, input longint c,
                                                 input int n, output longint out);

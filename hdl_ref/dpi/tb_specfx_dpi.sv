@@ -6,13 +6,17 @@
 //   +config=ARG    the model, as specfx's --config takes it (a built-in name, a TOML file, a
 //                  vector directory); the same configuration as the parameters
 //   +seed=S        the seed of the stimulus (default 1)
-//   +nvec=N        random vectors to drive (default 10000)
-//   +bubble=P      percent of cycles the source offers nothing (default 25)
+//   +nvec=N        random vectors to drive after the directed ones (default 10000)
+//   +bubble=P      percent of cycles the source does not offer its pending vector (default 25)
 //   +stall=P       percent of cycles out_ready is low (default 25)
-//   +exhaustive    every code of the input format for every n of the configuration (n changing
-//                  on every vector), instead of random vectors; no bubbles or stalls unless given
+//   +exhaustive    every code of the input format up to 1.0 for every n of the configuration
+//                  (n changing on every vector), instead of random vectors (the codes above 1.0
+//                  all clamp to 1.0: the directed vectors hold them); no bubbles or stalls
+//                  unless given
 //
-// Random vectors draw n from the configuration's set on every input, and c uniformly over every
+// The directed vectors come first: the cases `specfx vectors` always writes (every n's corner
+// cases, codes with a non-zero output, inputs on and next to every stage's rounding boundary),
+// interleaved. Random vectors draw n from the configuration's set on every input, and c uniformly over every
 // code, near 1.0 (above it included), on and next to the cutoff's boundary and the paper
 // threshold, at the ends of the code range, and below 1.0. A vector's per-n constants drive
 // in_slope, in_offset, in_threshold and in_coef, as a ROM addressed by n would.
@@ -21,7 +25,8 @@
 // each output transfer is checked against the head of the queue. Every cycle, the cycle model
 // (specfx_dpi_machine_cycle, docs/cycle.md) says what in_ready, out_valid and the output's
 // input number must be, so every output is also checked on its cycle; out_data must hold
-// while out_valid is high and out_ready low (rule 5). Prints the first 10 mismatches, a
+// while out_valid is high and out_ready low (rule 5), and with RESET_DATA = 1 be 0 in cycle 0.
+// Prints the first 10 mismatches, a
 // coverage line, then exactly one line `N passed, N failed` (a vector passes when its output
 // has the expected value on the expected cycle; protocol errors count as failures too).
 `timescale 1ns / 1ps
@@ -85,6 +90,7 @@ module tb_specfx_dpi #(
     // The per-n constants as specfx_top's ports take them, by index into n_values (a ROM).
     longint rom_slope[], rom_offset[], rom_threshold[], rom_coef[];
     longint total;  // vectors to drive
+    int n_directed = 0;
 
     // xorshift64*: the same stream in every simulator.
     function automatic longint unsigned rnd();
@@ -159,14 +165,16 @@ module tb_specfx_dpi #(
             rom_coef[i] = v;
         end
         if (exhaustive) begin
-            if (longint'(c_max - c_min) >= 64'h1_0000_0000) begin
+            if (longint'(c_one - c_min) >= 64'h1_0000_0000) begin
                 $display("specfx_dpi: +exhaustive: %0d input codes is too many to drive",
-                         c_max - c_min + 1);
+                         c_one - c_min + 1);
                 $fatal(1);
             end
-            total = (c_max - c_min + 1) * n_count;
+            total = (c_one - c_min + 1) * n_count;
         end else begin
-            total = nvec;
+            n_directed = specfx_dpi_directed_count(model);
+            if (n_directed < 0) die("the directed cases");
+            total = n_directed + nvec;
         end
     end
 
@@ -218,6 +226,10 @@ module tb_specfx_dpi #(
             idx = int'(drawn % longint'(n_count));
             n = n_values[idx];
             c = c_min + drawn / n_count;
+        end else if (drawn < n_directed) begin
+            if (specfx_dpi_directed_at(model, int'(drawn), n, c) != 0) die("a directed case");
+            idx = 0;
+            while (n_values[idx] != n) idx = idx + 1;
         end else begin
             idx = int'(rnd() % longint'(n_count));
             n = n_values[idx];
@@ -251,6 +263,7 @@ module tb_specfx_dpi #(
     longint n_nonzero = 0, n_stalls = 0, n_bubbles = 0, n_above_one = 0;
     longint n_distinct = 0;
     reg held = 1'b0;
+    bit pending = 0;  // a vector is drawn and has not transferred yet
     reg [OUT_W-1:0] held_data;
 
     task automatic fail(input string what);
@@ -260,8 +273,8 @@ module tb_specfx_dpi #(
     endtask
 
     task automatic finish();
-        $display("coverage: %0d vectors checked, %0d of %0d n, %0d non-zero outputs, %0d stall cycles, %0d bubbles, %0d inputs above 1.0",
-                 n_out, n_distinct, n_count, n_nonzero, n_stalls, n_bubbles, n_above_one);
+        $display("coverage: %0d vectors checked (%0d directed), %0d of %0d n, %0d non-zero outputs, %0d stall cycles, %0d bubbles, %0d inputs above 1.0",
+                 n_out, n_directed, n_distinct, n_count, n_nonzero, n_stalls, n_bubbles, n_above_one);
         $display("%0d passed, %0d failed", n_passed, n_failed);
         specfx_dpi_machine_free(machine);
         specfx_dpi_free(model);
@@ -283,6 +296,9 @@ module tb_specfx_dpi #(
             if (out_valid !== m_out_valid[0])
                 fail($sformatf("protocol: cycle %0d: out_valid=%b, the cycle model says %0d", cycle,
                                out_valid, m_out_valid));
+            if (RESET_DATA != 0 && cycle == 0 && out_data !== {OUT_W{1'b0}})
+                fail($sformatf("protocol: out_data=%h after reset with RESET_DATA=1, want 0",
+                               out_data));
             if (held && (!out_valid || out_data !== held_data))
                 fail($sformatf("protocol: out_valid/out_data changed while stalled, cycle=%0d",
                                cycle));
@@ -317,15 +333,18 @@ module tb_specfx_dpi #(
                 n_out = n_out + 1;
                 if (n_out >= total) finish();
             end
-            // The next cycle's stimulus.
-            if (!in_valid || in_ready) begin
-                if (drawn < total && percent() >= bubble) begin
-                    next_vector();
-                    in_valid <= 1'b1;
-                end else begin
-                    if (drawn < total) n_bubbles = n_bubbles + 1;
-                    in_valid <= 1'b0;
-                end
+            // The next cycle's stimulus: the pending vector (drawn once its predecessor has
+            // transferred, held until it transfers) is offered or not, cycle by cycle.
+            if (in_valid && in_ready) pending = 0;
+            if (!pending && drawn < total) begin
+                next_vector();
+                pending = 1;
+            end
+            if (pending && percent() >= bubble) begin
+                in_valid <= 1'b1;
+            end else begin
+                if (pending) n_bubbles = n_bubbles + 1;
+                in_valid <= 1'b0;
             end
             out_ready <= percent() >= stall;
             if (total == 0) finish();

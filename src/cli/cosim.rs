@@ -90,9 +90,10 @@ pub struct CosimArgs {
     /// Check with the constrained-random testbench `hdl_ref/dpi/tb_specfx_dpi.sv` instead of
     /// vectors: its scoreboard calls specfx's model through DPI-C for the expected output of
     /// every input as it is accepted, and the cycle model for its cycle (Verilator only;
-    /// Icarus Verilog has no DPI-C). `--cases random:N` drives N random vectors;
-    /// `--cases exhaustive` every input code of every n, one per cycle.
-    #[arg(long, conflicts_with_all = ["vcd", "lint", "reset_data", "order"])]
+    /// Icarus Verilog has no DPI-C). `--cases random:N` drives the directed cases of
+    /// `specfx vectors`, then N random vectors; `--cases exhaustive` every input code up to 1.0
+    /// of every n, one per cycle.
+    #[arg(long, conflicts_with_all = ["vcd", "lint", "order"])]
     pub(super) dpi: bool,
     /// The C library the DPI testbench links (`libspecfx_c.a`); default: $SPECFX_DPI_LIB, or
     /// the one beside the specfx executable (`cargo build --release` builds it).

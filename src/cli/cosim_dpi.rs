@@ -65,11 +65,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             "--dpi: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator; ./scripts/test installs it)"
         );
     }
-    for (given, what) in [
-        (args.vcd.is_some(), "--vcd"),
-        (args.lint, "--lint"),
-        (args.reset_data, "--reset-data"),
-    ] {
+    for (given, what) in [(args.vcd.is_some(), "--vcd"), (args.lint, "--lint")] {
         if given {
             bail!("{what} is not available with --dpi (use the vector testbench for it)");
         }
@@ -99,15 +95,19 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     let mut plusargs = vec![
         format!("config={}", config.display()),
         format!("seed={}", run.seed),
+        // Registers without a reset start random (Verilator's seed is never 0: 0 asks it for a
+        // seed of its own).
+        "verilator+rand+reset+2".to_string(),
+        format!("verilator+seed+{}", run.seed % (1 << 31) + 1),
     ];
     let exhaustive = args.cases.exhaustive;
     let what = if exhaustive {
         plusargs.push("exhaustive".to_string());
-        "every input code of every n".to_string()
+        "every input code up to 1.0 of every n".to_string()
     } else {
         let n = args.cases.random.max(1);
         plusargs.push(format!("nvec={n}"));
-        format!("{n} random vectors")
+        format!("the directed vectors and {n} random ones")
     };
     // Exhaustive runs drive one input per cycle (the random runs exercise the handshakes).
     let (bubble, stall) = if exhaustive {
@@ -117,7 +117,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     };
     plusargs.push(format!("bubble={}", percent(bubble)));
     plusargs.push(format!("stall={}", percent(stall)));
-    let params = top_parameters(&dp, run.arch, false);
+    let params = top_parameters(&dp, run.arch, args.reset_data);
     log::info!(
         "cosim --dpi: verilator, {}, {} ({}), seed {}{}",
         run.arch,

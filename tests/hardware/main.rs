@@ -11,6 +11,7 @@ mod calibration;
 mod cli_hw;
 mod cocotb;
 mod cosim;
+mod dpi;
 mod lint;
 mod mutation;
 mod timing;

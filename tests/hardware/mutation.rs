@@ -192,7 +192,7 @@ fn config_arg(config: &str) -> String {
 fn copy_hdl_ref(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("specfx-mutant-{}-{tag}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    for sub in ["rtl", "tb"] {
+    for sub in ["rtl", "tb", "dpi"] {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
         for e in std::fs::read_dir(root().join("hdl_ref").join(sub)).unwrap() {
             let p = e.unwrap().path();
@@ -220,6 +220,31 @@ fn cosim(hdl_ref: &Path, config: &str, arch: &str, flags: &[&str]) -> Output {
         "0.3",
         "--cases",
         "corner,random:600",
+        "--hdl-ref",
+        hdl_ref.to_str().expect("a UTF-8 temporary path"),
+    ];
+    args.extend_from_slice(flags);
+    common::specfx(&args)
+}
+
+/// The DPI scoreboard (`specfx cosim --dpi`, Verilator) on random stimulus.
+fn cosim_dpi(hdl_ref: &Path, config: &str, arch: &str, flags: &[&str]) -> Output {
+    let config = config_arg(config);
+    let mut args = vec![
+        "cosim",
+        "--dpi",
+        "--config",
+        &config,
+        "--arch",
+        arch,
+        "--seed",
+        "7",
+        "--bubble",
+        "0.3",
+        "--stall",
+        "0.3",
+        "--cases",
+        "random:3000",
         "--hdl-ref",
         hdl_ref.to_str().expect("a UTF-8 temporary path"),
     ];
@@ -256,41 +281,68 @@ fn the_unmutated_rtl_passes_on_every_mutation_configuration() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The mutants `run` does not catch (exit code 1 with failed vectors, or no summary at all:
+/// a dead simulation), each with its verdict; two at a time.
+fn escaped(tag: &str, run: fn(&Path, &str, &str, &[&str]) -> Output) -> Vec<String> {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let escaped = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(m) = MUTANTS.get(i) else { break };
+                let dir = copy_hdl_ref(&format!("{tag}{i}"));
+                let path = dir.join(m.file);
+                let text = std::fs::read_to_string(&path).unwrap();
+                assert_eq!(
+                    text.matches(m.from).count(),
+                    1,
+                    "mutant '{}': `{}` must occur exactly once in {}",
+                    m.name,
+                    m.from,
+                    m.file
+                );
+                std::fs::write(&path, text.replace(m.from, m.to)).unwrap();
+                let o = run(&dir, m.config, m.arch, m.flags);
+                let verdict = summary(&o);
+                eprintln!("{tag}: mutant '{}': {:?}", m.name, verdict);
+                let caught =
+                    o.status.code() == Some(1) && verdict.is_none_or(|(_, failed)| failed > 0);
+                if !caught {
+                    escaped.lock().unwrap().push(format!(
+                        "{} (exit {:?}, {:?}): {}",
+                        m.name,
+                        o.status.code(),
+                        verdict,
+                        String::from_utf8_lossy(&o.stderr)
+                    ));
+                }
+                std::fs::remove_dir_all(&dir).unwrap();
+            });
+        }
+    });
+    escaped.into_inner().unwrap()
+}
+
 #[test]
 fn every_mutant_is_caught() {
-    let mut escaped = Vec::new();
-    for (i, m) in MUTANTS.iter().enumerate() {
-        let dir = copy_hdl_ref(&format!("m{i}"));
-        let path = dir.join(m.file);
-        let text = std::fs::read_to_string(&path).unwrap();
-        assert_eq!(
-            text.matches(m.from).count(),
-            1,
-            "mutant '{}': `{}` must occur exactly once in {}",
-            m.name,
-            m.from,
-            m.file
-        );
-        std::fs::write(&path, text.replace(m.from, m.to)).unwrap();
-        let o = cosim(&dir, m.config, m.arch, m.flags);
-        let verdict = summary(&o);
-        eprintln!("mutant '{}': {:?}", m.name, verdict);
-        // Caught: exit code 1 with failed vectors, or no summary at all (a dead simulation).
-        let caught = o.status.code() == Some(1) && verdict.is_none_or(|(_, failed)| failed > 0);
-        if !caught {
-            escaped.push(format!(
-                "{} (exit {:?}, {:?}): {}",
-                m.name,
-                o.status.code(),
-                verdict,
-                String::from_utf8_lossy(&o.stderr)
-            ));
-        }
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
+    let escaped = escaped("m", cosim);
     assert!(
         escaped.is_empty(),
         "mutants not caught:\n{}",
+        escaped.join("\n")
+    );
+}
+
+/// The DPI scoreboard (random stimulus, expected values and cycles from the model through
+/// DPI-C) catches every mutant too; the unmutated RTL passes it in
+/// `tests/hardware/dpi.rs`.
+#[test]
+fn every_mutant_is_caught_by_the_dpi_scoreboard() {
+    let escaped = escaped("dpi", cosim_dpi);
+    assert!(
+        escaped.is_empty(),
+        "mutants the DPI scoreboard does not catch:\n{}",
         escaped.join("\n")
     );
 }
