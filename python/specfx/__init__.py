@@ -1,0 +1,177 @@
+"""specfx: the bit-accurate model of a division-free fixed-point specular (cos^n) datapath.
+
+The same engine as the ``specfx`` command line, for cocotb scoreboards and notebooks::
+
+    import numpy as np, specfx
+    dp = specfx.Datapath("baseline")            # a built-in name, a TOML file or a vector dir
+    dp.eval(32768, 64)                          # one output code (c = 1.0, n = 64)
+    c = np.arange(dp.input_codes.start, dp.one_code + 1)
+    out = dp.eval(c, 64)                        # numpy in, numpy out (the GIL is released)
+    p = dp.probes(c, 64)                        # every stage's value and overflow event
+
+Raw codes are integers (two's complement for signed formats, every format up to 64 bits).
+An input outside the model's domain (an n not in the configuration's set, a code outside the
+input format) raises ``ValueError`` with the command line's message, as does a configuration
+the command line refuses.
+"""
+
+import json
+from typing import Any, Dict, List, Optional, Union
+
+import numpy as np
+
+from ._specfx import Model as _Model
+from ._specfx import __version__
+
+__all__ = ["Datapath", "EVENTS", "__version__"]
+
+#: The overflow events of ``probes()``, by code.
+EVENTS = ("none", "wrapped", "saturated", "zeroed")
+
+IntOrArray = Union[int, np.integer, np.ndarray]
+
+
+def _codes(x: Any, what: str, dtype: Any) -> np.ndarray:
+    """``x`` as an integer array of ``dtype``, refusing floats and values that do not fit."""
+    a = np.asarray(x)
+    if a.dtype == np.bool_ or not np.issubdtype(a.dtype, np.integer):
+        raise ValueError(f"{what}: expected integer codes, got an array of {a.dtype}")
+    info = np.iinfo(dtype)
+    if a.size and (a.min() < info.min or a.max() > info.max):
+        bad = a.min() if a.min() < info.min else a.max()
+        raise ValueError(f"{what} = {bad} does not fit in {np.dtype(dtype).name}")
+    return a.astype(dtype, copy=False)
+
+
+class Datapath:
+    """A validated datapath: its configuration, per-n constants and bit-accurate evaluation.
+
+    ``Datapath(config="baseline", n=None)`` reads ``config`` as ``specfx --config`` does: a
+    built-in name (``baseline``), a TOML file, or a vector directory written by
+    ``specfx vectors`` (or its ``manifest.json``; the whole directory is verified). ``n``
+    (e.g. ``"16..=64"``) replaces the exponent set. ``Datapath.from_toml(text)`` takes the TOML
+    text itself.
+    """
+
+    def __init__(self, config: str = "baseline", n: Optional[str] = None) -> None:
+        self._m = _Model.open(str(config), n)
+
+    @classmethod
+    def from_toml(cls, text: str) -> "Datapath":
+        """The datapath of a configuration's TOML text (merged onto ``baseline``)."""
+        dp = cls.__new__(cls)
+        dp._m = _Model.from_toml(text)
+        return dp
+
+    def __repr__(self) -> str:
+        return f"Datapath({self.name!r}, k={self.k}, n={len(self.n)} exponents)"
+
+    @property
+    def name(self) -> str:
+        """The configuration's name."""
+        return self._m.name()
+
+    @property
+    def toml(self) -> str:
+        """The whole configuration as TOML."""
+        return self._m.toml()
+
+    @property
+    def k(self) -> int:
+        """The number of squarings (m = 2^k)."""
+        return self._m.k()
+
+    @property
+    def n(self) -> List[int]:
+        """The exponents of the configuration, ascending."""
+        return self._m.n()
+
+    @property
+    def formats(self) -> Dict[str, str]:
+        """Every stage's format (``"u1.15"``), in evaluation order: c, d, t, b, sq1.., coef, out."""
+        return dict(self._m.formats())
+
+    @property
+    def stages(self) -> List[str]:
+        """The stages' names: d, t, b, sq1..sqk, coef, out."""
+        return [name for name, _ in self._m.formats()][1:]
+
+    @property
+    def input_codes(self) -> range:
+        """Every raw code of the input format c."""
+        lo, hi, _ = self._m.input_codes()
+        return range(lo, hi + 1)
+
+    @property
+    def one_code(self) -> int:
+        """The raw code of c = 1.0."""
+        return self._m.input_codes()[2]
+
+    def constants(self, n: int) -> Dict[str, Any]:
+        """The constants of exponent ``n`` as the datapath stores them (raw codes and their
+        fraction bits; ``threshold`` is None unless the paper cutoff applies) and their values
+        before quantization (``*_value``)."""
+        s, sf, o, of, th, coef, sv, ov, cv = self._m.constants(int(n))
+        return {
+            "n": int(n),
+            "slope": s,
+            "slope_frac": sf,
+            "offset": o,
+            "offset_frac": of,
+            "threshold": th,
+            "coef": coef,
+            "slope_value": sv,
+            "offset_value": ov,
+            "coef_value": cv,
+        }
+
+    def _pairs(self, c: IntOrArray, n: IntOrArray):
+        """Flat int64 codes and uint32 exponents (or one n), and the shape of the result."""
+        cs = _codes(c, "c", np.int64)
+        ns = _codes(n, "n", np.uint32)
+        if ns.ndim == 0:
+            return np.ascontiguousarray(cs.ravel()), None, int(ns), cs.shape
+        cs, ns = np.broadcast_arrays(cs, ns)
+        shape = cs.shape
+        return (
+            np.ascontiguousarray(cs.ravel()),
+            np.ascontiguousarray(ns.ravel()),
+            0,
+            shape,
+        )
+
+    def eval(self, c: IntOrArray, n: IntOrArray) -> Union[int, np.ndarray]:
+        """The output code of input code ``c`` with exponent ``n``: an ``int`` for two integers,
+        else an int64 array of their broadcast shape (``c`` and ``n`` arrays of the same shape,
+        or one ``n``), computed on every core with the GIL released."""
+        if np.ndim(c) == 0 and np.ndim(n) == 0:
+            _codes(c, "c", np.int64)
+            _codes(n, "n", np.uint32)
+            return self._m.eval(int(c), int(n))
+        cs, ns, n_all, shape = self._pairs(c, n)
+        return self._m.eval_array(cs, ns, n_all).reshape(shape)
+
+    def probes(self, c: IntOrArray, n: IntOrArray) -> Dict[str, Any]:
+        """Every stage's value (``d``, ``t``, ``b``, ``sq1``.., ``coef``, ``out``) of the
+        evaluations, each stage's overflow event under ``events`` (0 none, 1 wrapped,
+        2 saturated, 3 zeroed: ``EVENTS``), ``cut`` (the cutoff forced the base to zero) and
+        ``clamped`` (the input was above 1.0): ints and bools for two integers, else arrays of
+        the broadcast shape."""
+        scalar = np.ndim(c) == 0 and np.ndim(n) == 0
+        cs, ns, n_all, shape = self._pairs(c, n)
+        values, events, cut, clamped = self._m.probes_array(cs, ns, n_all)
+        names = self.stages
+
+        def shaped(a: np.ndarray) -> Any:
+            return a.reshape(shape).item() if scalar else a.reshape(shape)
+
+        out: Dict[str, Any] = {name: shaped(values[i]) for i, name in enumerate(names)}
+        out["events"] = {name: shaped(events[i]) for i, name in enumerate(names)}
+        out["cut"] = shaped(cut)
+        out["clamped"] = shaped(clamped)
+        return out
+
+    def check(self) -> Dict[str, Any]:
+        """The exhaustive check of every input code up to 1.0 and every n: the same figures as
+        ``specfx check --json`` prints, as a dict (the GIL released while it runs)."""
+        return json.loads(self._m.check_json())

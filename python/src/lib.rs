@@ -1,0 +1,202 @@
+//! The native half of the `specfx` Python package (`specfx._specfx`): a face of
+//! `specfx::input` (the model from a configuration) and `specfx::engine::pairs` (evaluations
+//! checked against the model's domain), with the GIL released during batch work. The Python
+//! half (`specfx/__init__.py`) turns numpy arrays of any integer type and shape into the
+//! contiguous 1-D arrays these functions take, and their results back.
+
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use specfx::engine::pairs::{self, Ns};
+
+/// A specfx error as Python's `ValueError`, with the command line's message.
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// A validated datapath (the native half of `specfx.Datapath`).
+#[pyclass(frozen, module = "specfx._specfx")]
+struct Model {
+    dp: specfx::pipeline::Datapath,
+}
+
+#[pymethods]
+impl Model {
+    /// The model a `--config` argument names (a built-in name, a TOML file, a vector
+    /// directory), with `n` (e.g. "16..=64") replacing its exponent set.
+    #[staticmethod]
+    #[pyo3(signature = (config, n=None))]
+    fn open(py: Python<'_>, config: &str, n: Option<&str>) -> PyResult<Model> {
+        let n = n
+            .map(|t| {
+                t.parse::<specfx::nset::NSet>()
+                    .map_err(|e| value_error(format!("n: {e}")))
+            })
+            .transpose()?;
+        let dp = py
+            .detach(|| specfx::input::load_datapath(config, n.as_ref()))
+            .map_err(value_error)?;
+        Ok(Model { dp })
+    }
+
+    /// The model of a configuration's TOML text.
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<Model> {
+        let dp = specfx::input::datapath_from_toml(text).map_err(value_error)?;
+        Ok(Model { dp })
+    }
+
+    /// The configuration's name.
+    fn name(&self) -> String {
+        self.dp.config().name.clone()
+    }
+
+    /// The configuration as TOML (every key).
+    fn toml(&self) -> String {
+        self.dp.config().to_toml()
+    }
+
+    /// The number of squarings k.
+    fn k(&self) -> u32 {
+        self.dp.config().k
+    }
+
+    /// The exponents, ascending.
+    fn n(&self) -> Vec<u32> {
+        self.dp.config().n.values().to_vec()
+    }
+
+    /// The stages: (name, format) in evaluation order, the input `c` first.
+    fn formats(&self) -> Vec<(String, String)> {
+        std::iter::once(("c".to_string(), self.dp.config().c.format.to_string()))
+            .chain(
+                self.dp
+                    .stages()
+                    .iter()
+                    .map(|s| (s.name.clone(), s.format.to_string())),
+            )
+            .collect()
+    }
+
+    /// The input format's smallest and largest raw codes and the code of 1.0.
+    fn input_codes(&self) -> (i64, i64, i64) {
+        let codes = self.dp.input_codes();
+        (*codes.start(), *codes.end(), self.dp.one_code())
+    }
+
+    /// The constants of `n`: (slope, slope_frac, offset, offset_frac, threshold or None,
+    /// coef, slope_value, offset_value, coef_value).
+    #[allow(clippy::type_complexity)]
+    fn constants(&self, n: u32) -> PyResult<(i64, i32, i64, i32, Option<i64>, i64, f64, f64, f64)> {
+        let nc = self.dp.constants_checked(n, "n").map_err(value_error)?;
+        Ok((
+            nc.slope_raw,
+            nc.slope_frac,
+            nc.offset_raw,
+            nc.offset_frac,
+            nc.threshold,
+            nc.coef_raw,
+            nc.slope,
+            nc.offset,
+            nc.coef,
+        ))
+    }
+
+    /// The output code of one input code and exponent.
+    fn eval(&self, c: i64, n: u32) -> PyResult<i64> {
+        let p = pairs::eval_one(&self.dp, c, n).map_err(value_error)?;
+        Ok(p.values[self.dp.stage_out()])
+    }
+
+    /// The output codes of `c[i]` with `n[i]` (or `n_all` for every code when `n` is None), on
+    /// every core with the GIL released.
+    #[pyo3(signature = (c, n, n_all))]
+    fn eval_array<'py>(
+        &self,
+        py: Python<'py>,
+        c: PyReadonlyArray1<'py, i64>,
+        n: Option<PyReadonlyArray1<'py, u32>>,
+        n_all: u32,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let cs = c.as_slice()?;
+        let ns = match &n {
+            Some(n) => Ns::Each(n.as_slice()?),
+            None => Ns::One(n_all),
+        };
+        let mut out = vec![0i64; cs.len()];
+        py.detach(|| pairs::eval_outputs(&self.dp, cs, ns, &mut out))
+            .map_err(value_error)?;
+        Ok(out.into_pyarray(py))
+    }
+
+    /// Every stage's value (a stages x len array), overflow event (0 none, 1 wrapped,
+    /// 2 saturated, 3 zeroed; stages x len), whether the cutoff forced the base to zero and
+    /// whether the input was above 1.0, for every pair, with the GIL released.
+    #[allow(clippy::type_complexity)]
+    #[pyo3(signature = (c, n, n_all))]
+    fn probes_array<'py>(
+        &self,
+        py: Python<'py>,
+        c: PyReadonlyArray1<'py, i64>,
+        n: Option<PyReadonlyArray1<'py, u32>>,
+        n_all: u32,
+    ) -> PyResult<(
+        Bound<'py, PyArray2<i64>>,
+        Bound<'py, PyArray2<u8>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<bool>>,
+    )> {
+        let cs = c.as_slice()?;
+        let ns = match &n {
+            Some(n) => Ns::Each(n.as_slice()?),
+            None => Ns::One(n_all),
+        };
+        let stages = self.dp.stages().len();
+        let len = cs.len();
+        let (values, events, cut, clamped) = py
+            .detach(|| {
+                let probes = pairs::eval_probes(&self.dp, cs, ns)?;
+                let mut values = vec![0i64; stages * len];
+                let mut events = vec![0u8; stages * len];
+                for (i, p) in probes.iter().enumerate() {
+                    for s in 0..stages {
+                        values[s * len + i] = p.values[s];
+                        events[s * len + i] = pairs::event_code(p.events[s]);
+                    }
+                }
+                let cut: Vec<bool> = probes.iter().map(|p| p.cut).collect();
+                let clamped: Vec<bool> = probes.iter().map(|p| p.input_clamped).collect();
+                Ok::<_, specfx::Error>((values, events, cut, clamped))
+            })
+            .map_err(value_error)?;
+        let shape = |v: Vec<i64>| numpy::ndarray::Array2::from_shape_vec((stages, len), v);
+        let values = shape(values).map_err(value_error)?.into_pyarray(py);
+        let events = numpy::ndarray::Array2::from_shape_vec((stages, len), events)
+            .map_err(value_error)?
+            .into_pyarray(py);
+        Ok((
+            values,
+            events,
+            cut.into_pyarray(py),
+            clamped.into_pyarray(py),
+        ))
+    }
+
+    /// The exhaustive check's report as JSON text (what `specfx check --json` prints), with the
+    /// GIL released.
+    fn check_json(&self, py: Python<'_>) -> PyResult<String> {
+        let report = py
+            .detach(|| specfx::analysis::check::check(&self.dp))
+            .map_err(|e| value_error(format!("config {}: {e}", self.dp.config().name)))?;
+        serde_json::to_string(&report).map_err(value_error)
+    }
+}
+
+/// specfx's bit-accurate datapath model (native half).
+#[pymodule]
+fn _specfx(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Model>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
