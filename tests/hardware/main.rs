@@ -14,6 +14,7 @@ mod cosim;
 mod dpi;
 mod lint;
 mod mutation;
+mod python;
 mod timing;
 mod trace;
 mod vectors;
