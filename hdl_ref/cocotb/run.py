@@ -1,9 +1,19 @@
 #!/usr/bin/env python3
-"""Runs the cocotb testbench test_specfx.py on specfx_top under Icarus Verilog.
+"""Runs a cocotb testbench of specfx_top under Icarus Verilog: the vector replay
+test_specfx.py, or the live scoreboard test_live.py.
 
 Usage:
   run.py --vectors DIR [--arch pipelined|folded] [--seed S] [--bubble P] [--stall P]
          [--reset-data] [--specfx PATH] [--hdl-ref DIR] [--build-dir DIR] [--keep]
+  run.py --live CONFIG [--n SET] [--nvec N] [the same options]
+
+With --live CONFIG (a built-in name, a TOML file or a vector directory, as specfx --config
+takes it), no vectors are read: test_live.py draws the directed cases and N random inputs,
+computes each expected output with the specfx Python package (`import specfx`, installed in
+target/cocotb-venv by ./scripts/test) as the input is accepted, checks every output and its
+cycle against the cycle model, and on a failure names the first register of the core that
+differs from the model. cocotb 2.0.1 (pinned) needs Verilator 5.036 or later and Debian has
+5.006: the cocotb testbenches run in Icarus Verilog; the DPI testbench runs in Verilator.
 
 For a vector directory written by `specfx vectors --out DIR`, it asks specfx for the Verilog
 parameters of specfx_top (`specfx hdl params --vectors DIR --arch A --format json
@@ -34,6 +44,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent.parent
 TOPLEVEL = "specfx_top"
 TEST_MODULE = "test_specfx"
+LIVE_TEST_MODULE = "test_live"
 
 EXIT_OK, EXIT_FAILED, EXIT_ERROR = 0, 1, 2
 
@@ -58,8 +69,20 @@ def parse_args(argv):
         description="Run the cocotb testbench of specfx_top (Icarus Verilog) on a vector "
         "directory.",
     )
+    source = ap.add_mutually_exclusive_group(required=True)
+    source.add_argument(
+        "--vectors", type=Path, help="vector directory (specfx vectors --out DIR): replay it"
+    )
+    source.add_argument(
+        "--live",
+        metavar="CONFIG",
+        help="no vectors: the live scoreboard test_live.py, expected values from `import "
+        "specfx` as inputs are accepted, for this configuration (as specfx --config takes it)",
+    )
+    ap.add_argument("--n", help="with --live: exponents, replacing the configuration's set")
     ap.add_argument(
-        "--vectors", required=True, type=Path, help="vector directory (specfx vectors --out DIR)"
+        "--nvec", type=int, default=2000,
+        help="with --live: random vectors after the directed ones (default 2000)",
     )
     ap.add_argument(
         "--arch", choices=["pipelined", "folded"], default="pipelined", help="microarchitecture"
@@ -140,33 +163,83 @@ def import_runner():
     return get_runner
 
 
-def simulate(args, build_dir):
-    """Builds and runs the test in build_dir; returns the test's summary (a dict)."""
+def live_setup(args, build_dir, specfx_bin):
+    """The DUT's parameters and the test's environment of a --live run."""
+    try:
+        import specfx
+    except ImportError:
+        raise UsageError(
+            f"the specfx Python package is not installed for {sys.executable}: ./scripts/test "
+            "installs it in target/cocotb-venv (or: maturin develop -m python/Cargo.toml)"
+        ) from None
+    try:
+        dp = specfx.Datapath(args.live, args.n)
+    except ValueError as e:
+        raise UsageError(str(e)) from None
+    config = build_dir / "config.toml"
+    config.write_text(dp.toml)
+    params_args = ["hdl", "params", "--config", str(config), "--arch", args.arch]
+    params_args += ["--format", "json"]
+    if args.reset_data:
+        params_args.append("--reset-data")
+    try:
+        parameters = json.loads(run_specfx(specfx_bin, params_args))
+    except ValueError as e:
+        raise UsageError(f"specfx hdl params printed no JSON: {e}") from None
+    environment = {
+        "SPECFX_CONFIG": str(config),
+        "SPECFX_ARCH": args.arch,
+        "SPECFX_SEED": str(args.seed),
+        "SPECFX_NVEC": str(args.nvec),
+        "SPECFX_BUBBLE": args.bubble,
+        "SPECFX_STALL": args.stall,
+        "SPECFX_RESET_DATA": str(parameters.get("RESET_DATA", 0)),
+    }
+    return parameters, environment
+
+
+def vector_setup(args, build_dir, specfx_bin):
+    """The DUT's parameters and the test's environment of a vector replay."""
     vectors = args.vectors.resolve()
     if not (vectors / "manifest.json").is_file():
         raise UsageError(
             f"{vectors}: no manifest.json (write one with specfx vectors --out {vectors})"
         )
-    if shutil.which("iverilog") is None or shutil.which("vvp") is None:
-        raise UsageError(
-            "iverilog and vvp not found on PATH (Debian/Ubuntu: apt-get install -y iverilog)"
-        )
-    get_runner = import_runner()
-    specfx = find_specfx(args.specfx)
-    sources = rtl_sources(args.hdl_ref.resolve())
-
     params_args = ["hdl", "params", "--vectors", str(vectors), "--arch", args.arch]
     params_args += ["--format", "json"]
     if args.reset_data:
         params_args.append("--reset-data")
     try:
-        parameters = json.loads(run_specfx(specfx, params_args))
+        parameters = json.loads(run_specfx(specfx_bin, params_args))
     except ValueError as e:
         raise UsageError(f"specfx hdl params printed no JSON: {e}") from None
     stim = build_dir / "stimulus"
     stim_args = ["hdl", "stimulus", "--vectors", str(vectors), "--arch", args.arch]
     stim_args += ["--seed", str(args.seed), "--bubble", args.bubble, "--stall", args.stall]
-    run_specfx(specfx, stim_args + ["--out", str(stim)])
+    run_specfx(specfx_bin, stim_args + ["--out", str(stim)])
+    environment = {
+        "SPECFX_VECTORS": str(vectors),
+        "SPECFX_STIMULUS": str(stim),
+        "SPECFX_RESET_DATA": str(parameters.get("RESET_DATA", 0)),
+    }
+    return parameters, environment
+
+
+def simulate(args, build_dir):
+    """Builds and runs the test in build_dir; returns the test's summary (a dict)."""
+    if shutil.which("iverilog") is None or shutil.which("vvp") is None:
+        raise UsageError(
+            "iverilog and vvp not found on PATH (Debian/Ubuntu: apt-get install -y iverilog)"
+        )
+    get_runner = import_runner()
+    specfx_bin = find_specfx(args.specfx)
+    sources = rtl_sources(args.hdl_ref.resolve())
+    if args.live is not None:
+        parameters, environment = live_setup(args, build_dir, specfx_bin)
+        test_module = LIVE_TEST_MODULE
+    else:
+        parameters, environment = vector_setup(args, build_dir, specfx_bin)
+        test_module = TEST_MODULE
 
     summary_path = build_dir / "summary.json"
     runner = get_runner("icarus")
@@ -184,16 +257,14 @@ def simulate(args, build_dir):
         raise UsageError(f"iverilog failed to build {TOPLEVEL} ({e})") from None
     try:
         runner.test(
-            test_module=TEST_MODULE,
+            test_module=test_module,
             hdl_toplevel=TOPLEVEL,
             build_dir=build_dir,
             test_dir=build_dir,
             extra_env={
-                "SPECFX_VECTORS": str(vectors),
-                "SPECFX_STIMULUS": str(stim),
-                "SPECFX_RESET_DATA": str(parameters.get("RESET_DATA", 0)),
+                **environment,
                 "SPECFX_SUMMARY": str(summary_path),
-                # No __pycache__ beside test_specfx.py in the repository.
+                # No __pycache__ beside the tests in the repository.
                 "PYTHONDONTWRITEBYTECODE": "1",
             },
         )
@@ -204,7 +275,7 @@ def simulate(args, build_dir):
                 f"the simulation failed (exit code {e.code}) before the test ended"
             ) from None
     if not summary_path.is_file():
-        raise UsageError("the test wrote no summary (did cocotb load test_specfx?)")
+        raise UsageError(f"the test wrote no summary (did cocotb load {test_module}?)")
     summary = json.loads(summary_path.read_text())
     from cocotb_tools.runner import get_results
 
@@ -224,6 +295,8 @@ def main(argv):
         build_dir = args.build_dir.resolve()
         build_dir.mkdir(parents=True, exist_ok=True)
     where = f"icarus, {args.arch}" + (", RESET_DATA = 1" if args.reset_data else "")
+    if args.live is not None:
+        where += ", live scoreboard"
     try:
         summary = simulate(args, build_dir)
     except UsageError as e:

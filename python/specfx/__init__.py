@@ -20,10 +20,11 @@ from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
 
+from ._specfx import Machine as _Machine
 from ._specfx import Model as _Model
 from ._specfx import __version__
 
-__all__ = ["Datapath", "EVENTS", "__version__"]
+__all__ = ["Datapath", "Machine", "EVENTS", "__version__"]
 
 #: The overflow events of ``probes()``, by code.
 EVENTS = ("none", "wrapped", "saturated", "zeroed")
@@ -171,7 +172,37 @@ class Datapath:
         out["clamped"] = shaped(clamped)
         return out
 
+    def directed(self, seed: int = 1):
+        """The directed cases ``specfx vectors`` always writes: every n's corner cases (the
+        ends of the code range, 1.0 and above, every cutoff switch +-1 code), codes with a
+        non-zero output, and the inputs on and next to every stage's rounding boundary,
+        interleaved with ``seed``. Returns ``(n, c)``, two arrays."""
+        return self._m.directed(int(seed))
+
     def check(self) -> Dict[str, Any]:
         """The exhaustive check of every input code up to 1.0 and every n: the same figures as
         ``specfx check --json`` prints, as a dict (the GIL released while it runs)."""
         return json.loads(self._m.check_json())
+
+
+class Machine:
+    """The cycle model of ``specfx_top`` (docs/cycle.md), stepped in lockstep with a simulation:
+    each call of ``cycle`` is one clock cycle.
+
+    ``Machine(datapath, arch="pipelined")`` starts empty, as after reset.
+    """
+
+    def __init__(self, datapath: Datapath, arch: str = "pipelined") -> None:
+        self._m = _Machine(datapath._m, arch)
+
+    def cycle(self, input: Optional[tuple], out_ready: bool):
+        """What the ports show during this cycle, given the input offered (``(c, n)`` when
+        in_valid is high, else None) and out_ready: ``(in_ready, out)``, ``out`` being
+        ``(input number, raw code)`` when out_valid is high, else None; then the clock edge
+        (the input transfers when in_ready is high)."""
+        return self._m.cycle(input, bool(out_ready))
+
+    def registers(self) -> List[tuple]:
+        """The RTL core's registers now, named as in the RTL below ``u_core``:
+        ``(name, width, value)``, value None when the register holds no valid data."""
+        return self._m.registers()

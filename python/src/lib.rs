@@ -8,6 +8,9 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+use std::sync::{Arc, Mutex};
+
+use specfx::cycle::lockstep::Lockstep;
 use specfx::engine::pairs::{self, Ns};
 
 /// A specfx error as Python's `ValueError`, with the command line's message.
@@ -18,7 +21,7 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
 /// A validated datapath (the native half of `specfx.Datapath`).
 #[pyclass(frozen, module = "specfx._specfx")]
 struct Model {
-    dp: specfx::pipeline::Datapath,
+    dp: Arc<specfx::pipeline::Datapath>,
 }
 
 #[pymethods]
@@ -37,14 +40,14 @@ impl Model {
         let dp = py
             .detach(|| specfx::input::load_datapath(config, n.as_ref()))
             .map_err(value_error)?;
-        Ok(Model { dp })
+        Ok(Model { dp: Arc::new(dp) })
     }
 
     /// The model of a configuration's TOML text.
     #[staticmethod]
     fn from_toml(text: &str) -> PyResult<Model> {
         let dp = specfx::input::datapath_from_toml(text).map_err(value_error)?;
-        Ok(Model { dp })
+        Ok(Model { dp: Arc::new(dp) })
     }
 
     /// The configuration's name.
@@ -183,6 +186,28 @@ impl Model {
         ))
     }
 
+    /// The directed cases `specfx vectors` always writes (every n's corners, codes with a
+    /// non-zero output, the inputs on and next to every stage's rounding boundary),
+    /// interleaved with `seed`: (n, c) arrays.
+    fn directed<'py>(
+        &self,
+        py: Python<'py>,
+        seed: u64,
+    ) -> PyResult<(Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<i64>>)> {
+        let sel = specfx::golden::CaseSelection {
+            corner: true,
+            exhaustive: false,
+            random: 0,
+        };
+        let mut cases = py
+            .detach(|| specfx::golden::cases::select(&self.dp, &sel, seed))
+            .map_err(value_error)?
+            .cases;
+        specfx::golden::cases::order(&mut cases, specfx::golden::Order::Interleaved, seed);
+        let (n, c): (Vec<u32>, Vec<i64>) = cases.into_iter().unzip();
+        Ok((n.into_pyarray(py), c.into_pyarray(py)))
+    }
+
     /// The exhaustive check's report as JSON text (what `specfx check --json` prints), with the
     /// GIL released.
     fn check_json(&self, py: Python<'_>) -> PyResult<String> {
@@ -193,10 +218,62 @@ impl Model {
     }
 }
 
+/// The cycle model of one architecture, stepped in lockstep with a simulation of
+/// `specfx_top` (docs/cycle.md).
+#[pyclass(module = "specfx._specfx")]
+struct Machine {
+    dp: Arc<specfx::pipeline::Datapath>,
+    lockstep: Mutex<Lockstep>,
+}
+
+#[pymethods]
+impl Machine {
+    /// An empty machine of `arch` (`pipelined` or `folded`) for the model, as after reset.
+    #[new]
+    fn new(model: &Model, arch: &str) -> PyResult<Machine> {
+        let arch: specfx::cycle::Arch = arch.parse().map_err(value_error)?;
+        Ok(Machine {
+            dp: model.dp.clone(),
+            lockstep: Mutex::new(Lockstep::new(&model.dp, arch)),
+        })
+    }
+
+    /// One clock cycle: what the ports show during it (in_ready, and the output's
+    /// (input number, raw code) or None when out_valid is low), given this cycle's offered
+    /// input (None when in_valid is low) and out_ready; then the clock edge.
+    #[pyo3(signature = (input, out_ready))]
+    fn cycle(
+        &self,
+        input: Option<(i64, u32)>,
+        out_ready: bool,
+    ) -> PyResult<(bool, Option<(u64, i64)>)> {
+        let mut ls = self.lockstep.lock().map_err(value_error)?;
+        let p = ls.cycle(&self.dp, input, out_ready).map_err(value_error)?;
+        Ok((p.in_ready, p.out))
+    }
+
+    /// The RTL core's registers now, under the RTL's names below `u_core`: (name, width,
+    /// value or None when the register holds no valid data).
+    fn registers(&self) -> PyResult<Vec<(String, u32, Option<u128>)>> {
+        let ls = self.lockstep.lock().map_err(value_error)?;
+        Ok(ls
+            .registers(&self.dp)
+            .into_iter()
+            .map(|r| {
+                let value = r.value.map(|w| {
+                    (0..w.width().min(128)).fold(0u128, |v, i| v | (u128::from(w.bit(i)) << i))
+                });
+                (r.name, r.width, value)
+            })
+            .collect())
+    }
+}
+
 /// specfx's bit-accurate datapath model (native half).
 #[pymodule]
 fn _specfx(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
+    m.add_class::<Machine>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! testbench's scoreboard asks each cycle (through the C ABI's DPI-C functions) is what
 //! `specfx_top`'s ports must show, given this cycle's `in_valid` and `out_ready`.
 
-use crate::cycle::{Arch, Folded, Item, Machine, Pipelined};
+use crate::cycle::{Arch, Folded, Item, Machine, Pipelined, RegisterView};
 use crate::error::Error;
 use crate::pipeline::Datapath;
 
@@ -94,5 +94,16 @@ impl Lockstep {
             Any::Folded(m) => m.step(dp, transfer, out_ready),
         }
         Ok(ports)
+    }
+
+    /// Every register of the RTL core now (but its ports), under the RTL's names below the
+    /// core instance `u_core` (`specfx_top`'s `g_pipelined.u_core` or `g_folded.u_core`):
+    /// what a testbench compares with the DUT's internal registers to say which stage went
+    /// wrong.
+    pub fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
+        match &self.machine {
+            Any::Pipelined(m) => m.registers(dp),
+            Any::Folded(m) => m.registers(dp),
+        }
     }
 }

@@ -244,3 +244,80 @@ fn an_output_that_moves_while_stalled_fails() {
         "protocol: out_valid/out_data changed while stalled",
     );
 }
+
+/// Runs `hdl_ref/cocotb/run.py --live CONFIG` (the live scoreboard, `import specfx`).
+fn run_live(config: &str, args: &[&str]) -> Output {
+    Command::new(cocotb_python())
+        .arg(root().join("hdl_ref/cocotb/run.py"))
+        .args(["--live", config, "--specfx", env!("CARGO_BIN_EXE_specfx")])
+        .args(args)
+        .output()
+        .expect("the cocotb Python runs")
+}
+
+/// The live scoreboard (random stimulus with backpressure, each expected value from the
+/// Python package as the input is accepted, each cycle from the cycle model) passes on
+/// configurations of both architectures, the directed cases and the random ones all checked.
+#[test]
+fn the_live_scoreboard_passes() {
+    let every_mode = config_path("every_mode.toml");
+    let conv = config_path("conv_sym_k5.toml");
+    for (config, args) in [
+        (
+            "baseline",
+            vec!["--n", "16..=20,1000..=1024", "--arch", "folded"],
+        ),
+        (
+            every_mode.as_str(),
+            vec!["--n", "8..=12,40", "--stall", "0.4"],
+        ),
+        (conv.as_str(), vec!["--n", "32,33,1000", "--bubble", "0.4"]),
+    ] {
+        let o = run_live(
+            config,
+            &[&args[..], &["--nvec", "400", "--seed", "3"]].concat(),
+        );
+        assert!(o.status.success(), "{config}: run.py failed:\n{}", text(&o));
+        let n = vectors_passed(&o).unwrap_or(0);
+        assert!(
+            n > 400,
+            "{config}: {n} vectors, want the directed ones and 400:\n{}",
+            text(&o)
+        );
+    }
+}
+
+/// A failing seed points at a stage: the b adder reading the offset one stage early fails,
+/// and the first register that differs from the model is the b stage's.
+#[test]
+fn the_live_scoreboard_names_the_stage_that_went_wrong() {
+    let dir = temp_dir("stage");
+    for sub in ["rtl"] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+        for e in std::fs::read_dir(root().join("hdl_ref").join(sub)).unwrap() {
+            let p = e.unwrap().path();
+            std::fs::copy(&p, dir.join(sub).join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    let file = dir.join("rtl/specfx_pipelined.v");
+    let text_v = std::fs::read_to_string(&file).unwrap();
+    let from = ".t(t_2), .offset(offset_2)";
+    assert_eq!(text_v.matches(from).count(), 1);
+    std::fs::write(&file, text_v.replace(from, ".t(t_2), .offset(offset_1)")).unwrap();
+    let minimax = config_path("minimax_folded.toml");
+    let o = run_live(
+        &minimax,
+        &["--nvec", "100", "--hdl-ref", dir.to_str().unwrap()],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let stage = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .find(|l| l.starts_with("stage: "))
+        .map(str::to_string)
+        .unwrap_or_else(|| panic!("no stage line:\n{}", text(&o)));
+    assert!(
+        stage.contains("the first register that differs from the model is b"),
+        "{stage}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

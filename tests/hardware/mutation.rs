@@ -252,6 +252,35 @@ fn cosim_dpi(hdl_ref: &Path, config: &str, arch: &str, flags: &[&str]) -> Output
     common::specfx(&args)
 }
 
+/// The cocotb live scoreboard (`hdl_ref/cocotb/run.py --live`, Icarus, `import specfx`) on
+/// random stimulus; the exponents cut to a few where the set is large.
+fn cocotb_live(hdl_ref: &Path, config: &str, arch: &str, flags: &[&str]) -> Output {
+    let config = config_arg(config);
+    let python = std::env::var_os("SPECFX_COCOTB_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target/cocotb-venv/bin/python"));
+    let mut cmd = std::process::Command::new(python);
+    cmd.arg(root().join("hdl_ref/cocotb/run.py"))
+        .args([
+            "--live", &config, "--arch", arch, "--seed", "7", "--nvec", "600",
+        ])
+        .args([
+            "--bubble",
+            "0.3",
+            "--stall",
+            "0.3",
+            "--specfx",
+            env!("CARGO_BIN_EXE_specfx"),
+        ])
+        .arg("--hdl-ref")
+        .arg(hdl_ref)
+        .args(flags);
+    if config == "baseline" || config.ends_with("sat_out.toml") {
+        cmd.args(["--n", "16..=32,1016..=1024"]);
+    }
+    cmd.output().expect("the cocotb Python runs")
+}
+
 fn summary(o: &Output) -> Option<(u64, u64)> {
     let text = String::from_utf8_lossy(&o.stdout);
     text.lines().rev().find_map(|l| {
@@ -343,6 +372,17 @@ fn every_mutant_is_caught_by_the_dpi_scoreboard() {
     assert!(
         escaped.is_empty(),
         "mutants the DPI scoreboard does not catch:\n{}",
+        escaped.join("\n")
+    );
+}
+
+/// The cocotb live scoreboard catches every mutant too.
+#[test]
+fn every_mutant_is_caught_by_the_cocotb_live_scoreboard() {
+    let escaped = escaped("live", cocotb_live);
+    assert!(
+        escaped.is_empty(),
+        "mutants the cocotb live scoreboard does not catch:\n{}",
         escaped.join("\n")
     );
 }
