@@ -13,6 +13,9 @@ use std::sync::{Arc, Mutex};
 use specfx::cycle::lockstep::Lockstep;
 use specfx::engine::pairs::{self, Ns};
 
+/// (n, c) arrays of cases.
+type Cases<'py> = (Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<i64>>);
+
 /// A specfx error as Python's `ValueError`, with the command line's message.
 fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
@@ -193,7 +196,7 @@ impl Model {
         &self,
         py: Python<'py>,
         seed: u64,
-    ) -> PyResult<(Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<i64>>)> {
+    ) -> PyResult<Cases<'py>> {
         let sel = specfx::golden::CaseSelection {
             corner: true,
             exhaustive: false,
