@@ -37,10 +37,13 @@ def _codes(x: Any, what: str, dtype: Any) -> np.ndarray:
     a = np.asarray(x)
     if a.dtype == np.bool_ or not np.issubdtype(a.dtype, np.integer):
         raise ValueError(f"{what}: expected integer codes, got an array of {a.dtype}")
-    info = np.iinfo(dtype)
-    if a.size and (a.min() < info.min or a.max() > info.max):
-        bad = a.min() if a.min() < info.min else a.max()
-        raise ValueError(f"{what} = {bad} does not fit in {np.dtype(dtype).name}")
+    info, have = np.iinfo(dtype), np.iinfo(a.dtype)
+    # Only a type wider than dtype, or signed into unsigned, can hold a value that does not fit.
+    if a.size and (have.min < info.min or have.max > info.max):
+        lo, hi = a.min(), a.max()
+        if lo < info.min or hi > info.max:
+            bad = lo if lo < info.min else hi
+            raise ValueError(f"{what} = {bad} does not fit in {np.dtype(dtype).name}")
     return a.astype(dtype, copy=False)
 
 
@@ -141,16 +144,34 @@ class Datapath:
             shape,
         )
 
-    def eval(self, c: IntOrArray, n: IntOrArray) -> Union[int, np.ndarray]:
+    def eval(
+        self, c: IntOrArray, n: IntOrArray, out: Optional[np.ndarray] = None
+    ) -> Union[int, np.ndarray]:
         """The output code of input code ``c`` with exponent ``n``: an ``int`` for two integers,
         else an int64 array of their broadcast shape (``c`` and ``n`` arrays of the same shape,
-        or one ``n``), computed on every core with the GIL released."""
-        if np.ndim(c) == 0 and np.ndim(n) == 0:
+        or one ``n``), computed on every core with the GIL released. ``out``, a C-contiguous
+        int64 array of that shape, receives the codes instead of a new array (reusing it saves
+        the allocation, as numpy's ``out=``); it is written only when every input is in the
+        model's domain."""
+        if out is None and np.ndim(c) == 0 and np.ndim(n) == 0:
             _codes(c, "c", np.int64)
             _codes(n, "n", np.uint32)
             return self._m.eval(int(c), int(n))
         cs, ns, n_all, shape = self._pairs(c, n)
-        return self._m.eval_array(cs, ns, n_all).reshape(shape)
+        if out is None:
+            return self._m.eval_array(cs, ns, n_all).reshape(shape)
+        if (
+            not isinstance(out, np.ndarray)
+            or out.dtype != np.int64
+            or out.shape != shape
+            or not out.flags.c_contiguous
+        ):
+            raise ValueError(
+                f"out: expected a C-contiguous int64 array of shape {shape}, got "
+                f"{getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}"
+            )
+        self._m.eval_into(cs, ns, n_all, out.reshape(-1))
+        return out
 
     def probes(self, c: IntOrArray, n: IntOrArray) -> Dict[str, Any]:
         """Every stage's value (``d``, ``t``, ``b``, ``sq1``.., ``coef``, ``out``) of the

@@ -28,6 +28,13 @@ class Model:
         n: Optional[npt.NDArray[np.uint32]],
         n_all: int,
     ) -> npt.NDArray[np.int64]: ...
+    def eval_into(
+        self,
+        c: npt.NDArray[np.int64],
+        n: Optional[npt.NDArray[np.uint32]],
+        n_all: int,
+        out: npt.NDArray[np.int64],
+    ) -> None: ...
     def probes_array(
         self,
         c: npt.NDArray[np.int64],

@@ -4,7 +4,7 @@
 //! half (`specfx/__init__.py`) turns numpy arrays of any integer type and shape into the
 //! contiguous 1-D arrays these functions take, and their results back.
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -130,10 +130,31 @@ impl Model {
             Some(n) => Ns::Each(n.as_slice()?),
             None => Ns::One(n_all),
         };
-        let mut out = vec![0i64; cs.len()];
-        py.detach(|| pairs::eval_outputs(&self.dp, cs, ns, &mut out))
+        let out = py
+            .detach(|| pairs::eval_outputs_vec(&self.dp, cs, ns))
             .map_err(value_error)?;
         Ok(out.into_pyarray(py))
+    }
+
+    /// [`Model::eval_array`] into `out` (as long as `c`), which is written only when every pair
+    /// is in the model's domain.
+    #[pyo3(signature = (c, n, n_all, out))]
+    fn eval_into<'py>(
+        &self,
+        py: Python<'py>,
+        c: PyReadonlyArray1<'py, i64>,
+        n: Option<PyReadonlyArray1<'py, u32>>,
+        n_all: u32,
+        mut out: PyReadwriteArray1<'py, i64>,
+    ) -> PyResult<()> {
+        let cs = c.as_slice()?;
+        let ns = match &n {
+            Some(n) => Ns::Each(n.as_slice()?),
+            None => Ns::One(n_all),
+        };
+        let out = out.as_slice_mut()?;
+        py.detach(|| pairs::eval_outputs(&self.dp, cs, ns, out))
+            .map_err(value_error)
     }
 
     /// Every stage's value (a stages x len array), overflow event (0 none, 1 wrapped,
@@ -192,11 +213,7 @@ impl Model {
     /// The directed cases `specfx vectors` always writes (every n's corners, codes with a
     /// non-zero output, the inputs on and next to every stage's rounding boundary),
     /// interleaved with `seed`: (n, c) arrays.
-    fn directed<'py>(
-        &self,
-        py: Python<'py>,
-        seed: u64,
-    ) -> PyResult<Cases<'py>> {
+    fn directed<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<Cases<'py>> {
         let sel = specfx::golden::CaseSelection {
             corner: true,
             exhaustive: false,

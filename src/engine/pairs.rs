@@ -48,19 +48,54 @@ pub fn eval_one(dp: &Datapath, c_raw: i64, n: u32) -> Result<Probes, Error> {
     Ok(dp.eval(c_raw, nc))
 }
 
-/// Checks every pair and returns the index into [`Datapath::constants`] of each n (empty for
-/// [`Ns::One`], whose index is the second value).
-fn check_pairs(dp: &Datapath, cs: &[i64], ns: Ns) -> Result<(Vec<u32>, u32), Error> {
+/// The index into [`Datapath::constants`] of every exponent, as a table (n is at most 65535:
+/// `nset` refuses more).
+struct NIndex {
+    /// `table[n]`: the index of n, or `u32::MAX` when n is not in the set.
+    table: Vec<u32>,
+}
+
+impl NIndex {
+    fn new(dp: &Datapath) -> NIndex {
+        let values = dp.config().n.values();
+        let max = values.last().copied().unwrap_or(0);
+        let mut table = vec![u32::MAX; max as usize + 1];
+        for (i, &n) in values.iter().enumerate() {
+            table[n as usize] = i as u32;
+        }
+        NIndex { table }
+    }
+
+    #[inline]
+    fn of(&self, n: u32) -> Option<usize> {
+        match self.table.get(n as usize) {
+            Some(&i) if i != u32::MAX => Some(i as usize),
+            _ => None,
+        }
+    }
+}
+
+/// The index of the first element where `bad` holds, scanning pieces in parallel (each a
+/// plain loop).
+fn first_where<T: Sync>(xs: &[T], bad: impl Fn(&T) -> bool + Sync) -> Option<usize> {
+    xs.par_chunks(PIECE)
+        .enumerate()
+        .filter_map(|(k, piece)| piece.iter().position(&bad).map(|i| k * PIECE + i))
+        .min()
+}
+
+/// Checks every pair (in parallel): the first code outside the input format, else the first
+/// n outside the set, is the error.
+fn check_pairs(dp: &Datapath, index: &NIndex, cs: &[i64], ns: Ns) -> Result<(), Error> {
     let codes = dp.input_codes();
-    if let Some(i) = cs.iter().position(|c| !codes.contains(c)) {
+    let (lo, hi) = (*codes.start(), *codes.end());
+    if let Some(i) = first_where(cs, |&c| c < lo || c > hi) {
         dp.check_code(cs[i], &format!("c[{i}]"))?;
     }
-    let index = |n: u32, what: &str| -> Result<u32, Error> {
-        dp.constants_checked(n, what)?;
-        Ok(dp.config().n.values().binary_search(&n).unwrap_or(0) as u32)
-    };
     match ns {
-        Ns::One(n) => Ok((Vec::new(), index(n, "n")?)),
+        Ns::One(n) => {
+            dp.constants_checked(n, "n")?;
+        }
         Ns::Each(ns) => {
             if ns.len() != cs.len() {
                 return Err(domain(format!(
@@ -69,19 +104,12 @@ fn check_pairs(dp: &Datapath, cs: &[i64], ns: Ns) -> Result<(Vec<u32>, u32), Err
                     ns.len()
                 )));
             }
-            let values = dp.config().n.values();
-            let mut idx = Vec::with_capacity(ns.len());
-            for (i, &n) in ns.iter().enumerate() {
-                match values.binary_search(&n) {
-                    Ok(j) => idx.push(j as u32),
-                    Err(_) => {
-                        index(n, &format!("n[{i}]"))?;
-                    }
-                }
+            if let Some(i) = first_where(ns, |&n| index.of(n).is_none()) {
+                dp.constants_checked(ns[i], &format!("n[{i}]"))?;
             }
-            Ok((idx, 0))
         }
     }
+    Ok(())
 }
 
 /// The output code of every pair into `out` (as long as `cs`): the same codes as
@@ -106,49 +134,138 @@ pub fn eval_outputs(dp: &Datapath, cs: &[i64], ns: Ns, out: &mut [i64]) -> Resul
             cs.len()
         )));
     }
-    let (idx, one) = check_pairs(dp, cs, ns)?;
-    let constants = dp.constants();
+    let index = NIndex::new(dp);
+    check_pairs(dp, &index, cs, ns)?;
     out.par_chunks_mut(PIECE)
         .zip(cs.par_chunks(PIECE))
         .enumerate()
         .for_each_init(OutputScratch::default, |scratch, (piece, (out, cs))| {
-            let idx = (!idx.is_empty()).then(|| &idx[piece * PIECE..piece * PIECE + cs.len()]);
-            let mut start = 0;
-            while start < cs.len() {
-                let (n_idx, end) = match idx {
-                    None => (one, cs.len()),
-                    Some(idx) => {
-                        let n_idx = idx[start];
-                        let len = idx[start..].iter().take_while(|&&j| j == n_idx).count();
-                        (n_idx, start + len)
-                    }
-                };
-                let nc = &constants[n_idx as usize];
-                run(dp, nc, &cs[start..end], &mut out[start..end], scratch);
-                start = end;
-            }
+            eval_piece(dp, &index, piece, cs, ns, out, scratch, false);
         });
     Ok(())
 }
 
+/// The outputs of piece number `piece` (`cs`, into `out`) of a batch, by runs of one n; with
+/// `check`, each run is checked first (its n once, its codes at their ends when they are
+/// consecutive) and the piece stops at the first run outside the domain, returning false.
+#[allow(clippy::too_many_arguments)]
+fn eval_piece(
+    dp: &Datapath,
+    index: &NIndex,
+    piece: usize,
+    cs: &[i64],
+    ns: Ns,
+    out: &mut [i64],
+    scratch: &mut OutputScratch,
+    check: bool,
+) -> bool {
+    let constants = dp.constants();
+    let codes = dp.input_codes();
+    let (lo, hi) = (*codes.start(), *codes.end());
+    let start_at = piece * PIECE;
+    let mut start = 0;
+    while start < cs.len() {
+        let (n, end) = match ns {
+            Ns::One(n) => (n, cs.len()),
+            Ns::Each(ns) => {
+                let ns = &ns[start_at..start_at + cs.len()];
+                let n = ns[start];
+                let len = ns[start..].iter().take_while(|&&m| m == n).count();
+                (n, start + len)
+            }
+        };
+        let Some(n_idx) = index.of(n) else {
+            return false;
+        };
+        let run_cs = &cs[start..end];
+        let first = run_cs[0];
+        let consecutive = run_cs
+            .iter()
+            .enumerate()
+            .all(|(i, &c)| c == first.wrapping_add(i as i64));
+        if check {
+            let last = run_cs[run_cs.len() - 1];
+            let in_format = if consecutive {
+                first >= lo && last <= hi && first <= last
+            } else {
+                run_cs.iter().all(|&c| c >= lo && c <= hi)
+            };
+            if !in_format {
+                return false;
+            }
+        }
+        run(
+            dp,
+            &constants[n_idx],
+            run_cs,
+            &mut out[start..end],
+            scratch,
+            consecutive,
+        );
+        start = end;
+    }
+    true
+}
+
+/// [`eval_outputs`] into a new vector: each piece is checked just before it is evaluated (one
+/// pass over the inputs instead of two; a batch with an input outside the domain returns the
+/// same error and no vector).
+///
+/// # Examples
+/// ```
+/// use specfx::engine::pairs::{eval_outputs_vec, Ns};
+/// let dp = specfx::input::load_datapath("baseline", None).unwrap();
+/// let out = eval_outputs_vec(&dp, &[32768, 0], Ns::Each(&[64, 16])).unwrap();
+/// assert_eq!(out[0], dp.constants_for(64).unwrap().coef_raw);
+/// assert!(eval_outputs_vec(&dp, &[0], Ns::One(7)).is_err());
+/// ```
+pub fn eval_outputs_vec(dp: &Datapath, cs: &[i64], ns: Ns) -> Result<Vec<i64>, Error> {
+    let index = NIndex::new(dp);
+    let length_ok = match ns {
+        Ns::One(n) => index.of(n).is_some(),
+        Ns::Each(ns) => ns.len() == cs.len(),
+    };
+    let mut out = vec![0i64; cs.len()];
+    let all_in_domain = length_ok
+        && out
+            .par_chunks_mut(PIECE)
+            .zip(cs.par_chunks(PIECE))
+            .enumerate()
+            .map_init(OutputScratch::default, |scratch, (piece, (out, cs))| {
+                eval_piece(dp, &index, piece, cs, ns, out, scratch, true)
+            })
+            .reduce(|| true, |a, b| a && b);
+    if !all_in_domain {
+        // The error the two-pass check names (the first code, else the first n, outside).
+        check_pairs(dp, &index, cs, ns)?;
+    }
+    Ok(out)
+}
+
 /// The outputs of one run of codes with one n: short runs one by one, runs of consecutive
 /// codes by [`Datapath::eval_outputs_range`], the others by [`Datapath::eval_outputs`].
-fn run(dp: &Datapath, nc: &NConstants, cs: &[i64], out: &mut [i64], scratch: &mut OutputScratch) {
+fn run(
+    dp: &Datapath,
+    nc: &NConstants,
+    cs: &[i64],
+    out: &mut [i64],
+    scratch: &mut OutputScratch,
+    consecutive: bool,
+) {
     if cs.len() < SHORT_RUN {
         for (o, &c) in out.iter_mut().zip(cs) {
             *o = dp.eval(c, nc).values[dp.stage_out()];
         }
-        return;
-    }
-    for (out, cs) in out
-        .chunks_mut(crate::engine::BATCH_CODES)
-        .zip(cs.chunks(crate::engine::BATCH_CODES))
-    {
+    } else if consecutive && cs[cs.len() - 1] < i64::MAX {
+        // One bisection finds the run's dead prefix; the live codes go through the kernels
+        // (a run ending at i64::MAX, a u1.62 input's largest code, has no end to name).
         let first = cs[0];
-        let consecutive = cs.iter().enumerate().all(|(i, &c)| c == first + i as i64);
-        if consecutive {
-            dp.eval_outputs_range(nc, first..first + cs.len() as i64, out, scratch);
-        } else {
+        dp.eval_outputs_range(nc, first..first + cs.len() as i64, out, scratch);
+    } else {
+        for (out, cs) in out
+            .chunks_mut(crate::engine::BATCH_CODES)
+            .zip(cs.chunks(crate::engine::BATCH_CODES))
+        {
             dp.eval_outputs(nc, cs, out, scratch);
         }
     }
@@ -157,15 +274,19 @@ fn run(dp: &Datapath, nc: &NConstants, cs: &[i64], out: &mut [i64], scratch: &mu
 /// Every stage's probe and event of every pair, by [`Datapath::eval`] in parallel, in pair
 /// order. Nothing is evaluated unless every pair is in the datapath's domain.
 pub fn eval_probes(dp: &Datapath, cs: &[i64], ns: Ns) -> Result<Vec<Probes>, Error> {
-    let (idx, one) = check_pairs(dp, cs, ns)?;
+    let index = NIndex::new(dp);
+    check_pairs(dp, &index, cs, ns)?;
     let constants = dp.constants();
     Ok(cs
         .par_iter()
         .enumerate()
         .with_min_len(1024)
         .map(|(i, &c)| {
-            let n_idx = if idx.is_empty() { one } else { idx[i] };
-            dp.eval(c, &constants[n_idx as usize])
+            let n = match ns {
+                Ns::One(n) => n,
+                Ns::Each(ns) => ns[i],
+            };
+            dp.eval(c, &constants[index.of(n).expect("checked above")])
         })
         .collect())
 }

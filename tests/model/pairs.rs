@@ -6,7 +6,7 @@ use crate::common;
 use crate::common::oracle::oracle_eval;
 
 use rand::{Rng, SeedableRng};
-use specfx::engine::pairs::{eval_one, eval_outputs, eval_probes, Ns};
+use specfx::engine::pairs::{eval_one, eval_outputs, eval_outputs_vec, eval_probes, Ns};
 use specfx::pipeline::Datapath;
 
 /// Configurations at the edges: signed inputs, a 64-bit output, one-bit stages, wrapping,
@@ -52,6 +52,11 @@ fn pairs(dp: &Datapath, seed: u64) -> (Vec<i64>, Vec<u32>) {
         cs.push((start + i).min(hi));
         n.push(n0);
     }
+    // A run of consecutive codes ending at the largest code (i64::MAX for u1.62).
+    for i in 0..100 {
+        cs.push((hi - 99).max(lo) + i.min(hi - lo));
+        n.push(n0);
+    }
     let n1 = ns[rng.gen_range(0..ns.len())];
     for _ in 0..3000 {
         cs.push(rng.gen_range(lo..=hi));
@@ -72,6 +77,8 @@ fn pairs_give_the_oracles_bits() {
         let mut out = vec![0; cs.len()];
         eval_outputs(&dp, &cs, Ns::Each(&ns), &mut out).expect("pairs in the domain");
         let probes = eval_probes(&dp, &cs, Ns::Each(&ns)).expect("pairs in the domain");
+        let fused = eval_outputs_vec(&dp, &cs, Ns::Each(&ns)).expect("pairs in the domain");
+        assert_eq!(fused, out, "{name}: eval_outputs_vec");
         for (i, (&c, &n)) in cs.iter().zip(&ns).enumerate() {
             let nc = dp.constants_for(n).expect("n in the set");
             let want = oracle_eval(dp.config(), nc, c);
@@ -127,6 +134,24 @@ fn inputs_outside_the_domain_are_refused_by_name_and_nothing_is_written() {
         "the output has 3 elements and c has 2: expected as many"
     );
     assert_eq!(out, [-1, -1, -1], "nothing written");
+    // The one-pass batch names the same input: the first code outside, else the first n.
+    let many_c: Vec<i64> = (0..200_000).map(|i| i % 60_000).collect();
+    let mut many_n = vec![16u32; 200_000];
+    many_n[150_000] = 2000;
+    let mut bad_c = many_c.clone();
+    bad_c[190_000] = -5;
+    let err = eval_outputs_vec(&dp, &bad_c, Ns::Each(&many_n)).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "c[190000] = -5 is not a code of the input format u1.15 (expected 0..=65535)"
+    );
+    let err = eval_outputs_vec(&dp, &many_c, Ns::Each(&many_n)).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "n[150000] = 2000 is not in the configuration's exponent set 16..=1024"
+    );
+    assert!(eval_outputs_vec(&dp, &many_c, Ns::One(7)).is_err());
+    assert!(eval_outputs_vec(&dp, &many_c, Ns::Each(&many_n[1..])).is_err());
     assert!(eval_probes(&dp, &[-1], Ns::One(16)).is_err());
     assert_eq!(
         eval_one(&dp, -1, 16).unwrap_err().to_string(),
