@@ -96,7 +96,7 @@ fn passes(args: &[&str], vectors: Option<u64>) -> Output {
         .unwrap_or_else(|| panic!("{cov}"));
     assert_eq!(
         (passed, failed),
-        (vectors.unwrap_or(20000 + directed), 0),
+        (vectors.unwrap_or(5000 + directed), 0),
         "{args:?}: {}{}",
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
@@ -143,7 +143,7 @@ fn the_dpi_scoreboard_passes_on_generated_configurations() {
                 let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 let Some(run) = runs.get(i) else { break };
                 let mut args = run.clone();
-                args.extend(["--cases", "random:20000"]);
+                args.extend(["--cases", "random:5000"]);
                 let o = passes(&args, None);
                 // Bubbles and stalls happened, and the inputs covered c above 1.0.
                 let cov = coverage(&o);
