@@ -37,14 +37,18 @@ fn dpi_library(arg: Option<&Path>) -> Result<PathBuf> {
     }
     let exe = std::env::current_exe().context("cannot find the specfx executable's directory")?;
     let dir = exe.parent().unwrap_or(Path::new("."));
-    let lib = dir.join("libspecfx_c.a");
-    if !lib.is_file() {
-        bail!(
+    // `cargo build` puts it beside the executable; `cargo test` builds it in deps/.
+    match [dir.to_path_buf(), dir.join("deps")]
+        .iter()
+        .map(|d| d.join("libspecfx_c.a"))
+        .find(|l| l.is_file())
+    {
+        Some(lib) => Ok(lib),
+        None => bail!(
             "--dpi: no libspecfx_c.a beside the specfx executable in {} (build it with `cargo build --release`, which builds capi/ too, or pass --dpi-lib)",
             dir.display()
-        );
+        ),
     }
-    Ok(lib)
 }
 
 /// A probability as the testbench's whole percent.

@@ -162,17 +162,20 @@ radius = 1.0
 #[allow(dead_code)]
 pub fn capi_dir() -> std::path::PathBuf {
     let exe = std::env::current_exe().expect("the test binary's path");
-    let dir = exe
-        .parent()
-        .and_then(|deps| deps.parent())
-        .expect("target/<profile>/deps/<test>")
-        .to_path_buf();
-    assert!(
-        dir.join("libspecfx_c.a").is_file(),
-        "{}: no libspecfx_c.a; build the C library with `cargo build -p specfx-capi --profile test` (a plain `cargo test` builds it)",
-        dir.display()
-    );
-    dir
+    let deps = exe.parent().expect("target/<profile>/deps/<test>");
+    let profile = deps.parent().expect("target/<profile>/deps");
+    // `cargo build` puts the library in target/<profile>/; `cargo test` alone builds it as
+    // the C crate's tests' dependency, in deps/.
+    [profile, deps]
+        .into_iter()
+        .find(|d| d.join("libspecfx_c.a").is_file())
+        .unwrap_or_else(|| {
+            panic!(
+                "{}: no libspecfx_c.a; build the C library with `cargo build` (a plain `cargo test` builds it too)",
+                profile.display()
+            )
+        })
+        .to_path_buf()
 }
 
 /// The flags that link a program against `libspecfx_c.a` (rustc's native-static-libs: the
