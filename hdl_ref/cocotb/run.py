@@ -163,6 +163,18 @@ def import_runner():
     return get_runner
 
 
+def dut_parameters(specfx_bin, source, args):
+    """specfx_top's parameters for a configuration (`source`: --config or --vectors and its
+    argument), the architecture and RESET_DATA of the arguments."""
+    params_args = ["hdl", "params", *source, "--arch", args.arch, "--format", "json"]
+    if args.reset_data:
+        params_args.append("--reset-data")
+    try:
+        return json.loads(run_specfx(specfx_bin, params_args))
+    except ValueError as e:
+        raise UsageError(f"specfx hdl params printed no JSON: {e}") from None
+
+
 def live_setup(args, build_dir, specfx_bin):
     """The DUT's parameters and the test's environment of a --live run."""
     try:
@@ -178,14 +190,7 @@ def live_setup(args, build_dir, specfx_bin):
         raise UsageError(str(e)) from None
     config = build_dir / "config.toml"
     config.write_text(dp.toml)
-    params_args = ["hdl", "params", "--config", str(config), "--arch", args.arch]
-    params_args += ["--format", "json"]
-    if args.reset_data:
-        params_args.append("--reset-data")
-    try:
-        parameters = json.loads(run_specfx(specfx_bin, params_args))
-    except ValueError as e:
-        raise UsageError(f"specfx hdl params printed no JSON: {e}") from None
+    parameters = dut_parameters(specfx_bin, ["--config", str(config)], args)
     environment = {
         "SPECFX_CONFIG": str(config),
         "SPECFX_ARCH": args.arch,
@@ -205,14 +210,7 @@ def vector_setup(args, build_dir, specfx_bin):
         raise UsageError(
             f"{vectors}: no manifest.json (write one with specfx vectors --out {vectors})"
         )
-    params_args = ["hdl", "params", "--vectors", str(vectors), "--arch", args.arch]
-    params_args += ["--format", "json"]
-    if args.reset_data:
-        params_args.append("--reset-data")
-    try:
-        parameters = json.loads(run_specfx(specfx_bin, params_args))
-    except ValueError as e:
-        raise UsageError(f"specfx hdl params printed no JSON: {e}") from None
+    parameters = dut_parameters(specfx_bin, ["--vectors", str(vectors)], args)
     stim = build_dir / "stimulus"
     stim_args = ["hdl", "stimulus", "--vectors", str(vectors), "--arch", args.arch]
     stim_args += ["--seed", str(args.seed), "--bubble", args.bubble, "--stall", args.stall]

@@ -21,6 +21,14 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
+/// The exponents of a batch: `n[i]` for each code, or `n_all` for all when `n` is None.
+fn exponents<'a>(n: &'a Option<PyReadonlyArray1<'_, u32>>, n_all: u32) -> PyResult<Ns<'a>> {
+    Ok(match n {
+        Some(n) => Ns::Each(n.as_slice()?),
+        None => Ns::One(n_all),
+    })
+}
+
 /// A validated datapath (the native half of `specfx.Datapath`).
 #[pyclass(frozen, module = "specfx._specfx")]
 struct Model {
@@ -126,10 +134,7 @@ impl Model {
         n_all: u32,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let cs = c.as_slice()?;
-        let ns = match &n {
-            Some(n) => Ns::Each(n.as_slice()?),
-            None => Ns::One(n_all),
-        };
+        let ns = exponents(&n, n_all)?;
         let out = py
             .detach(|| pairs::eval_outputs_vec(&self.dp, cs, ns))
             .map_err(value_error)?;
@@ -148,10 +153,7 @@ impl Model {
         mut out: PyReadwriteArray1<'py, i64>,
     ) -> PyResult<()> {
         let cs = c.as_slice()?;
-        let ns = match &n {
-            Some(n) => Ns::Each(n.as_slice()?),
-            None => Ns::One(n_all),
-        };
+        let ns = exponents(&n, n_all)?;
         let out = out.as_slice_mut()?;
         py.detach(|| pairs::eval_outputs(&self.dp, cs, ns, out))
             .map_err(value_error)
@@ -175,10 +177,7 @@ impl Model {
         Bound<'py, PyArray1<bool>>,
     )> {
         let cs = c.as_slice()?;
-        let ns = match &n {
-            Some(n) => Ns::Each(n.as_slice()?),
-            None => Ns::One(n_all),
-        };
+        let ns = exponents(&n, n_all)?;
         let stages = self.dp.stages().len();
         let len = cs.len();
         let (values, events, cut, clamped) = py

@@ -203,51 +203,39 @@ fn copy_hdl_ref(tag: &str) -> PathBuf {
 }
 
 fn cosim(hdl_ref: &Path, config: &str, arch: &str, flags: &[&str]) -> Output {
-    let config = config_arg(config);
-    let mut args = vec![
-        "cosim",
-        "--sim",
-        "icarus",
-        "--config",
-        &config,
-        "--arch",
+    run_cosim(
+        &["--sim", "icarus", "--cases", "corner,random:600"],
+        hdl_ref,
+        config,
         arch,
-        "--seed",
-        "7",
-        "--bubble",
-        "0.3",
-        "--stall",
-        "0.3",
-        "--cases",
-        "corner,random:600",
-        "--hdl-ref",
-        hdl_ref.to_str().expect("a UTF-8 temporary path"),
-    ];
-    args.extend_from_slice(flags);
-    common::specfx(&args)
+        flags,
+    )
 }
 
 /// The DPI scoreboard (`specfx cosim --dpi`, Verilator) on random stimulus.
 fn cosim_dpi(hdl_ref: &Path, config: &str, arch: &str, flags: &[&str]) -> Output {
-    let config = config_arg(config);
-    let mut args = vec![
-        "cosim",
-        "--dpi",
-        "--config",
-        &config,
-        "--arch",
+    run_cosim(
+        &["--dpi", "--cases", "random:3000"],
+        hdl_ref,
+        config,
         arch,
-        "--seed",
-        "7",
-        "--bubble",
-        "0.3",
-        "--stall",
-        "0.3",
-        "--cases",
-        "random:3000",
+        flags,
+    )
+}
+
+/// `specfx cosim` with `how` (simulator, cases) on a configuration, seeded stimulus with
+/// bubbles and stalls, and a copy of the reference Verilog.
+fn run_cosim(how: &[&str], hdl_ref: &Path, config: &str, arch: &str, flags: &[&str]) -> Output {
+    let config = config_arg(config);
+    let mut args = vec!["cosim"];
+    args.extend_from_slice(how);
+    args.extend([
+        "--config", &config, "--arch", arch, "--seed", "7", "--bubble", "0.3", "--stall", "0.3",
+    ]);
+    args.extend([
         "--hdl-ref",
         hdl_ref.to_str().expect("a UTF-8 temporary path"),
-    ];
+    ]);
     args.extend_from_slice(flags);
     common::specfx(&args)
 }
