@@ -12,7 +12,9 @@ output is also checked on its cycle.
 Every cycle it also compares every register of the core (`specfx_top.g_pipelined.u_core` or
 `g_folded.u_core`) holding valid data with the cycle model's (`Machine.registers`, the RTL's
 names): when the run fails, the first register that differed (e.g. `g_square[1].y_q`, the
-second squaring) names the stage that went wrong, in a `stage:` line.
+second squaring) names the stage that went wrong, in a `stage:` line. Under Verilator the
+registers are visible as run.py builds it (`--public-flat-rw`), and are found by their full
+names (cocotb_compat.signal_at); the log says how many of the model's registers were found.
 
 Environment (hdl_ref/cocotb/run.py --live sets it):
   SPECFX_CONFIG    the configuration, as specfx --config takes it (the same as the DUT's
@@ -30,15 +32,17 @@ import random
 from pathlib import Path
 
 import cocotb
-from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
 import specfx
+from cocotb_compat import signal_at, start_clock
 
 RESET_EDGES = 4
 CLOCK_PERIOD_NS = 10
 MAX_SHOWN = 10
 PORTS = ("in_slope", "in_offset", "in_threshold", "in_coef")
+# The core below specfx_top, by architecture.
+CORE = {"pipelined": "g_pipelined.u_core", "folded": "g_folded.u_core"}
 
 
 def env(name, default=None):
@@ -93,22 +97,6 @@ def drive(dut, widths, item):
         getattr(dut, name).value = v & ((1 << widths[name]) - 1)
 
 
-def core(dut, arch):
-    return dut.g_pipelined.u_core if arch == "pipelined" else dut.g_folded.u_core
-
-
-def handle_of(root, name):
-    """The handle of a register below the core, e.g. `g_square[2].y_q`."""
-    h = root
-    for part in name.split("."):
-        if "[" in part:
-            base, idx = part[:-1].split("[")
-            h = getattr(h, base)[int(idx)]
-        else:
-            h = getattr(h, part)
-    return h
-
-
 async def reset(dut):
     dut.rst.value = 1
     dut.in_valid.value = 0
@@ -136,18 +124,20 @@ async def specfx_live_scoreboard(dut):
     rng = random.Random(seed + 1)
     log.info("%d vectors (%d directed), %s, seed %d", stim.total, len(stim.directed), arch, seed)
 
-    Clock(dut.clk, CLOCK_PERIOD_NS, unit="ns").start(start_high=False)
+    start_clock(dut.clk, CLOCK_PERIOD_NS)
     await reset(dut)
-    root = core(dut, arch)
     handles = {}
     for name, _, _ in machine.registers():
         try:
-            handles[name] = handle_of(root, name)
+            # A register below the core, e.g. `g_square[2].y_q`.
+            handles[name] = signal_at(dut, f"{CORE[arch]}.{name}")
         except (AttributeError, IndexError, KeyError):
             # A register the RTL does not have: the cycle model's registers are the reference
             # RTL's; a modified RTL may differ, and then the outputs still say whether it is
             # right.
             pass
+    log.info("%d of the cycle model's %d registers found in the core", len(handles),
+             len(machine.registers()))
     first_register = None  # the first register that differed from the model's
 
     expected = []  # (c, n, constants, output) of the inputs that transferred, in order
@@ -210,10 +200,10 @@ async def specfx_live_scoreboard(dut):
             else:
                 c, n, constants, want = expected[out_idx]
                 on_cycle = m_out is not None and m_out[0] == out_idx
-                if data.is_resolvable and data.to_unsigned() == want & mask and on_cycle:
+                if data.is_resolvable and int(data) == want & mask and on_cycle:
                     passed += 1
                 else:
-                    got = f"{data.to_unsigned():x}" if data.is_resolvable else str(data)
+                    got = f"{int(data):x}" if data.is_resolvable else str(data)
                     fail(
                         f"mismatch i={out_idx} n={n} c={c} got={got} want={want & mask:x} "
                         f"cycle={cycle} (the cycle model "

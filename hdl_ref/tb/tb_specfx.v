@@ -1,10 +1,11 @@
 // tb_specfx: co-simulation testbench of specfx_top against the golden vectors of
 // `specfx vectors` and the stimulus of `specfx hdl stimulus` (docs/cycle.md).
 //
-// Reads from the current directory ($readmemh): in_c.hex, in_n.hex, in_slope.hex,
-// in_offset.hex, in_threshold.hex, in_coef.hex, expected_out.hex (one word per vector),
-// stim_valid.hex, stim_ready.hex (one bit per cycle) and expected_cycle.hex (one 32-bit word
-// per vector). Parameters (set per run: iverilog -Ptb_specfx.<NAME>=<value>, verilator
+// Reads ($readmemh) in_c.hex, in_n.hex, in_slope.hex, in_offset.hex, in_threshold.hex,
+// in_coef.hex, expected_out.hex (one word per vector) from the directory of the plusarg
+// +vectors=DIR, and stim_valid.hex, stim_ready.hex (one bit per cycle) and expected_cycle.hex
+// (one 32-bit word per vector) from that of +stimulus=DIR; each defaults to the current
+// directory (paths up to 500 characters). Parameters (set per run: iverilog -Ptb_specfx.<NAME>=<value>, verilator
 // -G<NAME>=<value>; `specfx hdl params --format iverilog --top tb_specfx` prints them):
 // NVEC (vectors), NCYC (lines of the stimulus files) and every parameter of specfx_top, passed
 // to the DUT instance `dut`. Defining SPECFX_VCD dumps every signal to rtl.vcd.
@@ -74,20 +75,26 @@ module tb_specfx #(
     reg                stim_valid    [0:NCYC_MEM-1];
     reg                stim_ready    [0:NCYC_MEM-1];
 
+    // The directories of the vector and the stimulus files (plusargs), and a file's path.
+    reg [8*500-1:0] vec_dir, stim_dir;
+    reg [8*520-1:0] path;
     initial begin
+        if (!$value$plusargs("vectors=%s", vec_dir)) vec_dir = ".";
+        if (!$value$plusargs("stimulus=%s", stim_dir)) stim_dir = ".";
         if (NVEC > 0) begin
-            $readmemh("in_c.hex", mem_c);
-            $readmemh("in_n.hex", mem_n);
-            $readmemh("in_slope.hex", mem_slope);
-            $readmemh("in_offset.hex", mem_offset);
-            $readmemh("in_threshold.hex", mem_threshold);
-            $readmemh("in_coef.hex", mem_coef);
-            $readmemh("expected_out.hex", mem_out);
-            $readmemh("expected_cycle.hex", mem_cycle);
+            $sformat(path, "%0s/in_c.hex", vec_dir);         $readmemh(path, mem_c);
+            $sformat(path, "%0s/in_n.hex", vec_dir);         $readmemh(path, mem_n);
+            $sformat(path, "%0s/in_slope.hex", vec_dir);     $readmemh(path, mem_slope);
+            $sformat(path, "%0s/in_offset.hex", vec_dir);    $readmemh(path, mem_offset);
+            $sformat(path, "%0s/in_threshold.hex", vec_dir); $readmemh(path, mem_threshold);
+            $sformat(path, "%0s/in_coef.hex", vec_dir);      $readmemh(path, mem_coef);
+            $sformat(path, "%0s/expected_out.hex", vec_dir); $readmemh(path, mem_out);
+            $sformat(path, "%0s/expected_cycle.hex", stim_dir);
+            $readmemh(path, mem_cycle);
         end
         if (NCYC > 0) begin
-            $readmemh("stim_valid.hex", stim_valid);
-            $readmemh("stim_ready.hex", stim_ready);
+            $sformat(path, "%0s/stim_valid.hex", stim_dir);  $readmemh(path, stim_valid);
+            $sformat(path, "%0s/stim_ready.hex", stim_dir);  $readmemh(path, stim_ready);
         end
     end
 

@@ -25,6 +25,9 @@ enum FormatArg {
     Iverilog,
     /// Verilator flags, one per line: `-G<NAME>=<value>` (for the top module).
     Verilator,
+    /// FuseSoC flags, one per line: `--<NAME>=<value>` (after the core's name in `fusesoc
+    /// run`; hdl_ref/specfx.core).
+    Fusesoc,
     /// A Verilog instantiation of `specfx_top` with every parameter set.
     Instance,
 }
@@ -36,6 +39,7 @@ impl From<FormatArg> for ParamsFormat {
             FormatArg::Json => ParamsFormat::Json,
             FormatArg::Iverilog => ParamsFormat::Iverilog,
             FormatArg::Verilator => ParamsFormat::Verilator,
+            FormatArg::Fusesoc => ParamsFormat::Fusesoc,
             FormatArg::Instance => ParamsFormat::Instance,
         }
     }

@@ -191,6 +191,9 @@ pub enum ParamsFormat {
     Iverilog,
     /// Verilator flags, one per line: `-G<NAME>=<value>` (for the top module).
     Verilator,
+    /// FuseSoC parameter flags, one per line: `--<NAME>=<value>` (`fusesoc run --target T
+    /// specfx:specfx:specfx_top` takes them after the core's name; `hdl_ref/specfx.core`).
+    Fusesoc,
     /// A Verilog instantiation of `specfx_top` with every parameter set.
     Instance,
 }
@@ -234,6 +237,11 @@ pub fn render_parameters(
         ParamsFormat::Verilator => {
             for (name, value) in params {
                 writeln!(s, "-G{name}={value}").expect("write to String");
+            }
+        }
+        ParamsFormat::Fusesoc => {
+            for (name, value) in params {
+                writeln!(s, "--{name}={value}").expect("write to String");
             }
         }
         ParamsFormat::Instance => {

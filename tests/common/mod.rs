@@ -182,3 +182,23 @@ pub fn capi_dir() -> std::path::PathBuf {
 /// C++ of nv-flip needs libstdc++).
 #[allow(dead_code)]
 pub const CAPI_LINK_FLAGS: &[&str] = &["-lstdc++", "-lpthread", "-lm", "-ldl"];
+
+/// The Python of the virtual environment `./scripts/test` makes (cocotb, FuseSoC, numpy and the
+/// specfx wheel): `$SPECFX_COCOTB_PYTHON`, else `target/cocotb-venv/bin/python`; a test
+/// needing it fails with one clear line when it is missing.
+#[allow(dead_code)]
+pub fn venv_python() -> std::path::PathBuf {
+    let python = std::env::var_os("SPECFX_COCOTB_PYTHON")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| {
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/cocotb-venv/bin/python")
+        });
+    assert!(
+        python.is_file(),
+        "{}: no Python with cocotb and FuseSoC; ./scripts/test makes it (or: python3 -m venv \
+         target/cocotb-venv && target/cocotb-venv/bin/pip install -r \
+         hdl_ref/cocotb/requirements.txt), or set SPECFX_COCOTB_PYTHON",
+        python.display()
+    );
+    python
+}

@@ -3,29 +3,13 @@
 //! fails. Needs cocotb in `target/cocotb-venv` (`./scripts/test` makes it and sets
 //! `SPECFX_COCOTB_PYTHON`) and Icarus Verilog.
 
-use crate::common::{config_path, specfx};
+use crate::common::{config_path, specfx, venv_python as cocotb_python};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The Python that has the pinned cocotb: `$SPECFX_COCOTB_PYTHON`, else the virtual
-/// environment `./scripts/test` makes.
-fn cocotb_python() -> PathBuf {
-    let python = std::env::var_os("SPECFX_COCOTB_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target/cocotb-venv/bin/python"));
-    assert!(
-        python.is_file(),
-        "{}: no Python with cocotb; ./scripts/test makes it (or: python3 -m venv \
-         target/cocotb-venv && target/cocotb-venv/bin/pip install -r \
-         hdl_ref/cocotb/requirements.txt), or set SPECFX_COCOTB_PYTHON",
-        python.display()
-    );
-    python
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -245,11 +229,43 @@ fn an_output_that_moves_while_stalled_fails() {
     );
 }
 
-/// Runs `hdl_ref/cocotb/run.py --live CONFIG` (the live scoreboard, `import specfx`).
+/// Runs `hdl_ref/cocotb/run.py --live CONFIG` (the live scoreboard, `import specfx`) under
+/// Icarus Verilog.
 fn run_live(config: &str, args: &[&str]) -> Output {
     Command::new(cocotb_python())
         .arg(root().join("hdl_ref/cocotb/run.py"))
         .args(["--live", config, "--specfx", env!("CARGO_BIN_EXE_specfx")])
+        .args(args)
+        .output()
+        .expect("the cocotb Python runs")
+}
+
+/// The Python with cocotb 1.8.1, which runs Verilator 5.006 (cocotb 2.x needs 5.036):
+/// `$SPECFX_COCOTB_VERILATOR_PYTHON`, else the virtual environment `./scripts/test` makes.
+fn cocotb_verilator_python() -> PathBuf {
+    let python = std::env::var_os("SPECFX_COCOTB_VERILATOR_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target/cocotb18-venv/bin/python"));
+    assert!(
+        python.is_file(),
+        "{}: no Python with cocotb 1.8.1; ./scripts/test makes it (or: python3 -m venv \
+         target/cocotb18-venv && target/cocotb18-venv/bin/pip install -r \
+         hdl_ref/cocotb/requirements-verilator.txt and the specfx wheel)",
+        python.display()
+    );
+    python
+}
+
+/// `hdl_ref/cocotb/run.py --sim verilator ARGS` with cocotb 1.8.1.
+fn run_verilator(args: &[&str]) -> Output {
+    Command::new(cocotb_verilator_python())
+        .arg(root().join("hdl_ref/cocotb/run.py"))
+        .args([
+            "--sim",
+            "verilator",
+            "--specfx",
+            env!("CARGO_BIN_EXE_specfx"),
+        ])
         .args(args)
         .output()
         .expect("the cocotb Python runs")
@@ -287,37 +303,117 @@ fn the_live_scoreboard_passes() {
     }
 }
 
-/// A failing seed points at a stage: the b adder reading the offset one stage early fails,
-/// and the first register that differs from the model is the b stage's.
-#[test]
-fn the_live_scoreboard_names_the_stage_that_went_wrong() {
-    let dir = temp_dir("stage");
-    for sub in ["rtl"] {
-        std::fs::create_dir_all(dir.join(sub)).unwrap();
-        for e in std::fs::read_dir(root().join("hdl_ref").join(sub)).unwrap() {
-            let p = e.unwrap().path();
-            std::fs::copy(&p, dir.join(sub).join(p.file_name().unwrap())).unwrap();
-        }
+/// A copy of `hdl_ref/rtl` whose b adder reads the offset one stage early.
+fn offset_one_stage_early(name: &str) -> PathBuf {
+    let dir = temp_dir(name);
+    std::fs::create_dir_all(dir.join("rtl")).unwrap();
+    for e in std::fs::read_dir(root().join("hdl_ref/rtl")).unwrap() {
+        let p = e.unwrap().path();
+        std::fs::copy(&p, dir.join("rtl").join(p.file_name().unwrap())).unwrap();
     }
     let file = dir.join("rtl/specfx_pipelined.v");
     let text_v = std::fs::read_to_string(&file).unwrap();
     let from = ".t(t_2), .offset(offset_2)";
     assert_eq!(text_v.matches(from).count(), 1);
     std::fs::write(&file, text_v.replace(from, ".t(t_2), .offset(offset_1)")).unwrap();
+    dir
+}
+
+/// The `stage:` line of a failed live run: the first register that differs from the model.
+fn stage_line(o: &Output) -> String {
+    assert_eq!(o.status.code(), Some(1), "{}", text(o));
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .find(|l| l.starts_with("stage: "))
+        .map(str::to_string)
+        .unwrap_or_else(|| panic!("no stage line:\n{}", text(o)))
+}
+
+/// A failing seed points at a stage: the b adder reading the offset one stage early fails,
+/// and the first register that differs from the model is the b stage's.
+#[test]
+fn the_live_scoreboard_names_the_stage_that_went_wrong() {
+    let dir = offset_one_stage_early("stage");
     let minimax = config_path("minimax_folded.toml");
     let o = run_live(
         &minimax,
         &["--nvec", "100", "--hdl-ref", dir.to_str().unwrap()],
     );
-    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    let stage = String::from_utf8_lossy(&o.stdout)
-        .lines()
-        .find(|l| l.starts_with("stage: "))
-        .map(str::to_string)
-        .unwrap_or_else(|| panic!("no stage line:\n{}", text(&o)));
+    let stage = stage_line(&o);
     assert!(
         stage.contains("the first register that differs from the model is b"),
         "{stage}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Under Verilator (cocotb 1.8.1): the live scoreboard passes in the folded architecture with
+/// bubbles and stalls, the vector replay passes pipelined, and the same broken b adder is
+/// named by its register.
+#[test]
+fn the_cocotb_testbenches_pass_and_fail_under_verilator() {
+    let o = run_verilator(&[
+        "--live",
+        "baseline",
+        "--n",
+        "16..=20,1000..=1024",
+        "--arch",
+        "folded",
+        "--nvec",
+        "400",
+        "--seed",
+        "5",
+        "--bubble",
+        "0.3",
+        "--stall",
+        "0.3",
+    ]);
+    assert!(
+        o.status.success(),
+        "live, folded: run.py failed:\n{}",
+        text(&o)
+    );
+    assert!(vectors_passed(&o).unwrap_or(0) > 400, "{}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("(verilator, folded, live scoreboard)"),
+        "{}",
+        text(&o)
+    );
+
+    let (dir, n) = vectors(
+        "verilator",
+        &[
+            "--config",
+            &config_path("conv_sym_k5.toml"),
+            "--cases",
+            "corner,random:200",
+        ],
+    );
+    let o = run_verilator(&[
+        "--vectors",
+        dir.to_str().unwrap(),
+        "--seed",
+        "6",
+        "--stall",
+        "0.3",
+    ]);
+    assert!(o.status.success(), "vectors: run.py failed:\n{}", text(&o));
+    assert_eq!(vectors_passed(&o), Some(n), "{}", text(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    let broken = offset_one_stage_early("stage-verilator");
+    let o = run_verilator(&[
+        "--live",
+        &config_path("minimax_folded.toml"),
+        "--nvec",
+        "100",
+        "--hdl-ref",
+        broken.to_str().unwrap(),
+    ]);
+    let stage = stage_line(&o);
+    assert!(
+        stage.contains("the first register that differs from the model is b"),
+        "{stage}"
+    );
+    std::fs::remove_dir_all(&broken).unwrap();
 }

@@ -12,6 +12,7 @@ mod cli_hw;
 mod cocotb;
 mod cosim;
 mod dpi;
+mod fusesoc;
 mod lint;
 mod mutation;
 mod python;

@@ -244,10 +244,7 @@ fn run_cosim(how: &[&str], hdl_ref: &Path, config: &str, arch: &str, flags: &[&s
 /// random stimulus; the exponents cut to a few where the set is large.
 fn cocotb_live(hdl_ref: &Path, config: &str, arch: &str, flags: &[&str]) -> Output {
     let config = config_arg(config);
-    let python = std::env::var_os("SPECFX_COCOTB_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target/cocotb-venv/bin/python"));
-    let mut cmd = std::process::Command::new(python);
+    let mut cmd = std::process::Command::new(common::venv_python());
     cmd.arg(root().join("hdl_ref/cocotb/run.py"))
         .args([
             "--live", &config, "--arch", arch, "--seed", "7", "--nvec", "600",

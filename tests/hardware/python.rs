@@ -7,10 +7,7 @@ use std::process::Command;
 
 /// The Python with the specfx wheel: `$SPECFX_COCOTB_PYTHON`, else `target/cocotb-venv`.
 fn python() -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let python = std::env::var_os("SPECFX_COCOTB_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join("target/cocotb-venv/bin/python"));
+    let python = crate::common::venv_python();
     let o = Command::new(&python).args(["-c", "import specfx"]).output();
     assert!(
         o.as_ref().is_ok_and(|o| o.status.success()),
