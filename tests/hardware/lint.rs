@@ -704,16 +704,21 @@ fn tool_text(tool: &str, o: &Output) -> String {
     )
 }
 
-/// Lints the DUT and the RTL with the header in `dir`, and the parameterized top
-/// `specfx_top` with the configuration's `-G` flags: every tool's complaints, if any.
-fn lint(dir: &Path, files: &[PathBuf], top_flags: &[String]) -> Vec<String> {
+/// Lints the DUT and the RTL with the header in `dir` (Icarus; Verilator too when `dut_verilator`),
+/// and the parameterized top `specfx_top` with the configuration's `-G` flags (Verilator):
+/// every tool's complaints, if any. Verilator sees the same RTL with the same parameter values
+/// through the header and through `-G`: the generated configurations lint the RTL through `-G`
+/// and the header path through Icarus, the fixed ones through all three.
+fn lint(dir: &Path, files: &[PathBuf], top_flags: &[String], dut_verilator: bool) -> Vec<String> {
     let include = format!("-I{}", dir.display());
-    let verilator = Command::new("verilator")
-        .args(["--lint-only", "-Wall", "--top-module", "specfx_dut"])
-        .arg(&include)
-        .args(files)
-        .output()
-        .expect("verilator is installed (./scripts/test installs it)");
+    let verilator = dut_verilator.then(|| {
+        Command::new("verilator")
+            .args(["--lint-only", "-Wall", "--top-module", "specfx_dut"])
+            .arg(&include)
+            .args(files)
+            .output()
+            .expect("verilator is installed (./scripts/test installs it)")
+    });
     let top = Command::new("verilator")
         .args(["--lint-only", "-Wall", "--top-module", "specfx_top"])
         .args(top_flags)
@@ -729,17 +734,24 @@ fn lint(dir: &Path, files: &[PathBuf], top_flags: &[String]) -> Vec<String> {
         .expect("iverilog is installed (./scripts/test installs it)");
     [
         ("verilator", verilator),
-        ("verilator (specfx_top, -G parameters)", top),
-        ("iverilog", icarus),
+        ("verilator (specfx_top, -G parameters)", Some(top)),
+        ("iverilog", Some(icarus)),
     ]
     .into_iter()
+    .filter_map(|(tool, o)| Some((tool, o?)))
     .filter(|(_, o)| !o.status.success() || !o.stderr.is_empty())
     .map(|(tool, o)| tool_text(tool, &o))
     .collect()
 }
 
 /// Lints one configuration file for both architectures; the failures, each with the TOML.
-fn lint_config(label: &str, config: &Path, dir: &Path, files: &[PathBuf]) -> Vec<String> {
+fn lint_config(
+    label: &str,
+    config: &Path,
+    dir: &Path,
+    files: &[PathBuf],
+    dut_verilator: bool,
+) -> Vec<String> {
     let mut failures = Vec::new();
     for arch in ["pipelined", "folded"] {
         if let Err(o) = params(config, arch, dir) {
@@ -760,7 +772,7 @@ fn lint_config(label: &str, config: &Path, dir: &Path, files: &[PathBuf]) -> Vec
             .lines()
             .map(str::to_string)
             .collect();
-        for complaint in lint(dir, files, &flags) {
+        for complaint in lint(dir, files, &flags, dut_verilator) {
             failures.push(format!(
                 "{label} ({arch}): {complaint}\n--- {}\n{}",
                 config.display(),
@@ -872,24 +884,62 @@ fn rtl_is_lint_clean_for_generated_and_edge_configurations() {
         } else {
             config_path(name)
         };
-        failures.extend(lint_config(name, &config, &dir, &files));
+        failures.extend(lint_config(name, &config, &dir, &files, true));
         fixed += 1;
     }
 
+    // The generated candidates on two workers, each in a directory of its own; the verdicts
+    // are put back in the candidates' order.
     let all = candidates();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut verdicts: Vec<(usize, Result<Vec<String>, String>)> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..2)
+            .map(|w| {
+                let (all, next, files) = (&all, &next, &files);
+                s.spawn(move || {
+                    let dir = temp_dir(&format!("lint-{w}"));
+                    let config = dir.join("generated.toml");
+                    let mut out = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(c) = all.get(i) else { break };
+                        std::fs::write(&config, c.to_toml()).unwrap();
+                        let verdict = match params(&config, "pipelined", &dir) {
+                            Err(o) => {
+                                let why = String::from_utf8_lossy(&o.stderr);
+                                Err(why
+                                    .rsplit(".toml: ")
+                                    .next()
+                                    .unwrap_or_default()
+                                    .trim()
+                                    .to_string())
+                            }
+                            Ok(()) => Ok(lint_config(&c.name, &config, &dir, files, false)),
+                        };
+                        out.push((i, verdict));
+                    }
+                    std::fs::remove_dir_all(&dir).unwrap();
+                    out
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().unwrap())
+            .collect()
+    });
+    verdicts.sort_by_key(|v| v.0);
     let mut kept = Vec::new();
     let mut rejected = String::new();
-    let config = dir.join("generated.toml");
-    for c in &all {
-        std::fs::write(&config, c.to_toml()).unwrap();
-        if let Err(o) = params(&config, "pipelined", &dir) {
-            let why = String::from_utf8_lossy(&o.stderr);
-            let why = why.rsplit(".toml: ").next().unwrap_or_default().trim();
-            rejected += &format!("  {} ({:?}): {why}\n", c.name, c.shape);
-            continue;
+    for (i, verdict) in verdicts {
+        let c = &all[i];
+        match verdict {
+            Err(why) => rejected += &format!("  {} ({:?}): {why}\n", c.name, c.shape),
+            Ok(complaints) => {
+                failures.extend(complaints);
+                kept.push(c.clone());
+            }
         }
-        failures.extend(lint_config(&c.name, &config, &dir, &files));
-        kept.push(c.clone());
     }
     std::fs::remove_dir_all(&dir).unwrap();
 
