@@ -151,8 +151,8 @@ class Datapath:
         else an int64 array of their broadcast shape (``c`` and ``n`` arrays of the same shape,
         or one ``n``), computed on every core with the GIL released. ``out``, a C-contiguous
         int64 array of that shape, receives the codes instead of a new array (reusing it saves
-        the allocation, as numpy's ``out=``); it is written only when every input is in the
-        model's domain."""
+        the allocation, as numpy's ``out=``); when an input is outside the model's domain the
+        ``ValueError`` comes after some of it may have been written, as with numpy's ``out=``."""
         if out is None and np.ndim(c) == 0 and np.ndim(n) == 0:
             _codes(c, "c", np.int64)
             _codes(n, "n", np.uint32)

@@ -141,8 +141,8 @@ impl Model {
         Ok(out.into_pyarray(py))
     }
 
-    /// [`Model::eval_array`] into `out` (as long as `c`), which is written only when every pair
-    /// is in the model's domain.
+    /// [`Model::eval_array`] into `out` (as long as `c`), in one pass: on an error (a pair
+    /// outside the model's domain) `out` may hold some outputs, as numpy's `out=`.
     #[pyo3(signature = (c, n, n_all, out))]
     fn eval_into<'py>(
         &self,
@@ -155,7 +155,7 @@ impl Model {
         let cs = c.as_slice()?;
         let ns = exponents(&n, n_all)?;
         let out = out.as_slice_mut()?;
-        py.detach(|| pairs::eval_outputs(&self.dp, cs, ns, out))
+        py.detach(|| pairs::eval_outputs_streaming(&self.dp, cs, ns, out))
             .map_err(value_error)
     }
 

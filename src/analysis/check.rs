@@ -209,7 +209,12 @@ struct OutputsOfN {
 /// The output figures of one exponent: the dead prefix (cut in both models, see
 /// [`dead_prefix_end`]) counts as exact, without evaluation; every later code is evaluated and
 /// compared with the f64 walk, exactly as [`check_one_n`] compares them.
-fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> OutputsOfN {
+fn outputs_one_n(
+    dp: &Datapath,
+    nc: &NConstants,
+    shared: &CodeColumns,
+    cache: Option<&CosCache>,
+) -> OutputsOfN {
     let cfg = dp.config();
     let codes = &shared.codes.codes[..];
     let (lo, last) = (codes[0], codes[codes.len() - 1]);
@@ -220,15 +225,18 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
     let nf = f64::from(nc.n);
     let threshold = nc.threshold.unwrap_or(i64::MIN);
     let one = dp.one_code();
-    let cos_n = |i: usize| {
-        if codes[i] as f64 * c_lsb <= 0.0 {
-            0.0
-        } else {
-            (nf * shared.codes.ln_c[i]).exp()
-        }
-    };
+    let cos_direct = |i: usize| cos_n_of(codes[i], c_lsb, nf, shared.codes.ln_c[i]);
     let dead_end = dead_prefix_end(dp, nc, codes);
     let n_dead = (dead_end - lo) as usize;
+    let row = cache.and_then(|c| {
+        c.row(nc.n, n_dead, || {
+            (n_dead..codes.len()).map(cos_direct).collect()
+        })
+    });
+    let cos_n = |i: usize| match &row {
+        Some(r) if i >= r.start => r.values[i - r.start],
+        _ => cos_direct(i),
+    };
     let mut r = OutputsOfN {
         quant: -1.0,
         approx: -1.0,
@@ -291,6 +299,84 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
     r
 }
 
+/// `cos^n` of the input code `code` (`lsb` its weight, `ln_c` the `ln` of its value clamped to
+/// 1.0): 0 at and below 0.
+fn cos_n_of(code: i64, lsb: f64, n: f64, ln_c: f64) -> f64 {
+    if code as f64 * lsb <= 0.0 {
+        0.0
+    } else {
+        (n * ln_c).exp()
+    }
+}
+
+/// `cos^n` of one exponent's codes from `start` (an index into the input codes) to the last.
+#[derive(Debug)]
+struct CosRow {
+    start: usize,
+    values: Vec<f64>,
+}
+
+/// The `cos^n` of the live codes of each exponent, kept across the exhaustive checks of
+/// datapaths with the same input format (the optimiser's candidates differ in their stages,
+/// not in `c` or its codes): each row is computed once, by the first check that needs it,
+/// from that check's first live code on (a later check with more live codes computes the
+/// extra ones itself). At most `capacity` values are kept (8 bytes each); past that, rows are
+/// computed and not kept. Shared by threads.
+#[derive(Debug)]
+pub struct CosCache {
+    format: std::sync::OnceLock<crate::fixed::Format>,
+    rows: std::sync::Mutex<std::collections::BTreeMap<u32, std::sync::Arc<CosRow>>>,
+    capacity: usize,
+    kept: std::sync::atomic::AtomicUsize,
+}
+
+impl CosCache {
+    /// An empty cache keeping at most `capacity` values.
+    pub fn new(capacity: usize) -> CosCache {
+        CosCache {
+            format: std::sync::OnceLock::new(),
+            rows: std::sync::Mutex::new(std::collections::BTreeMap::new()),
+            capacity,
+            kept: std::sync::atomic::AtomicUsize::new(0),
+        }
+    }
+
+    /// The values kept.
+    pub fn entries(&self) -> usize {
+        self.kept.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Whether the cache holds this datapath's codes: the input format of the first datapath
+    /// it served.
+    fn serves(&self, dp: &Datapath) -> bool {
+        *self.format.get_or_init(|| dp.config().c.format) == dp.config().c.format
+    }
+
+    /// The row of exponent `n`, made by `make` (the values from index `start` on) when absent;
+    /// None when it is absent and does not fit.
+    fn row(
+        &self,
+        n: u32,
+        start: usize,
+        make: impl FnOnce() -> Vec<f64>,
+    ) -> Option<std::sync::Arc<CosRow>> {
+        use std::sync::atomic::Ordering;
+        if let Some(r) = self.rows.lock().expect("not poisoned").get(&n) {
+            return Some(r.clone());
+        }
+        let values = make();
+        if self.kept.load(Ordering::Relaxed) + values.len() > self.capacity {
+            return Some(std::sync::Arc::new(CosRow { start, values }));
+        }
+        let mut rows = self.rows.lock().expect("not poisoned");
+        let r = rows.entry(n).or_insert_with(|| {
+            self.kept.fetch_add(values.len(), Ordering::Relaxed);
+            std::sync::Arc::new(CosRow { start, values })
+        });
+        Some(r.clone())
+    }
+}
+
 /// The output figures of an exhaustive check ([`OutputFigures`]) without the per-stage
 /// statistics: the dead prefix of each n is not evaluated at all.
 ///
@@ -305,8 +391,34 @@ fn outputs_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> Output
 /// assert_eq!(check_outputs(&dp).unwrap(), check(&dp).unwrap().output_figures());
 /// ```
 pub fn check_outputs(dp: &Datapath) -> Result<OutputFigures, Error> {
+    check_outputs_cached(dp, None)
+}
+
+/// [`check_outputs`] with the `cos^n` of the live codes taken from `cache` where it holds
+/// them (the same values, computed once for every datapath with the same input format: the
+/// optimiser's candidates). The figures are those of [`check_outputs`], bit for bit.
+///
+/// # Errors
+/// As [`check`]: [`Error::TooManyCodes`].
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::check::{check_outputs, check_outputs_cached, CosCache};
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let cache = CosCache::new(1 << 24);
+/// let first = check_outputs_cached(&dp, Some(&cache)).unwrap();
+/// assert!(cache.entries() > 0);
+/// assert_eq!(check_outputs_cached(&dp, Some(&cache)).unwrap(), first);
+/// assert_eq!(check_outputs(&dp).unwrap(), first);
+/// ```
+pub fn check_outputs_cached(
+    dp: &Datapath,
+    cache: Option<&CosCache>,
+) -> Result<OutputFigures, Error> {
     let shared = code_columns(dp)?;
-    let per_n = map_n(dp, |nc| outputs_one_n(dp, nc, &shared));
+    let cache = cache.filter(|c| c.serves(dp));
+    let per_n = map_n(dp, |nc| outputs_one_n(dp, nc, &shared, cache));
     let mut f = OutputsOfN {
         quant: -1.0,
         approx: -1.0,

@@ -19,7 +19,7 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::analysis::budget_expr::{Bound, Budget, Metric, Synthesise, Verdict};
-use crate::analysis::check::check_outputs;
+use crate::analysis::check::{check_outputs, check_outputs_cached, CosCache};
 use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
 use crate::pipeline::walk::Stage;
@@ -132,16 +132,23 @@ fn set_frac(cfg: &mut Config, stage: Stage, frac: i32) -> Result<(), Error> {
     Ok(())
 }
 
-/// Whether the exhaustive check proves a stage of a configuration never overflows (no wrap,
-/// saturation or zeroing on any input).
-fn never_overflows(cfg: &Config, stage: Stage) -> Result<bool, Error> {
+/// The stages the exhaustive check proves never overflow in a configuration (no wrap,
+/// saturation or zeroing on any input): there every overflow mode gives the same values.
+fn stages_never_overflowing(cfg: &Config) -> Result<Vec<Stage>, Error> {
     let report = crate::analysis::check::check(&Datapath::new(cfg.clone())?)?;
-    let name = stage.to_string();
-    Ok(report
-        .stages
-        .iter()
-        .find(|s| s.stage == name)
-        .is_some_and(|s| s.wrapped == 0 && s.saturated == 0 && s.zeroed == 0))
+    let mut stages = searched_stages(cfg.k);
+    stages.push(Stage::Out);
+    Ok(stages
+        .into_iter()
+        .filter(|stage| {
+            let name = stage.to_string();
+            report
+                .stages
+                .iter()
+                .find(|s| s.stage == name)
+                .is_some_and(|s| s.wrapped == 0 && s.saturated == 0 && s.zeroed == 0)
+        })
+        .collect())
 }
 
 /// What the optimiser minimises: the calibrated analytic model's logic cells (instant) or
@@ -256,7 +263,9 @@ pub fn optimize(
         local_roundings: Rounding::ALL.to_vec(),
         overflow_moves: true,
     };
-    let mut judge = |dp: &Datapath| -> Result<Verdict, Error> { exhaustive_judge(dp, budget) };
+    let cos = CosCache::new(COS_CACHE_VALUES);
+    let mut judge =
+        |dp: &Datapath| -> Result<Verdict, Error> { exhaustive_judge(dp, budget, Some(&cos)) };
     let r = search(base, &space, &mut judge, cost, progress)?;
     Ok(OptimizeResult {
         budget: budget.clone(),
@@ -283,6 +292,7 @@ pub fn search(
         judge,
         cost,
         memo: BTreeMap::new(),
+        costs: BTreeMap::new(),
         n_eval: 0,
     };
     let mut best: Option<Candidate> = None;
@@ -343,11 +353,13 @@ impl Space {
     }
 }
 
-/// The search's judge and cost with a memo: each configuration is judged once, and counted.
+/// The search's judge and cost with memos: each configuration is judged once, and counted,
+/// and priced once.
 struct Evaluator<'a> {
     judge: &'a mut dyn FnMut(&Datapath) -> Result<Verdict, Error>,
     cost: &'a mut dyn FnMut(&Datapath) -> Result<f64, Error>,
     memo: BTreeMap<String, Option<Candidate>>,
+    costs: BTreeMap<String, Option<f64>>,
     n_eval: u64,
 }
 
@@ -365,13 +377,41 @@ impl Evaluator<'_> {
                 let v = (self.judge)(&dp)?;
                 Some(Candidate {
                     config: cfg.clone(),
-                    cost: (self.cost)(&dp)?,
+                    cost: self.price(&key, &dp)?,
                     feasible: v.feasible,
                     excess: v.excess,
                 })
             }
         };
         self.memo.insert(key, c.clone());
+        Ok(c)
+    }
+
+    /// The cost of `cfg` alone, without judging it (None when it is not a valid datapath):
+    /// the same figure [`Evaluator::evaluate`] gives it.
+    fn cost_of(&mut self, cfg: &Config) -> Result<Option<f64>, Error> {
+        let key = cfg.to_toml();
+        if let Some(c) = self.memo.get(&key) {
+            return Ok(c.as_ref().map(|c| c.cost));
+        }
+        if let Some(&c) = self.costs.get(&key) {
+            return Ok(c);
+        }
+        match Datapath::new(cfg.clone()) {
+            Err(_) => {
+                self.costs.insert(key, None);
+                Ok(None)
+            }
+            Ok(dp) => self.price(&key, &dp).map(Some),
+        }
+    }
+
+    fn price(&mut self, key: &str, dp: &Datapath) -> Result<f64, Error> {
+        if let Some(&Some(c)) = self.costs.get(key) {
+            return Ok(c);
+        }
+        let c = (self.cost)(dp)?;
+        self.costs.insert(key.to_string(), Some(c));
         Ok(c)
     }
 }
@@ -435,6 +475,12 @@ fn bisect(eval: &mut Evaluator, knobs: &[Knob], start: Candidate) -> Result<Cand
 /// Local search over each stage's rounding and overflow modes (the output's too: its format
 /// is the interface, its modes are not), alone or with one fraction bit less, until no single
 /// move is both feasible and cheaper. Returns the point and the number of moves tried.
+///
+/// A move is priced before it is judged: one that is not cheaper cannot be taken, so only
+/// the cheaper ones are checked exhaustively (the moves taken are those judging every move
+/// would take, in the same order). Overflow moves need a proof that the stage never
+/// overflows (an exhaustive check of the current point, made once per point and only when
+/// one of them is cheaper).
 fn local_search(
     eval: &mut Evaluator,
     space: &Space,
@@ -447,9 +493,37 @@ fn local_search(
     stages.push(Stage::Out);
     loop {
         let mut improved = false;
+        let mut overflows: Option<Vec<Stage>> = None;
         for &s in &stages {
-            for trial in local_moves(space, &current.config, s)? {
-                n_moves += 1;
+            let (rounding, overflow) = local_moves(space, &current.config, s)?;
+            n_moves += (rounding.len() + overflow.len()) as u64;
+            let mut cheaper = Vec::new();
+            for trial in rounding {
+                if eval
+                    .cost_of(&trial)?
+                    .is_some_and(|cost| cost < current.cost)
+                {
+                    cheaper.push(trial);
+                }
+            }
+            let mut cheaper_overflow = Vec::new();
+            for trial in overflow {
+                if eval
+                    .cost_of(&trial)?
+                    .is_some_and(|cost| cost < current.cost)
+                {
+                    cheaper_overflow.push(trial);
+                }
+            }
+            if !cheaper_overflow.is_empty() {
+                if overflows.is_none() {
+                    overflows = Some(stages_never_overflowing(&current.config)?);
+                }
+                if overflows.as_ref().is_some_and(|o| o.contains(&s)) {
+                    cheaper.extend(cheaper_overflow);
+                }
+            }
+            for trial in cheaper {
                 if let Some(c) = eval.evaluate(&trial)? {
                     if c.feasible && c.cost < current.cost {
                         let now = *spec_mut(&mut c.config.clone(), s);
@@ -459,6 +533,7 @@ fn local_search(
                         ));
                         current = c;
                         improved = true;
+                        overflows = None;
                         // The other trials of this stage were built from the old point.
                         break;
                     }
@@ -472,8 +547,14 @@ fn local_search(
 }
 
 /// The local search's moves on stage `s` of `config`: every other rounding mode, alone and
-/// (internal stages) with one fraction bit less; every other overflow mode where allowed.
-fn local_moves(space: &Space, config: &Config, s: Stage) -> Result<Vec<Config>, Error> {
+/// (internal stages) with one fraction bit less; then every other overflow mode, when the
+/// space allows overflow moves (valid only where the stage never overflows: see
+/// [`stages_never_overflowing`]).
+fn local_moves(
+    space: &Space,
+    config: &Config,
+    s: Stage,
+) -> Result<(Vec<Config>, Vec<Config>), Error> {
     let spec = *spec_mut(&mut config.clone(), s);
     let mut trials = Vec::new();
     for &r in space
@@ -491,19 +572,15 @@ fn local_moves(space: &Space, config: &Config, s: Stage) -> Result<Vec<Config>, 
         }
         trials.push(trial);
     }
-    // An overflow mode may change only where the exhaustive check proves the stage never
-    // overflows: there every mode gives the same values.
-    let overflows = if space.overflow_moves && never_overflows(config, s)? {
-        Overflow::ALL.to_vec()
-    } else {
-        Vec::new()
-    };
-    for o in overflows.into_iter().filter(|&o| o != spec.overflow) {
-        let mut trial = config.clone();
-        spec_mut(&mut trial, s).overflow = o;
-        trials.push(trial);
+    let mut overflow = Vec::new();
+    if space.overflow_moves {
+        for o in Overflow::ALL.into_iter().filter(|&o| o != spec.overflow) {
+            let mut trial = config.clone();
+            spec_mut(&mut trial, s).overflow = o;
+            overflow.push(trial);
+        }
     }
-    Ok(trials)
+    Ok((trials, overflow))
 }
 
 /// Why `best` is minimal within the search: how it was found, and each knob's verdict one
@@ -532,7 +609,7 @@ fn minimality(
                 .collect::<Vec<_>>()
         ),
         format!(
-            "then a local search over every stage's rounding{} modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried, none of the final ones both feasible and cheaper",
+            "then a local search over every stage's rounding{} modes (the output's included), each alone or with one fraction bit less: {n_moves} moves tried (each priced, the cheaper ones checked exhaustively), none of the final ones both feasible and cheaper",
             if space.overflow_moves {
                 " and overflow"
             } else {
@@ -695,10 +772,19 @@ pub fn optimize_space(a: Algorithm, budget: &Budget, start_frac: i32) -> Space {
     }
 }
 
+/// The `cos^n` values a search keeps across its candidates ([`CosCache`]): 128 MiB at most
+/// (the baseline's input format over n = 16..1024 needs about 18 MiB).
+pub const COS_CACHE_VALUES: usize = 1 << 24;
+
 /// The exhaustive judge of a budget, with a quick rejection: for budgets of maxima only, a
 /// candidate is first checked on every 8th exponent (and the last); a subset's maximum never
-/// exceeds the whole set's, so failing there is failing.
-pub fn exhaustive_judge(dp: &Datapath, budget: &Budget) -> Result<Verdict, Error> {
+/// exceeds the whole set's, so failing there is failing. `cos` keeps `cos^n` across the
+/// candidates of a search (the same figures with or without it).
+pub fn exhaustive_judge(
+    dp: &Datapath,
+    budget: &Budget,
+    cos: Option<&CosCache>,
+) -> Result<Verdict, Error> {
     // Cost ceilings are not judged here: the search minimises cost, so its answer is the
     // point most likely to meet them, and [`optimize_all`] checks them on it.
     let budget = &budget.without_costs();
@@ -711,7 +797,7 @@ pub fn exhaustive_judge(dp: &Datapath, budget: &Budget) -> Result<Verdict, Error
         }
         let mut cfg = dp.config().clone();
         cfg.n = crate::nset::NSet::from_values(&subset)?;
-        let quick = check_outputs(&Datapath::new(cfg)?)?;
+        let quick = check_outputs_cached(&Datapath::new(cfg)?, cos)?;
         if !budget.met_by(&quick, dp) {
             return Ok(Verdict {
                 feasible: false,
@@ -719,7 +805,7 @@ pub fn exhaustive_judge(dp: &Datapath, budget: &Budget) -> Result<Verdict, Error
             });
         }
     }
-    let r = check_outputs(dp)?;
+    let r = check_outputs_cached(dp, cos)?;
     Ok(Verdict {
         feasible: budget.met_by(&r, dp),
         excess: budget.excess(&r, dp),
@@ -780,12 +866,14 @@ pub fn optimize_all(
     done: &(dyn Fn(Algorithm, &SearchResult) + Sync),
 ) -> Result<OptimizeAll, Error> {
     use rayon::prelude::*;
+    // Every algorithm's candidates share the input format: one cache of cos^n for all.
+    let cos = CosCache::new(COS_CACHE_VALUES);
     let results: Vec<Result<SearchResult, Error>> = floors
         .par_iter()
         .filter(|f| f.reachable)
         .map(|f| {
             let space = optimize_space(f.algorithm, budget, start_frac);
-            let mut judge = |dp: &Datapath| exhaustive_judge(dp, budget);
+            let mut judge = |dp: &Datapath| exhaustive_judge(dp, budget, Some(&cos));
             let mut cost = |dp: &Datapath| cost(dp);
             let mut r = search(base, &space, &mut judge, &mut cost, &mut |_| {})?;
             // The cheapest point meeting the error bounds must meet the cost ceilings too.

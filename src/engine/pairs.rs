@@ -220,12 +220,43 @@ fn eval_piece(
 /// assert!(eval_outputs_vec(&dp, &[0], Ns::One(7)).is_err());
 /// ```
 pub fn eval_outputs_vec(dp: &Datapath, cs: &[i64], ns: Ns) -> Result<Vec<i64>, Error> {
+    let mut out = vec![0i64; cs.len()];
+    eval_outputs_streaming(dp, cs, ns, &mut out)?;
+    Ok(out)
+}
+
+/// [`eval_outputs`] in one pass: each piece is checked just before it is evaluated, so that
+/// an error (the same one) may come after some outputs were written; `out`'s contents are
+/// then unspecified (as with numpy's `out=`). For a caller that discards `out` on an error.
+///
+/// # Examples
+/// ```
+/// use specfx::engine::pairs::{eval_outputs_streaming, Ns};
+/// let dp = specfx::input::load_datapath("baseline", None).unwrap();
+/// let mut out = vec![0; 2];
+/// eval_outputs_streaming(&dp, &[32768, 0], Ns::Each(&[64, 16]), &mut out).unwrap();
+/// assert_eq!(out[0], dp.constants_for(64).unwrap().coef_raw);
+/// let err = eval_outputs_streaming(&dp, &[0, 1 << 20], Ns::One(16), &mut out).unwrap_err();
+/// assert!(err.to_string().starts_with("c[1] = 1048576 is not a code"));
+/// ```
+pub fn eval_outputs_streaming(
+    dp: &Datapath,
+    cs: &[i64],
+    ns: Ns,
+    out: &mut [i64],
+) -> Result<(), Error> {
+    if out.len() != cs.len() {
+        return Err(domain(format!(
+            "the output has {} elements and c has {}: expected as many",
+            out.len(),
+            cs.len()
+        )));
+    }
     let index = NIndex::new(dp);
     let length_ok = match ns {
         Ns::One(n) => index.of(n).is_some(),
         Ns::Each(ns) => ns.len() == cs.len(),
     };
-    let mut out = vec![0i64; cs.len()];
     let all_in_domain = length_ok
         && out
             .par_chunks_mut(PIECE)
@@ -239,7 +270,7 @@ pub fn eval_outputs_vec(dp: &Datapath, cs: &[i64], ns: Ns) -> Result<Vec<i64>, E
         // The error the two-pass check names (the first code, else the first n, outside).
         check_pairs(dp, &index, cs, ns)?;
     }
-    Ok(out)
+    Ok(())
 }
 
 /// The outputs of one run of codes with one n: short runs one by one, runs of consecutive

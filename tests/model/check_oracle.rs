@@ -3,7 +3,7 @@
 //! the same algorithm written out here, no shortcut. The check's fast paths (the dead prefix
 //! found by bisection, d's exact figures, the live compaction) must give the same figures.
 
-use specfx::analysis::check::{check, check_outputs};
+use specfx::analysis::check::{check, check_outputs, check_outputs_cached, CosCache};
 use specfx::fixed::Event;
 use specfx::pipeline::{Config, Datapath};
 use specfx::reference::lobe::Cutoff;
@@ -216,4 +216,42 @@ fn minimax_signed_inputs_and_narrow_formats() {
         "k = 2\n[c]\nformat = \"u1.8\"\n[d]\nformat = \"s1.8\"\n[b]\nformat = \"u1.6\"\n\
          [square]\nformat = \"u1.5\"\nrounding = \"TRN\"\n[out]\nformat = \"u6.2\"\n",
     );
+}
+
+/// The optimiser's cache of `cos^n` (`check_outputs_cached`): datapaths with the first one's
+/// input format read its rows, their live codes starting elsewhere (other cutoffs, wider
+/// stages with more live codes, other variants and overflow modes), one of another input
+/// format bypasses it, and a cache too small to keep anything computes every row itself. Every
+/// figure is the uncached check's, bit for bit.
+#[test]
+fn cached_cos_gives_the_same_figures() {
+    let shared = CosCache::new(1 << 22);
+    let tiny = CosCache::new(0);
+    for toml in [
+        "",
+        "[square]\nformat = \"u1.24\"\n[out]\nformat = \"u8.24\"\n",
+        "cutoff = \"paper\"\nk = 5\n",
+        "cutoff = \"none\"\nk = 3\n",
+        "variant = \"minimax\"\n",
+        "[t]\nformat = \"s2.12\"\noverflow = \"WRAP\"\n",
+        "[b]\nformat = \"u1.9\"\n",
+        "[c]\nformat = \"s2.10\"\n[d]\nformat = \"s3.11\"\n",
+    ] {
+        let mut cfg = Config::from_toml(toml).unwrap();
+        cfg.n = "16,17,40,100,333,1000,1024".parse().unwrap();
+        let dp = Datapath::new(cfg).unwrap();
+        let want = check_outputs(&dp).unwrap();
+        assert_eq!(
+            check_outputs_cached(&dp, Some(&shared)).unwrap(),
+            want,
+            "{toml}"
+        );
+        assert_eq!(
+            check_outputs_cached(&dp, Some(&tiny)).unwrap(),
+            want,
+            "{toml}"
+        );
+    }
+    assert!(shared.entries() > 0);
+    assert_eq!(tiny.entries(), 0);
 }
