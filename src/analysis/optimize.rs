@@ -497,24 +497,8 @@ fn local_search(
         for &s in &stages {
             let (rounding, overflow) = local_moves(space, &current.config, s)?;
             n_moves += (rounding.len() + overflow.len()) as u64;
-            let mut cheaper = Vec::new();
-            for trial in rounding {
-                if eval
-                    .cost_of(&trial)?
-                    .is_some_and(|cost| cost < current.cost)
-                {
-                    cheaper.push(trial);
-                }
-            }
-            let mut cheaper_overflow = Vec::new();
-            for trial in overflow {
-                if eval
-                    .cost_of(&trial)?
-                    .is_some_and(|cost| cost < current.cost)
-                {
-                    cheaper_overflow.push(trial);
-                }
-            }
+            let mut cheaper = cheaper_than(eval, rounding, current.cost)?;
+            let cheaper_overflow = cheaper_than(eval, overflow, current.cost)?;
             if !cheaper_overflow.is_empty() {
                 if overflows.is_none() {
                     overflows = Some(stages_never_overflowing(&current.config)?);
@@ -544,6 +528,21 @@ fn local_search(
             return Ok((current, n_moves));
         }
     }
+}
+
+/// The valid trials whose cost is below `bound`, in their order (priced, not judged).
+fn cheaper_than(
+    eval: &mut Evaluator,
+    trials: Vec<Config>,
+    bound: f64,
+) -> Result<Vec<Config>, Error> {
+    let mut cheaper = Vec::new();
+    for trial in trials {
+        if eval.cost_of(&trial)?.is_some_and(|cost| cost < bound) {
+            cheaper.push(trial);
+        }
+    }
+    Ok(cheaper)
 }
 
 /// The local search's moves on stage `s` of `config`: every other rounding mode, alone and
