@@ -11,7 +11,7 @@ use serde::Serialize;
 use crate::analysis::accumulate::MaxAt;
 use crate::engine::{each_chunk, map_n, Chunk, Codes, Span};
 use crate::error::Error;
-use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_T};
+use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_SQ0, STAGE_T};
 use crate::pipeline::f64_walk::F64Walk;
 use crate::pipeline::fast::EventCounts;
 use crate::pipeline::{first_code_where, Datapath, NConstants, MAX_STAGES};
@@ -273,7 +273,7 @@ fn outputs_one_n(
             let i = c.start + j;
             let t = nc.slope * shared.ref_d[i];
             let mut s = reference_base(cfg.cutoff, t, nc.offset, k.min(one) < threshold);
-            for _ in 0..cfg.k {
+            for _ in 0..nc.depth {
                 s *= s;
             }
             let fixed_lobe = cols.values[last_sq][j] as f64 * lobe_lsb;
@@ -935,7 +935,8 @@ impl<'a> NFold<'a> {
                 for r in &mut self.live_refs {
                     *r *= self.nc.coef;
                 }
-            } else if stage_idx > STAGE_B {
+            } else if stage_idx > STAGE_B && stage_idx - STAGE_SQ0 < self.nc.depth as usize {
+                // A squaring stage (a bypassed one passes its reference on as it is).
                 for r in &mut self.live_refs {
                     *r *= *r;
                 }

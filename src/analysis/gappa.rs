@@ -152,6 +152,10 @@ impl Arithmetic for Script<'_> {
         self.define(&format!("s{}", i + 1), &format!("{x} * {x}"))
     }
 
+    fn pass(&mut self, i: usize, x: String) -> String {
+        self.define(&format!("s{}", i + 1), &x)
+    }
+
     fn mul_out(&mut self, s: String) -> String {
         let value = format!("{s} * {}", self.constant("C"));
         self.define("out", &value)
@@ -247,8 +251,9 @@ pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, Error> {
         raw_value(nc.coef_raw, cfg.coef.format.frac_bits())
     );
     let _ = writeln!(s, "CE = {};", dyadic(nc.coef));
-    let quantized = walk(&mut Script::new(&mut s, false), cfg.cutoff, k);
-    let exact = walk(&mut Script::new(&mut s, true), cfg.cutoff, k);
+    let depth = nc.depth as usize;
+    let quantized = walk(&mut Script::new(&mut s, false), cfg.cutoff, k, depth);
+    let exact = walk(&mut Script::new(&mut s, true), cfg.cutoff, k, depth);
     let fc = cfg.c.format.frac_bits();
     let mut goal = format!(
         "{{ @FIX(c, {}) /\\ c in [{}, {}] -> out - Mout in ?",
@@ -272,10 +277,15 @@ pub fn job(dp: &Datapath, nc: &NConstants) -> Result<Job, Error> {
     );
     for i in 1..=k {
         let (p, mp) = &prev;
-        let _ = writeln!(
-            s,
-            "s{i} - Ms{i} -> (s{i} - {p} * {p}) + ({p} - {mp}) * ({p} + {mp});"
-        );
+        if i <= depth {
+            let _ = writeln!(
+                s,
+                "s{i} - Ms{i} -> (s{i} - {p} * {p}) + ({p} - {mp}) * ({p} + {mp});"
+            );
+        } else {
+            // A bypassed stage: its rounding plus the error it passes on.
+            let _ = writeln!(s, "s{i} - Ms{i} -> (s{i} - {p}) + ({p} - {mp});");
+        }
         prev = (format!("s{i}"), format!("Ms{i}"));
     }
     debug_assert_eq!((&prev.0, &prev.1), (&quantized.lobe, &exact.lobe));

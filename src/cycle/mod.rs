@@ -185,7 +185,7 @@ impl Op {
             Op::Sub => dp.op_sub(token.value),
             Op::MulT => (token.c, dp.op_mul_t(token.value, nc).raw),
             Op::AddB => (token.c, dp.op_add_b(token.value, token.c, nc).0.raw),
-            Op::Square(i) => (token.c, dp.op_square(i, token.value).raw),
+            Op::Square(i) => (token.c, dp.op_stage(i, nc.depth, token.value).raw),
             Op::MulOut => (token.c, dp.op_mul_out(token.value, nc).raw),
         };
         Token { c, value, ..token }

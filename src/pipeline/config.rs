@@ -83,6 +83,104 @@ pub struct MinimaxSpec {
     pub rounding: Rounding,
 }
 
+/// How many of the k squaring stages square at each n: `j(n)`, with `m(n) = 2^j(n)`; the
+/// stages past `j(n)` pass their input through (a bypass multiplexer, then the stage's own
+/// quantization). See `docs/arithmetic.md` section 2.
+///
+/// # Examples
+/// ```
+/// use specfx::pipeline::{Config, Depth, Variant};
+/// let mut c = Config::baseline();
+/// c.k = 7;
+/// c.variant = Variant::Minimax;
+/// c.depth = Depth::Best;
+/// // The minimax table's smallest floor: m = 16 up to n = 21, then 32, 64 and 128.
+/// assert_eq!([16, 21, 22, 42, 43, 85, 86, 1024].map(|n| c.depth_of(n)), [4, 4, 5, 5, 6, 6, 7, 7]);
+/// let steps: Config = Config::from_toml("depth = [{ from = 1, j = 3 }, { from = 100, j = 4 }]").unwrap();
+/// assert_eq!([16, 99, 100, 1024].map(|n| steps.depth_of(n)), [3, 3, 4, 4]);
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Default)]
+pub enum Depth {
+    /// Every n uses all k squarings (`depth = "fixed"`, the default).
+    #[default]
+    Fixed,
+    /// Each n uses the depth j in 1..=k whose lobe has the smallest f64 floor at n: the
+    /// minimax table's `max_abs_err` (minimax variant) or `plain_max_abs_err` (plain), ties
+    /// to the smaller j (`depth = "best"`).
+    Best,
+    /// A threshold list: each step's `j` holds from its `from` up to the next step's
+    /// (`depth = [{ from = 16, j = 4 }, { from = 22, j = 5 }]`).
+    Steps(Vec<DepthStep>),
+}
+
+/// One step of a [`Depth::Steps`] rule: from exponent `from` on, `j` squarings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DepthStep {
+    /// The first exponent of the step.
+    pub from: u32,
+    /// The squarings done from there on (1..=k).
+    pub j: u32,
+}
+
+impl Depth {
+    /// Whether every n uses all k squarings (what configuration files leave out).
+    pub fn is_fixed(&self) -> bool {
+        *self == Depth::Fixed
+    }
+
+    /// The rule's name in reports: `fixed`, `best` or `steps`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Depth::Fixed => "fixed",
+            Depth::Best => "best",
+            Depth::Steps(_) => "steps",
+        }
+    }
+}
+
+const DEPTH_EXPECTED: &str = "expected \"fixed\", \"best\" or a list of { from = N, j = J } tables";
+
+impl Serialize for Depth {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Depth::Fixed => s.serialize_str("fixed"),
+            Depth::Best => s.serialize_str("best"),
+            Depth::Steps(steps) => steps.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Depth {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = Depth;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(DEPTH_EXPECTED)
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Depth, E> {
+                match v {
+                    "fixed" => Ok(Depth::Fixed),
+                    "best" => Ok(Depth::Best),
+                    other => Err(E::custom(format!("depth: {DEPTH_EXPECTED}, got {other:?}"))),
+                }
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<Depth, A::Error> {
+                let mut steps = Vec::new();
+                while let Some(step) = seq.next_element::<DepthStep>()? {
+                    steps.push(step);
+                }
+                Ok(Depth::Steps(steps))
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
 /// Register latencies of the operations in the cycle-level model (`docs/cycle.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -103,8 +201,11 @@ pub struct Config {
     pub name: String,
     /// Plain (n/m, 1) or minimax (A(n), A(n) + B(n)) constants.
     pub variant: Variant,
-    /// Number of squarings; m = 2^k.
+    /// Number of squaring stages; m = 2^k (at every n unless `depth` says otherwise).
     pub k: u32,
+    /// How many of the k stages square at each n (`fixed`: all of them).
+    #[serde(default, skip_serializing_if = "Depth::is_fixed")]
+    pub depth: Depth,
     /// How the base is cut: `clamp`, `paper` or `none`.
     pub cutoff: Cutoff,
     /// The exponents the datapath serves.
@@ -204,8 +305,16 @@ impl Config {
     pub fn constant_formats(&self) -> (Format, Format) {
         match self.variant {
             Variant::Plain => {
-                let bits = (32 - self.n.max().leading_zeros()) as i32;
+                // n / 2^j(n) with k fraction bits: the raw n << (k - j(n)) needs
+                // bits(n) + k - j(n) bits, the widest over the set.
                 let k = self.k as i32;
+                let bits = self
+                    .n
+                    .values()
+                    .iter()
+                    .map(|&n| (32 - n.leading_zeros()) as i32 + k - self.depth_of(n) as i32)
+                    .max()
+                    .unwrap_or(k + 1);
                 (
                     Format::unsigned(bits - k, k).expect("1..=17 bits"),
                     Format::unsigned(1, 0).expect("one bit"),
@@ -213,6 +322,44 @@ impl Config {
             }
             Variant::Minimax => (self.minimax.a_format, self.minimax.offset_format),
         }
+    }
+
+    /// The squarings done at exponent `n`, `j(n)` in 1..=k (k for the fixed rule). Total: an n
+    /// the rule does not cover takes k (best, beyond the minimax table) or the first step's j;
+    /// [`crate::pipeline::Datapath::new`] refuses such rules.
+    pub fn depth_of(&self, n: u32) -> u32 {
+        match &self.depth {
+            Depth::Fixed => self.k,
+            Depth::Best => {
+                let floor = |j: u32| {
+                    crate::reference::minimax::constants(n, j).map(|f| match self.variant {
+                        Variant::Plain => f.plain_max_abs_err,
+                        Variant::Minimax => f.max_abs_err,
+                    })
+                };
+                let mut best = (self.k, f64::INFINITY);
+                for j in 1..=self.k {
+                    match floor(j) {
+                        Ok(e) if e < best.1 => best = (j, e),
+                        Ok(_) => {}
+                        Err(_) => return self.k,
+                    }
+                }
+                best.0
+            }
+            Depth::Steps(steps) => steps
+                .iter()
+                .take_while(|s| s.from <= n)
+                .last()
+                .or(steps.first())
+                .map_or(self.k, |s| s.j),
+        }
+    }
+
+    /// Whether some n uses fewer than k squarings (the datapath then needs its bypass
+    /// multiplexers and the per-n depth field).
+    pub fn has_bypass(&self) -> bool {
+        !self.depth.is_fixed() && self.n.values().iter().any(|&n| self.depth_of(n) < self.k)
     }
 
     /// The built-in `baseline` configuration (see `docs/arithmetic.md`).
@@ -234,6 +381,7 @@ impl Config {
             name: "baseline".to_string(),
             variant: Variant::Plain,
             k: 4,
+            depth: Depth::Fixed,
             cutoff: Cutoff::Clamp,
             n: NSet::range(16, 1024).expect("valid range"),
             c: FormatSpec {
@@ -384,6 +532,7 @@ pub(crate) struct ConfigFile {
     name: Option<String>,
     variant: Option<Variant>,
     k: Option<u32>,
+    depth: Option<Depth>,
     cutoff: Option<Cutoff>,
     n: Option<NSet>,
     c: Option<FormatPatch>,
@@ -448,6 +597,7 @@ impl ConfigFile {
             name: self.name.unwrap_or(base.name),
             variant: self.variant.unwrap_or(base.variant),
             k,
+            depth: self.depth.unwrap_or(base.depth),
             cutoff: self.cutoff.unwrap_or(base.cutoff),
             n: self.n.unwrap_or(base.n),
             c: FormatSpec {

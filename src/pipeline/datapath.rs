@@ -7,7 +7,7 @@
 
 use crate::error::Error;
 use crate::fixed::{quantize, Event, Exact, Format, Overflow, Quantized};
-use crate::pipeline::config::{Config, Variant};
+use crate::pipeline::config::{Config, Depth, Variant};
 use crate::pipeline::fast::{
     constant_bits, count_event, magnitude_bits, quantize_to, BatchPlan, EventCounts, Kernel, Pre,
 };
@@ -47,7 +47,11 @@ pub struct StageInfo {
 pub struct NConstants {
     /// The exponent.
     pub n: u32,
-    /// Raw slope: n (plain) or A(n) quantized (minimax).
+    /// The squaring stages that square at this n, j(n) in 1..=k; the rest pass their input
+    /// through (k for a fixed depth).
+    pub depth: u32,
+    /// Raw slope: n << (k - j(n)) (plain: the value n / 2^j(n) with k fraction bits) or A(n)
+    /// quantized (minimax).
     pub slope_raw: i64,
     /// Fraction bits of the slope: k (plain, the shift by k) or those of A's format.
     pub slope_frac: i32,
@@ -160,7 +164,8 @@ pub struct Datapath {
     one_raw: i64,
     d_shift: u32,
     plan: BatchPlan,
-    chain: std::sync::OnceLock<Option<ChainTable>>,
+    /// The squaring chain tabulated by b's code, one per depth j (index j), built on first use.
+    chain: [std::sync::OnceLock<Option<ChainTable>>; 8],
     cut_is_prefix: bool,
 }
 
@@ -322,6 +327,7 @@ impl Datapath {
             ));
         }
         let d_shift = d_shift as u32;
+        check_depth(&config)?;
 
         let mut constants = Vec::with_capacity(config.n.len());
         for &n in config.n.values() {
@@ -330,7 +336,7 @@ impl Datapath {
 
         // Every exact intermediate must fit in an i128.
         let slope_bits = match config.variant {
-            Variant::Plain => 33 - config.n.max().leading_zeros(),
+            Variant::Plain => config.constant_formats().0.width() + 1,
             Variant::Minimax => config.minimax.a_format.width(),
         };
         let offset_format = match config.variant {
@@ -400,7 +406,7 @@ impl Datapath {
             one_raw,
             d_shift,
             plan,
-            chain: std::sync::OnceLock::new(),
+            chain: std::array::from_fn(|_| std::sync::OnceLock::new()),
             cut_is_prefix,
         })
     }
@@ -424,11 +430,17 @@ impl Datapath {
             .max(offset_bits.saturating_add(offset_align))
             .saturating_add(1);
         let mut squares = Vec::with_capacity(config.square.len());
+        let mut passes = Vec::with_capacity(config.square.len());
         let mut prev = config.b.format;
         for spec in &config.square {
             squares.push(Kernel::for_stage(
                 2 * prev.frac_bits(),
                 2 * magnitude_bits(prev),
+                spec,
+            ));
+            passes.push(Kernel::for_stage(
+                prev.frac_bits(),
+                magnitude_bits(prev),
                 spec,
             ));
             prev = spec.format;
@@ -443,6 +455,7 @@ impl Datapath {
             offset_align,
             b: Kernel::for_stage(fb, sum_bits, &config.b),
             squares,
+            passes,
             out: Kernel::for_stage(
                 prev.frac_bits() + config.coef.format.frac_bits(),
                 magnitude_bits(prev) + coef_bits,
@@ -458,11 +471,20 @@ impl Datapath {
 
     fn constants_of(config: &Config, n: u32, one_raw: i64) -> Result<NConstants, Error> {
         let k = config.k;
+        // The lobe used at n: m(n) = 2^j(n) squarings, its constants and its coefficient.
+        let j = config.depth_of(n);
         let nf = f64::from(n);
         let (slope_raw, slope_frac, offset_raw, offset_frac, slope, offset) = match config.variant {
-            Variant::Plain => (i64::from(n), k as i32, 1, 0, nf / f64::from(m_of_k(k)), 1.0),
+            Variant::Plain => (
+                i64::from(n) << (k - j),
+                k as i32,
+                1,
+                0,
+                nf / f64::from(m_of_k(j)),
+                1.0,
+            ),
             Variant::Minimax => {
-                let fit = minimax::constants(n, k).map_err(|e| {
+                let fit = minimax::constants(n, j).map_err(|e| {
                     config_error(
                         "n",
                         format!("the minimax variant needs a cached entry: {e}"),
@@ -491,7 +513,7 @@ impl Datapath {
                 )
             }
         };
-        let coef = coefficient(config.coef.form, config.coef.source, nf, k);
+        let coef = coefficient(config.coef.form, config.coef.source, nf, j);
         let coef_exact = Exact::from_f64(coef).ok_or_else(|| {
             config_error(
                 "coef.source",
@@ -511,6 +533,7 @@ impl Datapath {
         };
         Ok(NConstants {
             n,
+            depth: j,
             slope_raw,
             slope_frac,
             offset_raw,
@@ -635,7 +658,13 @@ impl Datapath {
             c: c_raw,
             probes: &mut p,
         };
-        p.cut = walk(&mut fixed, self.config.cutoff, self.config.k as usize).cut;
+        p.cut = walk(
+            &mut fixed,
+            self.config.cutoff,
+            self.config.k as usize,
+            nc.depth as usize,
+        )
+        .cut;
         p
     }
 
@@ -696,6 +725,31 @@ impl Datapath {
         quantize_to(i128::from(x) * i128::from(x), 2 * f_in, &cfg.square[i])
     }
 
+    /// Operation `pass` number `i` (0-based): squaring stage `i` bypassed, the previous stage's
+    /// raw value quantized by stage `i` (what the stage gives at an n whose depth is at most
+    /// `i`).
+    #[inline]
+    pub fn op_pass(&self, i: usize, x: i64) -> Quantized {
+        let cfg = &self.config;
+        let f_in = if i == 0 {
+            cfg.b.format.frac_bits()
+        } else {
+            cfg.square[i - 1].format.frac_bits()
+        };
+        quantize_to(i128::from(x), f_in, &cfg.square[i])
+    }
+
+    /// Squaring stage `i` at an n of depth `depth`: [`Datapath::op_square`] below the depth,
+    /// [`Datapath::op_pass`] from it on.
+    #[inline]
+    pub fn op_stage(&self, i: usize, depth: u32, x: i64) -> Quantized {
+        if i < depth as usize {
+            self.op_square(i, x)
+        } else {
+            self.op_pass(i, x)
+        }
+    }
+
     /// Operation `mul_out`: out = sq_k * coef, exact, then quantized by the output stage.
     #[inline]
     pub fn op_mul_out(&self, s: i64, nc: &NConstants) -> Quantized {
@@ -743,8 +797,9 @@ impl Datapath {
             &mut cols.scratch,
             &mut cols.event_counts[STAGE_B],
         );
-        for (i, kernel) in plan.squares.iter().enumerate() {
-            stage(cols, kernel, Pre::Square, STAGE_SQ0 + i - 1, STAGE_SQ0 + i);
+        for i in 0..plan.squares.len() {
+            let (kernel, pre) = plan.square_stage(i, nc.depth);
+            stage(cols, kernel, pre, STAGE_SQ0 + i - 1, STAGE_SQ0 + i);
         }
         let coef_idx = STAGE_SQ0 + plan.squares.len();
         cols.values[coef_idx].fill(nc.coef_raw);
@@ -814,10 +869,10 @@ impl Datapath {
     }
 
     /// The last squaring's raw value as a function of b's raw value, tabulated once per
-    /// datapath when b has at most [`MAX_CHAIN_TABLE`] codes (the squaring chain does not
-    /// depend on n).
-    fn chain_table(&self) -> Option<&ChainTable> {
-        self.chain
+    /// datapath and depth when b has at most [`MAX_CHAIN_TABLE`] codes (the squaring chain
+    /// depends on n only through its depth).
+    fn chain_table(&self, depth: u32) -> Option<&ChainTable> {
+        self.chain[depth as usize]
             .get_or_init(|| {
                 let b = self.config.b.format;
                 let (lo, hi) = (b.min_raw(), b.max_raw());
@@ -826,7 +881,9 @@ impl Datapath {
                     return None;
                 }
                 let last = (lo..=hi)
-                    .map(|x| (0..self.config.k as usize).fold(x, |s, i| self.op_square(i, s).raw))
+                    .map(|x| {
+                        (0..self.config.k as usize).fold(x, |s, i| self.op_stage(i, depth, s).raw)
+                    })
                     .collect();
                 Some(ChainTable { b_min: lo, last })
             })
@@ -881,13 +938,14 @@ impl Datapath {
             &mut s.sums,
             &mut counts,
         );
-        if let Some(table) = self.chain_table() {
+        if let Some(table) = self.chain_table(nc.depth) {
             for (sq, &b) in s.b.iter_mut().zip(&s.a) {
                 *sq = table.last[(b - table.b_min) as usize];
             }
         } else {
-            for kernel in &self.plan.squares {
-                kernel.run(Pre::Square, &s.a, &mut s.b, &mut counts);
+            for i in 0..self.plan.squares.len() {
+                let (kernel, pre) = self.plan.square_stage(i, nc.depth);
+                kernel.run(pre, &s.a, &mut s.b, &mut counts);
                 std::mem::swap(&mut s.a, &mut s.b);
             }
             std::mem::swap(&mut s.a, &mut s.b);
@@ -1057,6 +1115,12 @@ impl Arithmetic for FixedWalk<'_> {
     }
 
     #[inline]
+    fn pass(&mut self, i: usize, x: i128) -> i128 {
+        let q = self.dp.op_pass(i, x as i64);
+        self.record(STAGE_SQ0 + i, q)
+    }
+
+    #[inline]
     fn mul_out(&mut self, s: i128) -> i128 {
         self.probes.values[self.dp.stage_coef()] = self.nc.coef_raw;
         let q = self.dp.op_mul_out(s as i64, self.nc);
@@ -1082,6 +1146,65 @@ pub struct OutputScratch {
     b: Vec<i64>,
     sums: Vec<i64>,
     cut: Vec<bool>,
+}
+
+/// Refuses a depth rule that does not give every exponent of the set a depth in 1..=k.
+fn check_depth(config: &Config) -> Result<(), Error> {
+    let k = config.k;
+    let (n_min, n_max) = (config.n.min(), config.n.max());
+    match &config.depth {
+        Depth::Fixed => Ok(()),
+        Depth::Best if n_max > minimax::TABLE_N_MAX => Err(config_error(
+            "depth",
+            format!(
+                "\"best\" ranks the depths by the minimax table's floors, which end at n = {}; the set reaches n = {n_max}",
+                minimax::TABLE_N_MAX
+            ),
+        )),
+        Depth::Best => Ok(()),
+        Depth::Steps(steps) => {
+            let Some(first) = steps.first() else {
+                return Err(config_error(
+                    "depth",
+                    "expected at least one { from = N, j = J } step".to_string(),
+                ));
+            };
+            if first.from > n_min {
+                return Err(config_error(
+                    "depth",
+                    format!(
+                        "the first step starts at n = {}, after the set's first exponent {n_min}: expected from <= {n_min}",
+                        first.from
+                    ),
+                ));
+            }
+            for (i, step) in steps.iter().enumerate() {
+                if !(1..=k).contains(&step.j) {
+                    return Err(config_error(
+                        "depth",
+                        format!(
+                            "step {} (from = {}): expected j in 1..=k = 1..={k}, got {}",
+                            i + 1,
+                            step.from,
+                            step.j
+                        ),
+                    ));
+                }
+                if i > 0 && step.from <= steps[i - 1].from {
+                    return Err(config_error(
+                        "depth",
+                        format!(
+                            "step {} starts at n = {}, not after the step before (from = {}): expected increasing from",
+                            i + 1,
+                            step.from,
+                            steps[i - 1].from
+                        ),
+                    ));
+                }
+            }
+            Ok(())
+        }
+    }
 }
 
 /// The paper cutoff's threshold code for n: the smallest input code whose value is at least

@@ -148,7 +148,7 @@ impl<'a> F64Walk<'a> {
     /// Walks the datapath: returns (lobe, output); every stage's value is in `values`.
     pub fn run(&mut self) -> (f64, f64) {
         let cfg = self.dp.config();
-        let w = walk(self, cfg.cutoff, cfg.k as usize);
+        let w = walk(self, cfg.cutoff, cfg.k as usize, self.nc.depth as usize);
         (w.lobe, w.out)
     }
 
@@ -206,6 +206,13 @@ impl Arithmetic for F64Walk<'_> {
             s = quantize_spec(s, &self.dp.config().square[i]);
         }
         self.record(Stage::Square(i), s)
+    }
+
+    fn pass(&mut self, i: usize, mut x: f64) -> f64 {
+        if self.on(Source::Square(i)) {
+            x = quantize_spec(x, &self.dp.config().square[i]);
+        }
+        self.record(Stage::Square(i), x)
     }
 
     fn mul_out(&mut self, s: f64) -> f64 {

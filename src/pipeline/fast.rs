@@ -371,10 +371,24 @@ pub struct BatchPlan {
     /// The b stage (input: the exact sum after the cutoff); when it is [`Kernel::Fast`] the
     /// sum itself is proven to fit in `i64`.
     pub b: Kernel,
-    /// The squaring stages.
+    /// The squaring stages (input: the previous stage squared).
     pub squares: Vec<Kernel>,
+    /// The squaring stages bypassed (input: the previous stage as it is).
+    pub passes: Vec<Kernel>,
     /// The output stage (input: sq_k * coef).
     pub out: Kernel,
+}
+
+impl BatchPlan {
+    /// The kernel of squaring stage `i` at an exponent of depth `depth`, and what feeds it:
+    /// the square below the depth, the previous stage as it is (bypassed) from it on.
+    pub fn square_stage(&self, i: usize, depth: u32) -> (&Kernel, Pre) {
+        if i < depth as usize {
+            (&self.squares[i], Pre::Square)
+        } else {
+            (&self.passes[i], Pre::Identity)
+        }
+    }
 }
 
 #[cfg(test)]

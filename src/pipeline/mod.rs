@@ -22,7 +22,9 @@ pub mod f64_walk;
 pub mod fast;
 pub mod walk;
 
-pub use config::{CoefSpec, Config, FormatSpec, LatencySpec, MinimaxSpec, StageSpec, Variant};
+pub use config::{
+    CoefSpec, Config, Depth, DepthStep, FormatSpec, LatencySpec, MinimaxSpec, StageSpec, Variant,
+};
 pub use datapath::{
     first_code_where, Datapath, NConstants, OutputScratch, ProbeColumns, Probes, StageInfo,
     MAX_STAGES,

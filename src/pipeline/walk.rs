@@ -9,7 +9,8 @@
 //! 2. `t = Q_t(slope * d)`;
 //! 3. `sum = t + offset`, exact; the cutoff decides whether the base is cut
 //!    ([`Cutoff::cuts`]); `b = Q_b(cut ? 0 : sum)`;
-//! 4. `sq_i = Q_i(sq_{i-1}^2)`, `sq_0 = b`, for i = 1..k;
+//! 4. `sq_i = Q_i(sq_{i-1}^2)` for i = 1..j(n) and `sq_i = Q_i(sq_{i-1})` (the stage bypassed)
+//!    for i = j(n)+1..k, `sq_0 = b`;
 //! 5. `out = Q_out(sq_k * coef)`.
 //!
 //! What `Q` means (a quantization, or nothing) is the interpreter's business.
@@ -110,6 +111,8 @@ pub trait Arithmetic {
     fn quant_b(&mut self, base: Self::Value) -> Self::Value;
     /// `sq_{i+1} = Q_i(x^2)`.
     fn square(&mut self, i: usize, x: Self::Value) -> Self::Value;
+    /// `sq_{i+1} = Q_i(x)`: squaring stage `i` bypassed (the exponent's depth is at most `i`).
+    fn pass(&mut self, i: usize, x: Self::Value) -> Self::Value;
     /// `out = Q_out(s * coef)`.
     fn mul_out(&mut self, s: Self::Value) -> Self::Value;
 }
@@ -126,9 +129,10 @@ pub struct Walked<V> {
     pub cut: bool,
 }
 
-/// Walks the stages of a datapath with `k` squarings and cutoff `cutoff` in an arithmetic.
+/// Walks the stages of a datapath with `k` squaring stages, of which the first `depth` square
+/// and the rest pass their input through, and cutoff `cutoff` in an arithmetic.
 #[inline]
-pub fn walk<A: Arithmetic>(a: &mut A, cutoff: Cutoff, k: usize) -> Walked<A::Value> {
+pub fn walk<A: Arithmetic>(a: &mut A, cutoff: Cutoff, k: usize, depth: usize) -> Walked<A::Value> {
     let d = a.sub();
     let t = a.mul_t(d);
     let sum = a.add_offset(t);
@@ -136,7 +140,11 @@ pub fn walk<A: Arithmetic>(a: &mut A, cutoff: Cutoff, k: usize) -> Walked<A::Val
     let base = if cut { a.zero() } else { sum };
     let mut s = a.quant_b(base);
     for i in 0..k {
-        s = a.square(i, s);
+        s = if i < depth {
+            a.square(i, s)
+        } else {
+            a.pass(i, s)
+        };
     }
     let out = a.mul_out(s.clone());
     Walked { lobe: s, out, cut }

@@ -274,8 +274,9 @@ fn to_i64(v: &BigInt) -> i64 {
 /// Evaluates the datapath on one raw input code with one n's constants (docs/arithmetic.md
 /// section 3.2, steps 1 to 7; the same as the Python `evaluate` of section 3.3).
 ///
-/// `nc` supplies `slope_raw`, `slope_frac`, `offset_raw`, `offset_frac`, `threshold` (paper
-/// cutoff only) and `coef_raw` as given (section 3.1); nothing else of it is read.
+/// `nc` supplies `depth` (j(n)), `slope_raw`, `slope_frac`, `offset_raw`, `offset_frac`,
+/// `threshold` (paper cutoff only) and `coef_raw` as given (section 3.1); nothing else of it
+/// is read.
 pub fn oracle_eval(cfg: &Config, nc: &NConstants, c_raw: i64) -> OracleProbes {
     let k = usize::try_from(cfg.k).expect("k fits usize");
     assert_eq!(cfg.square.len(), k, "one squaring spec per stage");
@@ -338,12 +339,18 @@ pub fn oracle_eval(cfg: &Config, nc: &NConstants, c_raw: i64) -> OracleProbes {
     values.push(b);
     events.push(ev_b);
 
-    // Step 5: k squarings, each exact (2 * fprev fraction bits) then quantized by its stage.
+    // Step 5: k squaring stages, each exact (2 * fprev fraction bits) then quantized by its
+    // stage; the stages past j(n) quantize their input as it is (fprev fraction bits).
     let mut s = BigInt::from(b);
     let mut fprev = fb;
-    for spec in &cfg.square {
-        let square = &s * &s;
-        let (sq, ev) = quantize_stage(&square, 2 * fprev, spec);
+    let depth = usize::try_from(nc.depth).expect("depth fits usize");
+    assert!((1..=k).contains(&depth), "validation: 1 <= j(n) <= k");
+    for (i, spec) in cfg.square.iter().enumerate() {
+        let (sq, ev) = if i < depth {
+            quantize_stage(&(&s * &s), 2 * fprev, spec)
+        } else {
+            quantize_stage(&s, fprev, spec)
+        };
         fprev = i64::from(spec.format.frac_bits());
         s = BigInt::from(sq);
         values.push(sq);

@@ -10,8 +10,8 @@ use proptest::prelude::*;
 use specfx::fixed::{Event, Format, Overflow, Rounding};
 use specfx::nset::NSet;
 use specfx::pipeline::{
-    CoefSpec, Config, Datapath, FormatSpec, LatencySpec, MinimaxSpec, OutputScratch, ProbeColumns,
-    StageSpec, Variant,
+    CoefSpec, Config, Datapath, Depth, DepthStep, FormatSpec, LatencySpec, MinimaxSpec,
+    OutputScratch, ProbeColumns, StageSpec, Variant,
 };
 use specfx::reference::lobe::Cutoff;
 use specfx::reference::normalisation::{CoefSource, Form};
@@ -35,6 +35,33 @@ fn stage() -> impl Strategy<Value = StageSpec> {
         })
 }
 
+/// What a depth rule is drawn from: its kind (fixed, best or steps), the later steps
+/// (`from` -> a depth index) and the first step's depth index.
+type DepthDraw = (u8, std::collections::BTreeMap<u32, u32>, u32);
+
+fn depth_draw() -> impl Strategy<Value = DepthDraw> {
+    (
+        0u8..=2,
+        prop::collection::btree_map(2u32..=300, 0u32..7, 0..=2),
+        0u32..7,
+    )
+}
+
+/// The depth rule of a draw for a datapath of `k` stages: fixed, best, or up to three steps
+/// from n = 1 (so they cover every exponent the generators draw) with depths in 1..=k.
+fn depth_rule((kind, later, first): &DepthDraw, k: u32) -> Depth {
+    match kind {
+        0 => Depth::Fixed,
+        1 => Depth::Best,
+        _ => Depth::Steps(
+            std::iter::once((1, *first))
+                .chain(later.iter().map(|(&f, &j)| (f, j)))
+                .map(|(from, j)| DepthStep { from, j: 1 + j % k })
+                .collect(),
+        ),
+    }
+}
+
 prop_compose! {
     fn config()(
         k in 1u32..=7,
@@ -55,6 +82,7 @@ prop_compose! {
         coef_rounding in prop::sample::select(Rounding::ALL.to_vec()),
         ns in prop::collection::btree_set(1u32..=300, 1..=3),
         lat in (1u32..=4, 1u32..=4, 1u32..=4),
+        depth in depth_draw(),
     ) -> Config {
         let n_text: Vec<String> = ns.iter().map(|n| n.to_string()).collect();
         let c = if signed_c { fmt(true, 2, fc) } else { fmt(false, 1, fc) };
@@ -63,6 +91,7 @@ prop_compose! {
             name: "random".into(),
             variant: if minimax { Variant::Minimax } else { Variant::Plain },
             k,
+            depth: depth_rule(&depth, k),
             cutoff,
             n: n_text.join(",").parse::<NSet>().unwrap(),
             c: FormatSpec { format: c },

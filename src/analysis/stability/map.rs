@@ -435,7 +435,7 @@ pub(super) fn fixed_chunk(
     let nc = chunk.nc;
     let n = nc.n;
     let cfg = dp.config();
-    let n_below_m = cfg.variant == Variant::Plain && n < m_of_k(cfg.k);
+    let n_below_m = cfg.variant == Variant::Plain && n < m_of_k(nc.depth);
     let nf = f64::from(n);
     let cols = chunk.probes;
     let last = dp.stage_last_square();
