@@ -24,7 +24,7 @@ use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
 use crate::pipeline::walk::Stage;
 use crate::pipeline::StageSpec;
-use crate::pipeline::{Config, Datapath, Variant};
+use crate::pipeline::{Config, Datapath, Depth, Variant};
 
 /// One dimension the search shrinks by bisection.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -211,6 +211,9 @@ pub struct Choices {
     pub k: Vec<u32>,
     /// Variants.
     pub variants: Vec<Variant>,
+    /// Squaring depths: all k at every n (`false`, [`Depth::Fixed`]) or the best j(n) per
+    /// n (`true`, [`Depth::Best`]).
+    pub per_n: Vec<bool>,
     /// Rounding modes (applied to every searched stage at once).
     pub roundings: Vec<Rounding>,
 }
@@ -297,13 +300,20 @@ pub fn search(
     };
     let mut best: Option<Candidate> = None;
     let mut closest: Option<Candidate> = None;
-    for &k in &choices.k {
-        for &variant in &choices.variants {
+    let algorithms = choices.k.iter().flat_map(|&k| {
+        choices.variants.iter().flat_map(move |&variant| {
+            choices
+                .per_n
+                .iter()
+                .map(move |&per_n| Algorithm { k, variant, per_n })
+        })
+    });
+    for algorithm in algorithms {
+        {
             for &rounding in &choices.roundings {
-                let cfg = start_config(base, space, k, variant, rounding)?;
+                let cfg = start_config(base, space, algorithm, rounding)?;
                 progress(&format!(
-                    "k = {k}, {}, {rounding}: start at {} fraction bits",
-                    variant.name(),
+                    "{algorithm}, {rounding}: start at {} fraction bits",
                     space.start_frac
                 ));
                 let Some(start) = eval.evaluate(&cfg)? else {
@@ -315,7 +325,7 @@ pub fn search(
                     }
                     continue;
                 }
-                let current = bisect(&mut eval, &space.knobs(k), start)?;
+                let current = bisect(&mut eval, &space.knobs(algorithm.k), start)?;
                 progress(&format!("  -> {:.0} LUTs", current.cost));
                 if best.as_ref().is_none_or(|b| current.cost < b.cost) {
                     best = Some(current);
@@ -421,14 +431,12 @@ impl Evaluator<'_> {
 fn start_config(
     base: &Config,
     space: &Space,
-    k: u32,
-    variant: Variant,
+    algorithm: Algorithm,
     rounding: Rounding,
 ) -> Result<Config, Error> {
+    let k = algorithm.k;
     let mut cfg = base.clone();
-    cfg.k = k;
-    cfg.square = vec![base.square[0]; k as usize];
-    cfg.variant = variant;
+    algorithm.apply(&mut cfg);
     for knob in space.knobs(k).into_iter().filter(|k| k.starts_wide()) {
         knob.set(&mut cfg, space.start_frac)?;
     }
@@ -593,13 +601,18 @@ fn minimality(
     let choices = &space.choices;
     let mut lines = vec![
         format!(
-            "cheapest of {} starting points (k in {:?}, variants {:?}, roundings {:?}), each shrunk by per-stage bisection until no stage could lose a fraction bit",
-            choices.k.len() * choices.variants.len() * choices.roundings.len(),
+            "cheapest of {} starting points (k in {:?}, variants {:?}, depths {:?}, roundings {:?}), each shrunk by per-stage bisection until no stage could lose a fraction bit",
+            choices.k.len() * choices.variants.len() * choices.per_n.len() * choices.roundings.len(),
             choices.k,
             choices
                 .variants
                 .iter()
                 .map(|v| v.name())
+                .collect::<Vec<_>>(),
+            choices
+                .per_n
+                .iter()
+                .map(|&p| depth_of_choice(p).name())
                 .collect::<Vec<_>>(),
             choices
                 .roundings
@@ -647,13 +660,76 @@ fn minimality(
     Ok(lines)
 }
 
-/// One algorithm the optimiser may choose: k squarings and a variant.
+/// One algorithm the optimiser may choose: k squaring stages, a variant, and whether each n
+/// squares only to its best depth.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Algorithm {
-    /// Squarings.
+    /// Squaring stages.
     pub k: u32,
     /// Variant.
     pub variant: Variant,
+    /// Each n squares to the depth j(n) <= k with the smallest f64 floor ([`Depth::Best`]),
+    /// the later stages bypassed; otherwise every n squares k times.
+    pub per_n: bool,
+}
+
+/// The depth rule of a choice: [`Depth::Best`] per n, [`Depth::Fixed`] otherwise.
+fn depth_of_choice(per_n: bool) -> Depth {
+    if per_n {
+        Depth::Best
+    } else {
+        Depth::Fixed
+    }
+}
+
+impl Algorithm {
+    /// The depth rule the algorithm gives a configuration.
+    pub fn depth(self) -> Depth {
+        depth_of_choice(self.per_n)
+    }
+
+    /// Gives `cfg` the algorithm: k stages (each like its first), the variant and the depth
+    /// rule.
+    pub fn apply(self, cfg: &mut Config) {
+        cfg.k = self.k;
+        cfg.square = vec![cfg.square[0]; self.k as usize];
+        cfg.variant = self.variant;
+        cfg.depth = self.depth();
+    }
+
+    /// Every algorithm of `ks` x `variants` x `per_n`, in that order, less the per-n ones
+    /// that would be their fixed twin (every exponent of `n` already at its best depth k).
+    pub fn all(base: &Config, ks: &[u32], variants: &[Variant], per_n: &[bool]) -> Vec<Algorithm> {
+        let mut v = Vec::new();
+        for &k in ks {
+            for &variant in variants {
+                for &p in per_n {
+                    let a = Algorithm {
+                        k,
+                        variant,
+                        per_n: p,
+                    };
+                    let mut cfg = base.clone();
+                    a.apply(&mut cfg);
+                    if !p || cfg.has_bypass() {
+                        v.push(a);
+                    }
+                }
+            }
+        }
+        v
+    }
+}
+
+impl fmt::Display for Algorithm {
+    /// `k = 6 minimax`, or `k = 6 minimax, per-n depth`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "k = {} {}", self.k, self.variant.name())?;
+        if self.per_n {
+            f.write_str(", per-n depth")?;
+        }
+        Ok(())
+    }
 }
 
 /// The f64 floor of an algorithm: max |f64 lobe - cos^n| over the input codes and the n set
@@ -675,24 +751,15 @@ pub struct AlgorithmFloor {
     pub reachable: bool,
 }
 
-/// The floors of every algorithm (k in `ks`, each variant), from `base` with the internal
-/// stages at `start_frac` fraction bits.
+/// The floors of every algorithm ([`Algorithm::all`]), from `base` with the internal stages
+/// at `start_frac` fraction bits.
 pub fn algorithm_floors(
     base: &Config,
     budget: &Budget,
-    ks: &[u32],
-    variants: &[Variant],
+    algorithms: &[Algorithm],
     start_frac: i32,
 ) -> Vec<AlgorithmFloor> {
     use rayon::prelude::*;
-    let algorithms: Vec<Algorithm> = ks
-        .iter()
-        .flat_map(|&k| {
-            variants
-                .iter()
-                .map(move |&variant| Algorithm { k, variant })
-        })
-        .collect();
     algorithms
         .par_iter()
         .map(|&algorithm| {
@@ -725,13 +792,11 @@ pub fn algorithm_floors(
         .collect()
 }
 
-/// The starting point of an algorithm: the base with k squarings (each like the base's first)
-/// and the variant, every internal stage at `start_frac` fraction bits.
+/// The starting point of an algorithm: the base with the algorithm ([`Algorithm::apply`]),
+/// every internal stage at `start_frac` fraction bits.
 pub fn start_of(base: &Config, a: Algorithm, start_frac: i32) -> Result<Config, Error> {
     let mut cfg = base.clone();
-    cfg.k = a.k;
-    cfg.variant = a.variant;
-    cfg.square = vec![base.square[0]; a.k as usize];
+    a.apply(&mut cfg);
     for s in searched_stages(a.k) {
         set_frac(&mut cfg, s, start_frac)?;
     }
@@ -762,6 +827,7 @@ pub fn optimize_space(a: Algorithm, budget: &Budget, start_frac: i32) -> Space {
         choices: Choices {
             k: vec![a.k],
             variants: vec![a.variant],
+            per_n: vec![a.per_n],
             roundings: vec![Rounding::Trn, Rounding::Rnd],
         },
         start_frac,
@@ -908,7 +974,7 @@ pub fn optimize_all(
     let skipped: Vec<String> = floors
         .iter()
         .filter(|f| !f.reachable)
-        .map(|f| format!("k = {} {}", f.algorithm.k, f.algorithm.variant.name()))
+        .map(|f| f.algorithm.to_string())
         .collect();
     if out.best.is_some() && !skipped.is_empty() {
         out.minimality.insert(

@@ -51,6 +51,11 @@ pub struct OptimizeArgs {
     #[arg(long, default_value = "plain,minimax", value_delimiter = ',',
           value_parser = |v: &str| v.trim().parse::<Variant>())]
     variants: Vec<Variant>,
+    /// Squaring depths to try: fixed (every n squares k times), best (each n squares to the
+    /// depth j(n) <= k with the smallest f64 floor, the later stages bypassed) or both.
+    #[arg(long, default_value = "fixed,best", value_delimiter = ',',
+          value_parser = super::datapath::parse_depth_choice)]
+    depth: Vec<bool>,
     /// Fraction bits every searched stage starts from (must meet the budget).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=48))]
     start_frac: i32,
@@ -97,26 +102,30 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         }
     };
     let variants = &args.variants;
+    let algorithms = Algorithm::all(&base, args.k.values(), variants, &args.depth);
     log::info!(
-        "optimize: f64 floor of {} algorithms (k in {}, {})",
-        args.k.len() * variants.len(),
+        "optimize: f64 floor of {} algorithms (k in {}, {}; depth {})",
+        algorithms.len(),
         args.k,
         variants
             .iter()
             .map(|v| v.name())
             .collect::<Vec<_>>()
+            .join(", "),
+        args.depth
+            .iter()
+            .map(|&p| if p { "best" } else { "fixed" })
+            .collect::<Vec<_>>()
             .join(", ")
     );
     let mut budget = args.budget.clone();
     budget.arch = arch;
-    let floors = algorithm_floors(&base, &budget, args.k.values(), variants, args.start_frac);
+    let floors = algorithm_floors(&base, &budget, &algorithms, args.start_frac);
     let reachable = floors.iter().filter(|f| f.reachable).count();
     let bar = super::progress::Progress::new("optimize", "algorithms", reachable as u64);
     let done = |a: Algorithm, r: &SearchResult| {
         let line = format!(
-            "optimize: k = {}, {}: {}",
-            a.k,
-            a.variant.name(),
+            "optimize: {a}: {}",
             r.best
                 .as_ref()
                 .map_or("nothing meets the budget".to_string(), |b| format!(

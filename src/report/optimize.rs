@@ -30,6 +30,7 @@ pub fn write_no_answer(
     let mut columns = vec![
         ("k", Align::Right),
         ("variant", Align::Left),
+        ("depth", Align::Left),
         ("shape_total floor", Align::Right),
         ("lsb8", Align::Right),
     ];
@@ -43,7 +44,11 @@ pub fn write_no_answer(
     let mut table = TextTable::new(&columns).indent(2);
     for f in &r.floors {
         let a = f.algorithm;
-        let mut row = vec![a.k.to_string(), a.variant.name().to_string()];
+        let mut row = vec![
+            a.k.to_string(),
+            a.variant.name().to_string(),
+            a.depth().name().to_string(),
+        ];
         match (f.shape_total, &f.reason) {
             (Some(x), _) => {
                 row.push(format!("{x:.3e}"));
@@ -78,9 +83,8 @@ pub fn write_no_answer(
     {
         writeln!(
             w,
-            "closest algorithm: k = {} {}, whose f64 floor is {:.3e} ({:.2} lsb8); what would meet the budget: a shape_total limit above that floor (quantization adds to it), or fewer exponents (--n: the floors fall when every n is at least m = 2^k)",
-            f.algorithm.k,
-            f.algorithm.variant.name(),
+            "closest algorithm: {}, whose f64 floor is {:.3e} ({:.2} lsb8); what would meet the budget: a shape_total limit above that floor (quantization adds to it), or fewer exponents (--n: the floors fall when every n is at least m = 2^k)",
+            f.algorithm,
             f.shape_total.unwrap(),
             f.shape_total.unwrap() * 256.0
         )?;

@@ -427,7 +427,15 @@ pub fn floors(
     let mut v = Vec::new();
     for k in crate::reference::lobe::K_RANGE {
         for variant in [Variant::Plain, Variant::Minimax] {
-            let dp = start_of(base, Algorithm { k, variant }, start_frac).and_then(Datapath::new);
+            let dp = start_of(
+                base,
+                Algorithm {
+                    k,
+                    variant,
+                    per_n: false,
+                },
+                start_frac,
+            ).and_then(Datapath::new);
             let floor = match dp {
                 Err(e) => Floor {
                     k,
@@ -473,6 +481,7 @@ pub fn fit_space(k: u32, variant: Variant, start_frac: i32) -> Space {
         choices: Choices {
             k: vec![k],
             variants: vec![variant],
+            per_n: vec![false],
             roundings: vec![Rounding::Trn, Rounding::Rnd],
         },
         start_frac,
