@@ -435,7 +435,8 @@ pub fn floors(
                     per_n: false,
                 },
                 start_frac,
-            ).and_then(Datapath::new);
+            )
+            .and_then(Datapath::new);
             let floor = match dp {
                 Err(e) => Floor {
                     k,

@@ -11,6 +11,7 @@ mod batch_edges;
 mod check_oracle;
 mod cycle_model;
 mod datapath_props;
+mod depth;
 mod engine;
 mod furnace;
 mod layers;
