@@ -204,7 +204,8 @@ pub struct Features {
     pub dsp_glue_bits: u64,
     /// Multiplexer inputs of the power-of-two slope shifter (pipelined, slopes all 2^j).
     pub shifter_bits: u64,
-    /// Operand-select inputs of the folded architecture's shared multiplier.
+    /// Operand-select inputs of the folded architecture's shared multiplier, and the bypass
+    /// multiplexers of the squaring stages some exponent bypasses (per-n depth).
     pub mux_bits: u64,
     /// Register bits (data, valid bits and the per-n constants carried along).
     pub register_bits: u64,
@@ -320,6 +321,24 @@ pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
             0
         };
     let lat = &cfg.latency;
+    // Per-n depth: each stage some n bypasses selects between the square and its input (two
+    // inputs per bit of the square), and the depth field (DEPTH_BITS) travels with the data
+    // up to the last such stage.
+    let k = cfg.k as usize;
+    let bypass_from = dp.bypass_from();
+    let mut bypass_mux = 0u64;
+    let mut prev_w = w(cfg.b.format);
+    for (i, sq) in cfg.square.iter().enumerate() {
+        if i >= bypass_from {
+            bypass_mux += 2 * 2 * u64::from(prev_w);
+        }
+        prev_w = w(sq.format);
+    }
+    let depth_bits = if bypass_from < k {
+        u64::from(crate::hdl::DEPTH_BITS)
+    } else {
+        0
+    };
     let (multipliers, register_bits, mux_bits) = match arch {
         Arch::Pipelined => {
             let mut bits = u64::from(lat.sub)
@@ -332,7 +351,12 @@ pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
                     * (u64::from(w(sq.format)) + 1 + u64::from(w(cfg.coef.format)));
             }
             bits += u64::from(lat.mul) * (u64::from(w(cfg.out.format)) + 1);
-            (products, bits, 0)
+            // The depth rides in the registers of sub, mul_t, add_b and the squarings before
+            // the last bypassed one.
+            let stages_carried = u64::from(lat.sub + lat.mul + lat.add)
+                + u64::from(lat.mul) * (k as u64 - 1);
+            bits += depth_bits * stages_carried;
+            (products, bits, bypass_mux)
         }
         Arch::Folded => {
             let a = products.iter().map(|m| m.a_bits).max().unwrap_or(1);
@@ -348,7 +372,8 @@ pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
                 + u64::from(w(cfg.out.format))
                 + 1
                 + 16
-                + u64::from(lat.mul - 1) * u64::from(a + b);
+                + u64::from(lat.mul - 1) * u64::from(a + b)
+                + depth_bits;
             let shared = Multiplier {
                 name: "shared".into(),
                 a_bits: a,
@@ -357,7 +382,7 @@ pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
                 b_signed: products.iter().any(|m| m.b_signed),
                 square: false,
             };
-            (vec![shared], bits, mux)
+            (vec![shared], bits, mux + bypass_mux)
         }
     };
     let multiplier_bits: u64 = multipliers

@@ -53,6 +53,10 @@ pub fn cutoff_code(c: Cutoff) -> u32 {
 /// The most squaring stages (`SQ1_*` .. `SQ7_*` parameters of `specfx_top`).
 pub const MAX_SQUARES: usize = 7;
 
+/// Width of the per-n depth field j(n) (1..=7) in the vectors, the ROM and the RTL's
+/// `in_depth` port.
+pub const DEPTH_BITS: u32 = 3;
+
 /// The values of `hdl_ref/rtl/specfx_top.v`'s parameters for a configuration and an
 /// architecture, in the module's order: `ARCH`, `K`, `CUTOFF`, the formats (`<X>_W`, `<X>_F`,
 /// `<X>_S`), modes (`<X>_RND`, `<X>_OVF`), the seven squaring stages `SQ1_*` .. `SQ7_*` (stages

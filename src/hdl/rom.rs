@@ -6,6 +6,8 @@
 //! the ROM with n itself, so the plain variant's slope (n with k fraction bits) is a wire; a
 //! design serving a list of exponents (a scene's materials) addresses it with an index and
 //! stores the slope. Constants that are the same for every n (the plain offset 1) are wires.
+//! A datapath with a per-n depth stores j(n) too (`depth`, [`crate::hdl::DEPTH_BITS`] bits)
+//! and its plain slope n / 2^j(n).
 
 use serde::Serialize;
 
@@ -77,7 +79,9 @@ pub fn constant_rom(dp: &Datapath, target: Target) -> ConstantRom {
     let (slope, offset) = cfg.constant_formats();
     let mut fields = Vec::new();
     let minimax = cfg.variant == Variant::Minimax;
-    if minimax || !addressed_by_n {
+    // Per-n depth: the plain slope n / 2^j(n) is no longer n itself, and j(n) is a field.
+    let bypass = dp.bypass_from() < cfg.k as usize;
+    if minimax || !addressed_by_n || bypass {
         fields.push(RomField {
             name: "slope",
             bits: slope.width(),
@@ -99,6 +103,12 @@ pub fn constant_rom(dp: &Datapath, target: Target) -> ConstantRom {
         name: "coef",
         bits: cfg.coef.format.width(),
     });
+    if bypass {
+        fields.push(RomField {
+            name: "depth",
+            bits: crate::hdl::DEPTH_BITS,
+        });
+    }
     let width: u64 = fields.iter().map(|f| u64::from(f.bits)).sum();
     let inputs = match target {
         Target::Xilinx => 6,
@@ -135,12 +145,16 @@ pub fn rom_verilog(dp: &Datapath) -> String {
     let rom = constant_rom(dp, Target::Generic);
     let (slope_f, offset_f) = cfg.constant_formats();
     let stored = |name: &str| rom.fields.iter().any(|f| f.name == name);
-    let ports = [
+    let mut ports = vec![
         ("slope", slope_f),
         ("offset", offset_f),
         ("threshold", cfg.c.format),
         ("coef", cfg.coef.format),
     ];
+    if stored("depth") {
+        let bits = crate::hdl::DEPTH_BITS as i32;
+        ports.push(("depth", Format::unsigned(bits, 0).expect("a few bits")));
+    }
     let mut v = String::new();
     v.push_str(&format!(
         "// specfx_rom: the per-n constants of datapath `{}` ({} entries, addressed by {}).\n// Written by specfx; do not edit.\n`timescale 1ns / 1ps\n`default_nettype none\n\nmodule specfx_rom (\n    input  wire [{}:0] addr",
@@ -149,7 +163,7 @@ pub fn rom_verilog(dp: &Datapath) -> String {
         if rom.addressed_by_n { "n" } else { "the index of n in the ascending set" },
         rom.address_bits - 1
     ));
-    for (name, f) in ports {
+    for &(name, f) in &ports {
         let kind = if stored(name) { "reg " } else { "wire" };
         v.push_str(&format!(
             ",\n    output {kind} [{}:0] {name}",
@@ -158,7 +172,7 @@ pub fn rom_verilog(dp: &Datapath) -> String {
     }
     v.push_str("\n);\n");
     let first = dp.constants_for(cfg.n.min()).expect("n set is not empty");
-    for (name, f) in ports {
+    for &(name, f) in &ports {
         if stored(name) {
             continue;
         }
@@ -175,7 +189,7 @@ pub fn rom_verilog(dp: &Datapath) -> String {
         let nc = dp.constants_for(n).expect("n in the set");
         let addr = if rom.addressed_by_n { n as usize } else { i };
         let mut body = Vec::new();
-        for (name, f) in ports {
+        for &(name, f) in &ports {
             if !stored(name) {
                 continue;
             }
@@ -183,6 +197,7 @@ pub fn rom_verilog(dp: &Datapath) -> String {
                 "slope" => nc.slope_raw,
                 "offset" => nc.offset_raw,
                 "threshold" => nc.threshold.unwrap_or(0),
+                "depth" => i64::from(nc.depth),
                 _ => nc.coef_raw,
             };
             body.push(format!("{name} = {};", hex(raw, f)));

@@ -561,6 +561,17 @@ impl Datapath {
         STAGE_SQ0 + self.config.k as usize - 1
     }
 
+    /// The first squaring stage (0-based) that some exponent of the set bypasses: the
+    /// smallest depth j(n) over the set, k when every n squares k times. Stages from it on
+    /// need a bypass multiplexer; the depth field travels with the data as far as them.
+    pub fn bypass_from(&self) -> usize {
+        self.constants
+            .iter()
+            .map(|c| c.depth as usize)
+            .min()
+            .unwrap_or(self.config.k as usize)
+    }
+
     /// Index of the coefficient probe.
     pub fn stage_coef(&self) -> usize {
         STAGE_SQ0 + self.config.k as usize
