@@ -14,7 +14,7 @@ use crate::error::Error;
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_SQ0, STAGE_T};
 use crate::pipeline::f64_walk::F64Walk;
 use crate::pipeline::fast::EventCounts;
-use crate::pipeline::{first_code_where, Datapath, NConstants, MAX_STAGES};
+use crate::pipeline::{first_code_where, Datapath, NConstants, OutputScratch, MAX_STAGES};
 use crate::reference::lobe::Cutoff;
 use crate::reference::normalisation::classic_coefficient;
 
@@ -260,24 +260,82 @@ fn outputs_one_n(
         r.norm = norm_peak * cn;
         r.norm_approx = norm_peak * cn;
     }
-    let mut prev_out = (n_dead > 0).then_some(0);
-    let (last_sq, out) = (dp.stage_last_square(), dp.stage_out());
-    let span = Span {
-        from: n_dead,
-        dead_end: i64::MIN,
-        chunk_codes: CHUNK,
+    // The f64 lobe of code index i by the same algorithm (see `reference_probes`).
+    let f64_lobe = |i: usize| {
+        let t = nc.slope * shared.ref_d[i];
+        let mut s = reference_base(cfg.cutoff, t, nc.offset, codes[i].min(one) < threshold);
+        for _ in 0..nc.depth {
+            s *= s;
+        }
+        s
     };
-    each_chunk(dp, nc, &shared.codes, span, |c| {
-        let cols = c.probes;
-        for (j, &k) in c.codes.iter().enumerate() {
-            let i = c.start + j;
+    let n_zero = zero_run_end(dp, nc, codes, n_dead, &f64_lobe);
+    if n_zero > n_dead {
+        // Every fixed-point lobe and output of the run is 0, and the f64 lobe s, its output
+        // s coef and cos^n grow with c: each error against 0 is largest at the run's last
+        // code, and the correctly rounded outputs (s coef <= half) are a prefix of the run.
+        // Only the f64 lobe's own error against cos^n is looked at code by code.
+        let last_zero = n_zero - 1;
+        let (s, cn) = (f64_lobe(last_zero), cos_n(last_zero));
+        r.quant = r.quant.max(s);
+        r.total = r.total.max(cn);
+        r.out_max_abs = r.out_max_abs.max((s * nc.coef).abs());
+        r.norm = r.norm.max((norm_peak * cn).abs());
+        let correct_end = first_code_where(n_dead as i64..n_zero as i64, |i| {
+            (-(f64_lobe(i as usize) * nc.coef)).abs() > half
+        });
+        r.n_correct += (correct_end - n_dead as i64) as u64;
+        let approx_over = |range: std::ops::Range<usize>| {
+            range.fold((-1.0f64, -1.0f64), |(a, na), i| {
+                let (s, cn) = (f64_lobe(i), cos_n(i));
+                (
+                    a.max((s - cn).abs()),
+                    na.max((s * nc.coef - norm_peak * cn).abs()),
+                )
+            })
+        };
+        // The f64 lobe's error over every code (0 in the dead prefix, which the f64 model
+        // cuts too) is the datapath's floor: a cache holds it across datapaths.
+        let (approx, norm_approx) = match cache {
+            Some(c) => {
+                let key = (
+                    nc.n,
+                    nc.depth,
+                    nc.slope.to_bits(),
+                    nc.offset.to_bits(),
+                    nc.coef.to_bits(),
+                    threshold,
+                    cfg.cutoff as u8,
+                    cfg.coef.form as u8,
+                );
+                c.floor(key, || approx_over(0..codes.len()))
+            }
+            None => approx_over(n_dead..n_zero),
+        };
+        r.approx = r.approx.max(approx);
+        r.norm_approx = r.norm_approx.max(norm_approx);
+    }
+    let mut prev_out = (n_zero > 0).then_some(0);
+    // The live codes, a chunk at a time: only the lobe and the output are looked at, so the
+    // chunk runs the outputs' path (the squaring chain looked up from b), not every probe.
+    let mut scratch = OutputScratch::default();
+    let mut outs = vec![0i64; CHUNK.min(codes.len())];
+    let mut start = n_zero;
+    while start < codes.len() {
+        let end = (start + CHUNK).min(codes.len());
+        let chunk = &codes[start..end];
+        let o_chunk = &mut outs[..chunk.len()];
+        dp.eval_outputs_untabulated(nc, chunk, o_chunk, &mut scratch);
+        let lobes = scratch.lobes();
+        for (j, &k) in chunk.iter().enumerate() {
+            let i = start + j;
             let t = nc.slope * shared.ref_d[i];
             let mut s = reference_base(cfg.cutoff, t, nc.offset, k.min(one) < threshold);
             for _ in 0..nc.depth {
                 s *= s;
             }
-            let fixed_lobe = cols.values[last_sq][j] as f64 * lobe_lsb;
-            let o = cols.values[out][j];
+            let fixed_lobe = lobes[j] as f64 * lobe_lsb;
+            let o = o_chunk[j];
             let err = o as f64 * out_lsb - s * nc.coef;
             r.out_max_abs = r.out_max_abs.max(err.abs());
             r.n_correct += u64::from(err.abs() <= half);
@@ -292,7 +350,8 @@ fn outputs_one_n(
             }
             prev_out = Some(o);
         }
-    });
+        start = end;
+    }
     debug_assert!(last >= lo);
     r.norm_rel = r.norm / norm_peak;
     r.norm_approx /= norm_peak;
@@ -326,6 +385,7 @@ struct CosRow {
 pub struct CosCache {
     format: std::sync::OnceLock<crate::fixed::Format>,
     rows: std::sync::Mutex<std::collections::BTreeMap<u32, std::sync::Arc<CosRow>>>,
+    floors: std::sync::Mutex<std::collections::BTreeMap<FloorKey, (f64, f64)>>,
     capacity: usize,
     kept: std::sync::atomic::AtomicUsize,
 }
@@ -336,6 +396,7 @@ impl CosCache {
         CosCache {
             format: std::sync::OnceLock::new(),
             rows: std::sync::Mutex::new(std::collections::BTreeMap::new()),
+            floors: std::sync::Mutex::new(std::collections::BTreeMap::new()),
             capacity,
             kept: std::sync::atomic::AtomicUsize::new(0),
         }
@@ -374,6 +435,24 @@ impl CosCache {
             std::sync::Arc::new(CosRow { start, values })
         });
         Some(r.clone())
+    }
+}
+
+/// What the f64 lobe of one exponent depends on besides the input codes: n, its depth, the
+/// f64 slope, offset and coefficient (as bits), the threshold, the cutoff and the form.
+type FloorKey = (u32, u32, u64, u64, u64, i64, u8, u8);
+
+impl CosCache {
+    /// The f64 floor of one exponent, `(max |s - cos^n|, max |s coef - peak cos^n|)` over
+    /// every code, made by `make` when absent: the same for every datapath whose f64 lobe is
+    /// the same (the optimiser's candidates of one algorithm differ only in their stages).
+    fn floor(&self, key: FloorKey, make: impl FnOnce() -> (f64, f64)) -> (f64, f64) {
+        if let Some(&f) = self.floors.lock().expect("not poisoned").get(&key) {
+            return f;
+        }
+        let f = make();
+        self.floors.lock().expect("not poisoned").insert(key, f);
+        f
     }
 }
 
@@ -733,6 +812,36 @@ fn dead_prefix_end(dp: &Datapath, nc: &NConstants, codes: &[i64]) -> i64 {
     first_code_where(lo..fixed, positive)
 }
 
+/// The end (a code index) of the zero run of one n: from `n_dead` on, the codes whose
+/// fixed-point lobe is 0 (a prefix, [`Datapath::first_nonzero_lobe`]) and whose f64 lobe
+/// `f64_lobe` is proven non-decreasing: a positive slope and a base that the cutoff cannot
+/// leave negative there (the clamp, or a non-negative base at the run's first code), since
+/// `c - 1`, the product, the sum and the squares of non-negative values are each monotone in
+/// f64. `n_dead` where nothing is proven.
+fn zero_run_end(
+    dp: &Datapath,
+    nc: &NConstants,
+    codes: &[i64],
+    n_dead: usize,
+    f64_lobe: &dyn Fn(usize) -> f64,
+) -> usize {
+    if n_dead >= codes.len() || nc.slope.is_nan() || nc.slope <= 0.0 {
+        return n_dead;
+    }
+    let cfg = dp.config();
+    if cfg.cutoff != Cutoff::Clamp {
+        // The base at the run's first code, uncut (s is its square or more, so its sign is
+        // not in s): non-negative there, it stays so above.
+        let c = codes[n_dead].min(dp.one_code()) as f64 * cfg.c.format.lsb();
+        if nc.slope * (c - 1.0) + nc.offset < 0.0 || f64_lobe(n_dead).is_nan() {
+            return n_dead;
+        }
+    }
+    let start = codes[n_dead];
+    let end = dp.first_nonzero_lobe(nc, start..codes[codes.len() - 1] + 1);
+    n_dead + (end - start) as usize
+}
+
 /// Per-code inputs shared by every n: the codes with ln c, and d's f64 reference.
 struct CodeColumns {
     codes: Codes,
@@ -1076,6 +1185,54 @@ fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
         fold.chunk(c, &shared.ref_d[c.start..c.start + c.codes.len()]);
     });
     fold.finish()
+}
+
+/// The overflow events of every stage (wrapped, saturated, zeroed; indexed like
+/// [`Datapath::stages`]) over every input code up to 1.0 and every n: the counts the full
+/// [`check`] reports, without its statistics (codes above 1.0 repeat the code of 1.0).
+///
+/// # Errors
+/// As [`check`]: [`Error::TooManyCodes`].
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::check::{check, stage_events};
+/// use specfx::pipeline::{Config, Datapath};
+/// let dp = Datapath::new(Config::baseline()).unwrap();
+/// let events = stage_events(&dp).unwrap();
+/// let report = check(&dp).unwrap();
+/// for (e, s) in events.iter().zip(&report.stages) {
+///     assert_eq!(*e, [s.wrapped, s.saturated, s.zeroed]);
+/// }
+/// ```
+pub fn stage_events(dp: &Datapath) -> Result<Vec<EventCounts>, Error> {
+    let shared = code_columns(dp)?;
+    let n_stages = dp.stages().len();
+    let per_n = map_n(dp, |nc| {
+        let span = Span {
+            from: 0,
+            dead_end: dead_prefix_end(dp, nc, &shared.codes.codes),
+            chunk_codes: CHUNK,
+        };
+        let mut counts = vec![[0u64; 3]; n_stages];
+        each_chunk(dp, nc, &shared.codes, span, |c| {
+            for (sum, e) in counts.iter_mut().zip(&c.probes.event_counts) {
+                for (a, b) in sum.iter_mut().zip(e) {
+                    *a += b;
+                }
+            }
+        });
+        counts
+    });
+    let mut total = vec![[0u64; 3]; n_stages];
+    for counts in per_n {
+        for (sum, e) in total.iter_mut().zip(&counts) {
+            for (a, b) in sum.iter_mut().zip(e) {
+                *a += b;
+            }
+        }
+    }
+    Ok(total)
 }
 
 /// The largest number of input codes an exhaustive check evaluates per exponent.

@@ -135,19 +135,13 @@ fn set_frac(cfg: &mut Config, stage: Stage, frac: i32) -> Result<(), Error> {
 /// The stages the exhaustive check proves never overflow in a configuration (no wrap,
 /// saturation or zeroing on any input): there every overflow mode gives the same values.
 fn stages_never_overflowing(cfg: &Config) -> Result<Vec<Stage>, Error> {
-    let report = crate::analysis::check::check(&Datapath::new(cfg.clone())?)?;
+    let events = crate::analysis::check::stage_events(&Datapath::new(cfg.clone())?)?;
+    let k = cfg.k as usize;
     let mut stages = searched_stages(cfg.k);
     stages.push(Stage::Out);
     Ok(stages
         .into_iter()
-        .filter(|stage| {
-            let name = stage.to_string();
-            report
-                .stages
-                .iter()
-                .find(|s| s.stage == name)
-                .is_some_and(|s| s.wrapped == 0 && s.saturated == 0 && s.zeroed == 0)
-        })
+        .filter(|stage| events[stage.index(k)] == [0, 0, 0])
         .collect())
 }
 

@@ -353,8 +353,8 @@ pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
             bits += u64::from(lat.mul) * (u64::from(w(cfg.out.format)) + 1);
             // The depth rides in the registers of sub, mul_t, add_b and the squarings before
             // the last bypassed one.
-            let stages_carried = u64::from(lat.sub + lat.mul + lat.add)
-                + u64::from(lat.mul) * (k as u64 - 1);
+            let stages_carried =
+                u64::from(lat.sub + lat.mul + lat.add) + u64::from(lat.mul) * (k as u64 - 1);
             bits += depth_bits * stages_carried;
             (products, bits, bypass_mux)
         }

@@ -167,6 +167,7 @@ pub struct Datapath {
     /// The squaring chain tabulated by b's code, one per depth j (index j), built on first use.
     chain: [std::sync::OnceLock<Option<ChainTable>>; 8],
     cut_is_prefix: bool,
+    lobe_monotone: bool,
 }
 
 /// Where the cutoff can force the base to zero, as far as the configuration proves it.
@@ -399,7 +400,7 @@ impl Datapath {
             }
             Cutoff::None => false,
         };
-        Ok(Datapath {
+        let mut dp = Datapath {
             config,
             stages,
             constants,
@@ -408,7 +409,10 @@ impl Datapath {
             plan,
             chain: std::array::from_fn(|_| std::sync::OnceLock::new()),
             cut_is_prefix,
-        })
+            lobe_monotone: false,
+        };
+        dp.lobe_monotone = dp.prove_lobe_monotone();
+        Ok(dp)
     }
 
     /// Chooses each stage's batch kernel from a bound on its exact input: the magnitude bits
@@ -922,6 +926,31 @@ impl Datapath {
         out: &mut [i64],
         scratch: &mut OutputScratch,
     ) {
+        self.outputs(nc, codes, out, scratch, true);
+    }
+
+    /// [`Datapath::eval_outputs`] with the squaring chain run stage by stage, never tabulated:
+    /// for a datapath evaluated once over few live codes (an exhaustive check of one of the
+    /// optimiser's candidates), where building the table would cost more than it saves. The
+    /// lobes are left in the scratch ([`OutputScratch::lobes`]).
+    pub fn eval_outputs_untabulated(
+        &self,
+        nc: &NConstants,
+        codes: &[i64],
+        out: &mut [i64],
+        scratch: &mut OutputScratch,
+    ) {
+        self.outputs(nc, codes, out, scratch, false);
+    }
+
+    fn outputs(
+        &self,
+        nc: &NConstants,
+        codes: &[i64],
+        out: &mut [i64],
+        scratch: &mut OutputScratch,
+        tabulate: bool,
+    ) {
         let len = codes.len();
         let s = scratch;
         for col in [&mut s.a, &mut s.b] {
@@ -949,7 +978,7 @@ impl Datapath {
             &mut s.sums,
             &mut counts,
         );
-        if let Some(table) = self.chain_table(nc.depth) {
+        if let Some(table) = self.chain_table(nc.depth).filter(|_| tabulate) {
             for (sq, &b) in s.b.iter_mut().zip(&s.a) {
                 *sq = table.last[(b - table.b_min) as usize];
             }
@@ -1001,6 +1030,77 @@ impl Datapath {
             return codes.start;
         }
         first_code_where(codes, |code| !self.is_cut(code, nc))
+    }
+
+    /// Whether the last squaring (the lobe) is proven non-decreasing in the input code up to
+    /// 1.0. t saturates and every slope is non-negative, so t is non-decreasing and at most 0
+    /// (c <= 1), and the exact sum at most the largest offset. From b on every stage must be
+    /// monotone on the values it can receive: every rounding mode is monotone, and so are the
+    /// squares of non-negative values and the bypassed stages' requantization; a stage's
+    /// overflow is monotone when it saturates, or when the quantization of the largest value
+    /// it can receive fits the format (then no value overflows: wrapping and zeroing never
+    /// act). Negative bases are cut by the clamp, or reach an unsigned b that saturates them
+    /// to 0. Then the codes whose lobe is 0 are a prefix ([`Datapath::first_nonzero_lobe`]).
+    pub fn lobe_is_monotone(&self) -> bool {
+        self.lobe_monotone
+    }
+
+    fn prove_lobe_monotone(&self) -> bool {
+        let cfg = &self.config;
+        let sat = |o: Overflow| matches!(o, Overflow::Sat | Overflow::SatSym);
+        if !sat(cfg.t.overflow) || self.constants.iter().any(|c| c.slope_raw < 0) {
+            return false;
+        }
+        if cfg.cutoff != Cutoff::Clamp && !(cfg.b.format.is_signed() || sat(cfg.b.overflow)) {
+            return false;
+        }
+        if cfg.cutoff != Cutoff::Clamp && cfg.b.format.is_signed() {
+            return false;
+        }
+        // The largest exact sum (the largest offset) on the sum's fraction bits, then the
+        // largest value each stage can hold, or None once a stage could overflow without
+        // saturating.
+        let Some(first) = self.constants.first() else {
+            return true;
+        };
+        let fb = self.b_frac(first);
+        let top = self
+            .constants
+            .iter()
+            .map(|c| i128::from(c.offset_raw) << (fb - c.offset_frac) as u32)
+            .max()
+            .unwrap_or(0)
+            .max(0);
+        let bound = |exact: i128, frac: i32, spec: &crate::pipeline::StageSpec| {
+            let q = quantize_to(exact, frac, spec);
+            (q.event == Event::None || sat(spec.overflow)).then_some(q.raw.max(0))
+        };
+        let Some(mut upper) = bound(top, fb, &cfg.b) else {
+            return false;
+        };
+        let mut frac = cfg.b.format.frac_bits();
+        for spec in &cfg.square {
+            let u = i128::from(upper);
+            let (Some(squared), Some(passed)) =
+                (bound(u * u, 2 * frac, spec), bound(u, frac, spec))
+            else {
+                return false;
+            };
+            upper = squared.max(passed);
+            frac = spec.format.frac_bits();
+        }
+        true
+    }
+
+    /// The first code of `codes` whose lobe (the last squaring) is not 0, by bisection where
+    /// [`Datapath::lobe_is_monotone`] proves the zero lobes a prefix; `codes.start` otherwise.
+    /// Below it every output is 0 too (the quantization of 0 is 0).
+    pub fn first_nonzero_lobe(&self, nc: &NConstants, codes: std::ops::Range<i64>) -> i64 {
+        if !self.lobe_is_monotone() {
+            return codes.start;
+        }
+        let last = self.stage_last_square();
+        first_code_where(codes, |code| self.eval(code, nc).values[last] != 0)
     }
 
     /// [`Datapath::eval_batch`] for a batch of codes that are all cut (every code below
@@ -1157,6 +1257,14 @@ pub struct OutputScratch {
     b: Vec<i64>,
     sums: Vec<i64>,
     cut: Vec<bool>,
+}
+
+impl OutputScratch {
+    /// The lobes (the last squaring's raw values) of the latest [`Datapath::eval_outputs`],
+    /// one per code it evaluated.
+    pub fn lobes(&self) -> &[i64] {
+        &self.b
+    }
 }
 
 /// Refuses a depth rule that does not give every exponent of the set a depth in 1..=k.

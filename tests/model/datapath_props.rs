@@ -272,11 +272,20 @@ fn corners_equal_brute_force(dp: &Datapath) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-/// The output-only check against the full check's output figures (they must be the same bits).
+/// The output-only check (without and with the cache of cos^n and floors) and the events-only
+/// pass against the full check's figures (they must be the same bits).
 fn output_check_equals_full_check(dp: &Datapath) -> Result<(), TestCaseError> {
-    let full = specfx::analysis::check::check(dp).unwrap().output_figures();
-    let fast = specfx::analysis::check::check_outputs(dp).unwrap();
-    prop_assert_eq!(fast, full);
+    use specfx::analysis::check::{check, check_outputs, check_outputs_cached, stage_events};
+    let report = check(dp).unwrap();
+    let full = report.output_figures();
+    prop_assert_eq!(check_outputs(dp).unwrap(), full);
+    let cache = specfx::analysis::check::CosCache::new(1 << 20);
+    prop_assert_eq!(check_outputs_cached(dp, Some(&cache)).unwrap(), full);
+    prop_assert_eq!(check_outputs_cached(dp, Some(&cache)).unwrap(), full);
+    let events = stage_events(dp).unwrap();
+    for (e, s) in events.iter().zip(&report.stages) {
+        prop_assert_eq!(*e, [s.wrapped, s.saturated, s.zeroed], "{}", s.stage);
+    }
     Ok(())
 }
 
