@@ -20,8 +20,11 @@ use serde::Serialize;
 
 use crate::analysis::budget_expr::{Bound, Budget, Metric, Synthesise, Verdict};
 use crate::analysis::check::{check_outputs, check_outputs_cached, CosCache};
+use crate::cycle::Arch;
 use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
+use crate::hdl::cost::{analytic_cost, Target};
+use crate::hdl::pnr::{device_check, Device};
 use crate::pipeline::walk::Stage;
 use crate::pipeline::StageSpec;
 use crate::pipeline::{Config, Datapath, Depth, Variant};
@@ -183,6 +186,8 @@ pub struct Space {
     pub local_roundings: Vec<Rounding>,
     /// Whether the local search may change overflow modes.
     pub overflow_moves: bool,
+    /// The microarchitecture the candidates are costed in.
+    pub arch: Arch,
 }
 
 /// What a search found.
@@ -223,6 +228,8 @@ pub struct Candidate {
     pub feasible: bool,
     /// How far from the budget (<= 1 when met).
     pub excess: f64,
+    /// The microarchitecture it was costed in.
+    pub arch: Arch,
 }
 
 /// What the optimiser found.
@@ -259,6 +266,7 @@ pub fn optimize(
         extra_knobs: Vec::new(),
         local_roundings: Rounding::ALL.to_vec(),
         overflow_moves: true,
+        arch: budget.arch,
     };
     let cos = CosCache::new(COS_CACHE_VALUES);
     let mut judge =
@@ -286,6 +294,7 @@ pub fn search(
 ) -> Result<SearchResult, Error> {
     let choices = &space.choices;
     let mut eval = Evaluator {
+        arch: space.arch,
         judge,
         cost,
         memo: BTreeMap::new(),
@@ -360,6 +369,7 @@ impl Space {
 /// The search's judge and cost with memos: each configuration is judged once, and counted,
 /// and priced once.
 struct Evaluator<'a> {
+    arch: Arch,
     judge: &'a mut dyn FnMut(&Datapath) -> Result<Verdict, Error>,
     cost: &'a mut dyn FnMut(&Datapath) -> Result<f64, Error>,
     memo: BTreeMap<String, Option<Candidate>>,
@@ -384,6 +394,7 @@ impl Evaluator<'_> {
                     cost: self.price(&key, &dp)?,
                     feasible: v.feasible,
                     excess: v.excess,
+                    arch: self.arch,
                 })
             }
         };
@@ -828,6 +839,7 @@ pub fn optimize_space(a: Algorithm, budget: &Budget, start_frac: i32) -> Space {
         extra_knobs,
         local_roundings: Rounding::ALL.to_vec(),
         overflow_moves: true,
+        arch: budget.arch,
     }
 }
 
@@ -911,47 +923,137 @@ pub struct OptimizeAll {
     pub n_evaluations: u64,
     /// Why the answer is minimal within the search.
     pub minimality: Vec<String>,
+    /// The device every answer had to fit, if any.
+    pub device: Option<Device>,
+}
+
+/// The device an answer must fit, checked on the analytic figures of the datapath alone
+/// (without its constant ROM) on the device's family ([`Target::Ice40`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct DeviceFit {
+    /// The device.
+    pub device: Device,
+    /// Whether an algorithm whose pipelined answer does not fit is searched again in the
+    /// folded architecture (one shared multiplier).
+    pub fold_when_needed: bool,
+}
+
+impl DeviceFit {
+    /// The resources a datapath in `arch` needs beyond the device's, one line each (empty
+    /// when it fits).
+    pub fn overflows(&self, dp: &Datapath, arch: Arch) -> Vec<String> {
+        let f = analytic_cost(dp, arch, Target::Ice40);
+        device_check(f.dsps, f.luts, f.ffs, self.device)
+    }
+
+    /// How far a datapath is from fitting: the largest ratio of a resource used to the
+    /// device's (above 1 when it does not fit).
+    fn excess(&self, dp: &Datapath, arch: Arch) -> f64 {
+        let f = analytic_cost(dp, arch, Target::Ice40);
+        let l = self.device.limits();
+        [(f.dsps, l.dsps), (f.luts, l.luts), (f.ffs, l.ffs)]
+            .into_iter()
+            .map(|(used, available)| match (used, available) {
+                (0, _) => 0.0,
+                (_, 0) => f64::INFINITY,
+                _ => used as f64 / available as f64,
+            })
+            .fold(0.0, f64::max)
+    }
 }
 
 /// Searches every reachable algorithm (in parallel, results combined in the floors' order) for
-/// the cheapest configuration meeting `budget`; `done(algorithm)` is called as each finishes.
+/// the cheapest configuration meeting `budget`, costed by `cost` in the budget's architecture;
+/// `done(algorithm)` is called as each finishes. With a device (`fit`), an answer that does
+/// not fit it is no answer (it becomes the closest point, and a line of the minimality); when
+/// no algorithm's answer fits and `fit` allows it, the algorithms are searched again in the
+/// folded architecture (one shared multiplier, an initiation interval of k + 2 cycles), whose
+/// answers then compete.
+#[allow(clippy::too_many_arguments)]
 pub fn optimize_all(
     base: &Config,
     budget: &Budget,
     floors: Vec<AlgorithmFloor>,
     start_frac: i32,
-    cost: &(dyn Fn(&Datapath) -> Result<f64, Error> + Sync),
+    cost: &(dyn Fn(&Datapath, Arch) -> Result<f64, Error> + Sync),
     synth: Option<Synthesise>,
+    fit: Option<DeviceFit>,
     done: &(dyn Fn(Algorithm, &SearchResult) + Sync),
 ) -> Result<OptimizeAll, Error> {
     use rayon::prelude::*;
     // Every algorithm's candidates share the input format: one cache of cos^n for all.
     let cos = CosCache::new(COS_CACHE_VALUES);
-    let results: Vec<Result<SearchResult, Error>> = floors
-        .par_iter()
-        .filter(|f| f.reachable)
-        .map(|f| {
-            let space = optimize_space(f.algorithm, budget, start_frac);
-            let mut judge = |dp: &Datapath| exhaustive_judge(dp, budget, Some(&cos));
-            let mut cost = |dp: &Datapath| cost(dp);
-            let mut r = search(base, &space, &mut judge, &mut cost, &mut |_| {})?;
-            // The cheapest point meeting the error bounds must meet the cost ceilings too.
-            if let Some(b) = r.best.take() {
-                let v = budget.cost_verdict(&Datapath::new(b.config.clone())?, synth)?;
-                if v.feasible {
-                    r.best = Some(b);
-                } else {
-                    r.closest = Some(Candidate {
-                        feasible: false,
-                        excess: v.excess,
-                        ..b
-                    });
-                }
+    let search_in = |a: Algorithm, arch: Arch| -> Result<SearchResult, Error> {
+        let mut budget = budget.clone();
+        budget.arch = arch;
+        let space = optimize_space(a, &budget, start_frac);
+        let mut judge = |dp: &Datapath| exhaustive_judge(dp, &budget, Some(&cos));
+        let mut cost = |dp: &Datapath| cost(dp, arch);
+        let mut r = search(base, &space, &mut judge, &mut cost, &mut |_| {})?;
+        // The cheapest point meeting the error bounds must meet the cost ceilings too.
+        if let Some(b) = r.best.take() {
+            let v = budget.cost_verdict(&Datapath::new(b.config.clone())?, synth)?;
+            if v.feasible {
+                r.best = Some(b);
+            } else {
+                r.closest = Some(Candidate {
+                    feasible: false,
+                    excess: v.excess,
+                    ..b
+                });
             }
-            done(f.algorithm, &r);
-            Ok(r)
-        })
+        }
+        Ok(r)
+    };
+    // Every reachable algorithm in the budget's architecture; with a device, an answer that
+    // does not fit becomes the closest point.
+    let phase = |algorithms: &[Algorithm],
+                 arch: Arch|
+     -> Result<Vec<(SearchResult, Option<String>)>, Error> {
+        algorithms
+            .par_iter()
+            .map(|&a| {
+                let mut r = search_in(a, arch)?;
+                let mut note = None;
+                if let (Some(fit), Some(b)) = (fit, r.best.clone()) {
+                    let dp = Datapath::new(b.config.clone())?;
+                    let over = fit.overflows(&dp, b.arch);
+                    if !over.is_empty() {
+                        note = Some(format!("{a}, {}: {}", b.arch, over.join(", ")));
+                        r.closest = Some(Candidate {
+                            feasible: false,
+                            excess: fit.excess(&dp, b.arch),
+                            ..b
+                        });
+                        r.best = None;
+                    }
+                }
+                done(a, &r);
+                Ok((r, note))
+            })
+            .collect()
+    };
+    let reachable: Vec<Algorithm> = floors
+        .iter()
+        .filter(|f| f.reachable)
+        .map(|f| f.algorithm)
         .collect();
+    let mut results = phase(&reachable, budget.arch)?;
+    // No answer fits: the folded architecture (one shared multiplier) for the algorithms
+    // whose answers did not.
+    if fit.is_some_and(|f| f.fold_when_needed) && budget.arch == Arch::Pipelined {
+        let unfit: Vec<Algorithm> = reachable
+            .iter()
+            .zip(&results)
+            .filter(|(_, (_, note))| note.is_some())
+            .map(|(&a, _)| a)
+            .collect();
+        if results.iter().all(|(r, _)| r.best.is_none()) && !unfit.is_empty() {
+            results.extend(phase(&unfit, Arch::Folded)?);
+        }
+    }
+    let notes: Vec<String> = results.iter().filter_map(|(_, n)| n.clone()).collect();
+    let results: Vec<SearchResult> = results.into_iter().map(|(r, _)| r).collect();
     let mut out = OptimizeAll {
         budget: budget.clone(),
         floors: Vec::new(),
@@ -959,8 +1061,9 @@ pub fn optimize_all(
         closest: None,
         n_evaluations: 0,
         minimality: Vec::new(),
+        device: None,
     };
-    let combined = combine(results.into_iter().collect::<Result<Vec<_>, Error>>()?);
+    let combined = combine(results);
     out.best = combined.best;
     out.closest = combined.closest;
     out.n_evaluations = combined.n_evaluations;
@@ -979,7 +1082,18 @@ pub fn optimize_all(
             ),
         );
     }
+    if let Some(fit) = fit {
+        let mut lines = vec![format!(
+            "device: every answer must fit the {} (analytic figures of the datapath, its constant ROM aside)",
+            fit.device.full_name()
+        )];
+        lines.extend(notes.into_iter().map(|n| format!("  does not fit: {n}")));
+        for (i, l) in lines.into_iter().enumerate() {
+            out.minimality.insert(i, l);
+        }
+    }
     out.floors = floors;
+    out.device = fit.map(|f| f.device);
     Ok(out)
 }
 

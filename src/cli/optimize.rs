@@ -9,10 +9,11 @@ use super::Outcome;
 use specfx::analysis::budget_expr::{Budget, Metric};
 use specfx::analysis::check::check;
 use specfx::analysis::optimize::{
-    algorithm_floors, optimize_all, Algorithm, Objective, SearchResult,
+    algorithm_floors, optimize_all, Algorithm, DeviceFit, Objective, SearchResult,
 };
 use specfx::cycle::Arch;
-use specfx::hdl::cost::{analytic_cost, Target};
+use specfx::hdl::cost::{analytic_cost, dsp_weight, objective_value, Target};
+use specfx::hdl::pnr::Device;
 use specfx::nset::NSet;
 use specfx::output::write_atomic;
 use specfx::pipeline::{Datapath, Variant};
@@ -59,15 +60,32 @@ pub struct OptimizeArgs {
     /// Fraction bits every searched stage starts from (must meet the budget).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=48))]
     start_frac: i32,
-    /// Microarchitecture costed.
-    #[arg(long, default_value = "pipelined")]
-    arch: Arch,
+    /// Microarchitecture costed: pipelined or folded. Left out: pipelined, and folded for an
+    /// algorithm whose pipelined answer does not fit the device.
+    #[arg(long)]
+    arch: Option<Arch>,
+    /// The device every answer must fit (its DSP blocks, LUTs and flip-flops, by the analytic
+    /// model): up5k or hx8k (iCE40), or none to lift the limit. Left out: the iCE40 UP5K when
+    /// the target is ice40, none otherwise.
+    #[arg(long, value_parser = parse_device)]
+    device: Option<Option<Device>>,
     /// Where to write the configuration found (TOML).
     #[arg(long, default_value = "specfx-optimized.toml")]
     out: PathBuf,
     /// Replace an existing output file that is not an earlier result of this command.
     #[arg(long)]
     force: bool,
+}
+
+/// Parses `--device`: a device, or `none`.
+fn parse_device(s: &str) -> std::result::Result<Option<Device>, String> {
+    match s.trim() {
+        "none" => Ok(None),
+        other => other
+            .parse::<Device>()
+            .map(Some)
+            .map_err(|e| format!("{e}, or none to lift the limit")),
+    }
 }
 
 /// Runs `specfx optimize`. Exit code 1 when no configuration meets the budget.
@@ -91,14 +109,44 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     }
     let yosys = args.objective == Objective::Yosys;
     let hdl = super::hdl_ref::hdl_ref_dir(None);
-    let arch = args.arch;
+    let arch = args.arch.unwrap_or(Arch::Pipelined);
     let target = args.target;
-    let unit = format!("{} on {}", target.logic_unit(), target.name());
-    let cost = |dp: &Datapath| -> Result<f64, specfx::Error> {
+    let device = match args.device {
+        Some(d) => d,
+        None => (target == Target::Ice40).then_some(Device::Up5k),
+    };
+    if device.is_some() && target != Target::Ice40 {
+        bail!(
+            "--device: the devices are iCE40s, costed on --target ice40 (got --target {}); give --device none to cost on {} without a device",
+            target.name(),
+            target.name()
+        );
+    }
+    let fit = device.map(|device| DeviceFit {
+        device,
+        fold_when_needed: args.arch.is_none(),
+    });
+    let unit = match dsp_weight(target) {
+        w if w > 0.0 => format!(
+            "{}-equivalents on {} ({} + {w:.0} per DSP block)",
+            target.logic_unit().trim_end_matches('s'),
+            target.name(),
+            target.logic_unit()
+        ),
+        _ => format!("{} on {}", target.logic_unit(), target.name()),
+    };
+    let cost = |dp: &Datapath, arch: Arch| -> Result<f64, specfx::Error> {
         if yosys {
-            specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| s.cost.luts as f64)
+            specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| {
+                objective_value(&specfx::hdl::cost::CostFigures {
+                    target,
+                    luts: s.cost.luts,
+                    dsps: s.cost.dsps,
+                    ffs: s.cost.ffs,
+                })
+            })
         } else {
-            Ok(analytic_cost(dp, arch, target).luts as f64)
+            Ok(objective_value(&analytic_cost(dp, arch, target).figures()))
         }
     };
     let variants = &args.variants;
@@ -123,15 +171,17 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     let floors = algorithm_floors(&base, &budget, &algorithms, args.start_frac);
     let reachable = floors.iter().filter(|f| f.reachable).count();
     let bar = super::progress::Progress::new("optimize", "algorithms", reachable as u64);
+    let no_answer = match device {
+        Some(d) => format!("nothing meets the budget and fits the {}", d.full_name()),
+        None => "nothing meets the budget".to_string(),
+    };
     let done = |a: Algorithm, r: &SearchResult| {
         let line = format!(
             "optimize: {a}: {}",
-            r.best
-                .as_ref()
-                .map_or("nothing meets the budget".to_string(), |b| format!(
-                    "{:.0} {unit} ({})",
-                    b.cost, args.objective
-                ))
+            r.best.as_ref().map_or(no_answer.to_string(), |b| format!(
+                "{:.0} {unit} ({})",
+                b.cost, args.objective
+            ))
         );
         log::info!("{line}");
         bar.inc(1);
@@ -156,6 +206,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         args.start_frac,
         &cost,
         Some(&synth),
+        fit,
         &done,
     )?;
     bar.finish();
@@ -171,13 +222,18 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         })?;
         return Ok(Outcome::CheckFailed);
     };
-    // The proof: the exhaustive check of the answer, against the budget.
+    // The proof: the exhaustive check of the answer, against the budget, in the answer's
+    // architecture.
+    let arch = best.arch;
+    let mut budget = r.budget.clone();
+    budget.arch = arch;
     let mut config = best.config.clone();
     config.name = "optimized".into();
     let dp = Datapath::new(config.clone())?;
     let proof = check(&dp)?;
-    if !r.budget.met_by(&proof.output_figures(), &dp)
-        || !r.budget.cost_verdict(&dp, Some(&synth))?.feasible
+    if !budget.met_by(&proof.output_figures(), &dp)
+        || !budget.cost_verdict(&dp, Some(&synth))?.feasible
+        || fit.is_some_and(|f| !f.overflows(&dp, arch).is_empty())
     {
         bail!("the configuration found does not meet the budget on re-check: this is a bug");
     }
@@ -217,7 +273,18 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             .option("k", canonical_nset(&args.k))
             .option("variants", variant_names)
             .option("start_frac", args.start_frac)
-            .option("arch", arch.to_string()),
+            .option(
+                "depth",
+                args.depth
+                    .iter()
+                    .map(|&p| if p { "best" } else { "fixed" })
+                    .collect::<Vec<_>>(),
+            )
+            .option(
+                "arch",
+                args.arch.map_or("auto".to_string(), |a| a.to_string()),
+            )
+            .option("device", device.map_or("none", |d| d.name())),
     );
     let text = format!(
         "{}{}{}",

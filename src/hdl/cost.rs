@@ -494,6 +494,30 @@ impl AnalyticCost {
     }
 }
 
+/// What one DSP block weighs in the optimiser's objective, in the target's logic unit: the
+/// logic cells its product (the block's full operands, 16 x 16 on iCE40, 25 x 18 on Xilinx)
+/// would take as soft partial-product bits under the calibrated model; 0 on targets without
+/// DSP blocks.
+///
+/// # Examples
+/// ```
+/// use specfx::hdl::cost::{dsp_weight, Target};
+/// assert!(dsp_weight(Target::Ice40) > 256.0); // above one LUT per partial-product bit
+/// assert_eq!(dsp_weight(Target::Generic), 0.0);
+/// ```
+pub fn dsp_weight(target: Target) -> f64 {
+    let soft = crate::hdl::calibrate::coefficients(target).logic[3];
+    target
+        .dsp_operands()
+        .map_or(0.0, |(a, b)| soft * f64::from(a * b))
+}
+
+/// The optimiser's objective for figures: logic cells plus each DSP block at its
+/// [`dsp_weight`], so that a block is worth the logic it saves and no more.
+pub fn objective_value(f: &CostFigures) -> f64 {
+    f.luts as f64 + f.dsps as f64 * dsp_weight(f.target)
+}
+
 /// The analytic cost figures of a datapath on every [`REPORTED_TARGETS`] target.
 pub fn figures_on_targets(dp: &Datapath, arch: Arch) -> Vec<CostFigures> {
     REPORTED_TARGETS

@@ -131,6 +131,28 @@ pub struct Answer<'a> {
     pub yosys: &'a [(&'a Bound, CostFigures)],
 }
 
+/// The depths of a per-n datapath as ranges of n: `m = 16 for n = 16..=21, m = 32 for ...`.
+pub fn depth_text(dp: &Datapath) -> String {
+    let mut runs: Vec<(u32, u32, u32)> = Vec::new();
+    for nc in dp.constants() {
+        match runs.last_mut() {
+            Some((j, _, last)) if *j == nc.depth => *last = nc.n,
+            _ => runs.push((nc.depth, nc.n, nc.n)),
+        }
+    }
+    runs.iter()
+        .map(|(j, first, last)| {
+            let ns = if first == last {
+                first.to_string()
+            } else {
+                format!("{first}..={last}")
+            };
+            format!("m = {} for n = {ns}", 1u32 << j)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The comment lines the configuration file `optimize` writes begins with: the budget, the
 /// cost and the proof, each line after `first` (the file's own header, `# specfx optimize:`).
 pub fn answer_header(first: &str, a: &Answer<'_>) -> String {
@@ -174,11 +196,17 @@ pub fn write_answer(
         )?;
     }
     let config = dp.config();
+    let depth = if config.has_bypass() {
+        format!(", per-n depth ({})", depth_text(dp))
+    } else {
+        String::new()
+    };
     writeln!(
         w,
-        "best: k = {}, {}, t {} b {} squares {} out {}: {:.0} {} ({})",
+        "best: k = {}, {}{depth}, {}, t {} b {} squares {} out {}: {:.0} {} ({})",
         config.k,
         config.variant.name(),
+        a.arch,
         config.t.format,
         config.b.format,
         config
@@ -192,6 +220,22 @@ pub fn write_answer(
         a.unit,
         a.objective
     )?;
+    if let Some(device) = a.result.device {
+        let f = analytic_cost(dp, a.arch, crate::hdl::cost::Target::Ice40);
+        let l = device.limits();
+        writeln!(
+            w,
+            "fits the {} ({}, analytic): {} of {} DSPs, {} of {} LUTs, {} of {} flip-flops; --device none lifts the limit",
+            device.full_name(),
+            a.arch,
+            f.dsps,
+            l.dsps,
+            f.luts,
+            l.luts,
+            f.ffs,
+            l.ffs
+        )?;
+    }
     writeln!(
         w,
         "proved by an exhaustive check: shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded",

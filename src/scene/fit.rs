@@ -489,6 +489,7 @@ pub fn fit_space(k: u32, variant: Variant, start_frac: i32) -> Space {
         extra_knobs,
         local_roundings: vec![Rounding::Trn, Rounding::Rnd],
         overflow_moves: false,
+        arch: crate::cycle::Arch::Pipelined,
     }
 }
 
@@ -606,6 +607,7 @@ pub fn fit_search(
             cost,
             feasible: true,
             excess: v.excess,
+            arch: crate::cycle::Arch::Pipelined,
         });
     }
     Ok(out)
