@@ -17,6 +17,27 @@ use crate::fixed::{Format, Overflow, Rounding};
 use crate::pipeline::{Datapath, StageSpec};
 use crate::reference::lobe::Cutoff;
 
+/// Refuses a datapath the reference RTL does not implement yet: one with a per-n squaring
+/// depth (some n bypasses a squaring stage; the RTL has no bypass multiplexers or depth port
+/// yet). The model, the check and the analyses serve it; vectors, co-simulation, synthesis and
+/// place and route do not.
+///
+/// # Errors
+/// [`Error::Config`] naming the `depth` key.
+pub fn check_rtl_support(dp: &Datapath) -> Result<(), crate::error::Error> {
+    let k = dp.config().k as usize;
+    if dp.bypass_from() < k {
+        return Err(crate::error::Error::Config {
+            key: "depth".to_string(),
+            problem: format!(
+                "the reference RTL has no bypass multiplexers yet: this datapath's per-n depth (some exponents use {} of its k = {k} squarings) is modelled bit for bit, but its vectors, co-simulation, synthesis and place and route need depth = \"fixed\"",
+                dp.bypass_from()
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The Verilog code of a rounding mode (0 TRN .. 7 RND_CONV_ODD).
 pub fn rounding_code(r: Rounding) -> u32 {
     match r {
