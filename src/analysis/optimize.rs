@@ -983,11 +983,25 @@ pub fn optimize_all(
     use rayon::prelude::*;
     // Every algorithm's candidates share the input format: one cache of cos^n for all.
     let cos = CosCache::new(COS_CACHE_VALUES);
+    // A candidate's error verdict does not depend on the architecture it is costed in: a
+    // folded search after a pipelined one judges again only what the first did not.
+    let verdicts = std::sync::Mutex::new(std::collections::HashMap::<String, Verdict>::new());
     let search_in = |a: Algorithm, arch: Arch| -> Result<SearchResult, Error> {
         let mut budget = budget.clone();
         budget.arch = arch;
         let space = optimize_space(a, &budget, start_frac);
-        let mut judge = |dp: &Datapath| exhaustive_judge(dp, &budget, Some(&cos));
+        let mut judge = |dp: &Datapath| -> Result<Verdict, Error> {
+            let key = dp.config().to_toml();
+            if let Some(v) = verdicts.lock().expect("not poisoned").get(&key) {
+                return Ok(*v);
+            }
+            let v = exhaustive_judge(dp, &budget, Some(&cos))?;
+            verdicts
+                .lock()
+                .expect("not poisoned")
+                .insert(key, v);
+            Ok(v)
+        };
         let mut cost = |dp: &Datapath| cost(dp, arch);
         let mut r = search(base, &space, &mut judge, &mut cost, &mut |_| {})?;
         // The cheapest point meeting the error bounds must meet the cost ceilings too.
