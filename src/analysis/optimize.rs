@@ -996,10 +996,7 @@ pub fn optimize_all(
                 return Ok(*v);
             }
             let v = exhaustive_judge(dp, &budget, Some(&cos))?;
-            verdicts
-                .lock()
-                .expect("not poisoned")
-                .insert(key, v);
+            verdicts.lock().expect("not poisoned").insert(key, v);
             Ok(v)
         };
         let mut cost = |dp: &Datapath| cost(dp, arch);

@@ -100,6 +100,24 @@ impl Machine for Literal {
     }
 }
 
+/// The datapath with a per-n depth when `per_n`: n < 300 squares in the first half of the k
+/// stages (the rest bypassed), n >= 300 in all of them.
+fn with_depth(dp: Datapath, per_n: bool) -> Datapath {
+    if !per_n {
+        return dp;
+    }
+    let mut cfg = dp.config().clone();
+    let k = cfg.k;
+    cfg.depth = specfx::pipeline::Depth::Steps(vec![
+        specfx::pipeline::DepthStep {
+            from: 1,
+            j: k.div_ceil(2),
+        },
+        specfx::pipeline::DepthStep { from: 300, j: k },
+    ]);
+    Datapath::new(cfg).unwrap()
+}
+
 fn datapath(k: u32, lat: (u32, u32, u32), n: &str) -> Datapath {
     let mut cfg = Config::baseline();
     cfg.k = k;
@@ -123,8 +141,10 @@ proptest! {
         bubble in 0.0f64..0.9,
         stall in 0.0f64..0.9,
         inputs in prop::collection::vec((0usize..3, 0i64..=65535), 1..120),
+        per_n in any::<bool>(),
     ) {
-        let dp = datapath(k, lat, "16,300,1024");
+        // A per-n depth changes values, not timing (docs/cycle.md): the same latencies.
+        let dp = with_depth(datapath(k, lat, "16,300,1024"), per_n);
         let arch = if folded { Arch::Folded } else { Arch::Pipelined };
         let mut stim = Stimulus::new(seed, bubble, stall);
         let r = simulate(&dp, arch, inputs.iter().copied(), &mut stim, Stop::Drained(1_000_000), 0);
@@ -161,8 +181,9 @@ proptest! {
         bubble in 0.0f64..0.9,
         stall in 0.0f64..0.9,
         inputs in prop::collection::vec((0usize..3, 0i64..=65535), 1..200),
+        per_n in any::<bool>(),
     ) {
-        let mut cfg = datapath(k, lat, "16,300,1024").config().clone();
+        let mut cfg = with_depth(datapath(k, lat, "16,300,1024"), per_n).config().clone();
         cfg.cutoff = specfx::reference::lobe::Cutoff::ALL[cutoff];
         let dp = Datapath::new(cfg).unwrap();
         let cycles = Stop::Cycles(2 * inputs.len() as u64 + 40);
