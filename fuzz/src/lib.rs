@@ -416,14 +416,14 @@ pub fn trace(data: &[u8]) -> bool {
 
 /// A simulator's log of the reference testbench (`specfx cosim`): `hdl::testbench::parse_log`.
 /// A log without a summary is refused with one line; an accepted log's problems are exactly
-/// its lines that begin with a problem's word, and a summary line appended to any log is the
-/// one read.
+/// its lines that begin with a problem's word or with the DPI testbench's `coverage:`, and a
+/// summary line appended to any log is the one read.
 pub fn testbench_log(data: &[u8]) -> bool {
     let log = String::from_utf8_lossy(data);
     let problems = log
         .lines()
         .filter(|l| {
-            ["mismatch", "protocol", "unexpected", "timeout"]
+            ["mismatch", "protocol", "unexpected", "timeout", "coverage:"]
                 .iter()
                 .any(|p| l.starts_with(p))
         })
