@@ -16,6 +16,7 @@ module specfx_dut (
     input  wire [(`SPECFX_OFFSET_W)-1:0] in_offset,
     input  wire [(`SPECFX_C_W)-1:0]      in_threshold,
     input  wire [(`SPECFX_COEF_W)-1:0]   in_coef,
+    input  wire [2:0]                   in_depth,
     output wire                         out_valid,
     input  wire                         out_ready,
     output wire [(`SPECFX_OUT_W)-1:0]    out_data
@@ -43,12 +44,13 @@ module specfx_dut (
         .COEF_F((`SPECFX_COEF_F)), .COEF_S((`SPECFX_COEF_S)), .OUT_W((`SPECFX_OUT_W)),
         .OUT_F((`SPECFX_OUT_F)), .OUT_S((`SPECFX_OUT_S)), .OUT_RND((`SPECFX_OUT_RND)),
         .OUT_OVF((`SPECFX_OUT_OVF)), .LAT_SUB((`SPECFX_LAT_SUB)), .LAT_MUL((`SPECFX_LAT_MUL)),
-        .LAT_ADD((`SPECFX_LAT_ADD)), .RESET_DATA((`SPECFX_RESET_DATA))
+        .LAT_ADD((`SPECFX_LAT_ADD)), .RESET_DATA((`SPECFX_RESET_DATA)),
+        .DEPTH_MIN((`SPECFX_DEPTH_MIN))
     ) u_top (
         .clk(clk), .rst(rst),
         .in_valid(in_valid), .in_ready(in_ready),
         .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),
-        .in_threshold(in_threshold), .in_coef(in_coef),
+        .in_threshold(in_threshold), .in_coef(in_coef), .in_depth(in_depth),
         .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)
     );
 endmodule

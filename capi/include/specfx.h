@@ -28,6 +28,10 @@
 // The coefficient's raw code.
 #define SPECFX_COEF 3
 
+// The per-n depth j(n), the squarings n uses (`specfx_top`'s `in_depth`; k for a fixed
+// depth).
+#define SPECFX_DEPTH 4
+
 // A validated datapath: made by `specfx_open` or `specfx_from_toml`, freed by
 // `specfx_free`.
 typedef struct specfx_model specfx_model;
@@ -50,6 +54,8 @@ typedef struct specfx_constants {
   int64_t threshold;
   // Raw coefficient in the coefficient's format.
   int64_t coef;
+  // The depth j(n): the squarings n uses (k for a fixed depth).
+  uint32_t depth;
 } specfx_constants;
 
 #ifdef __cplusplus
@@ -144,7 +150,7 @@ int specfx_dpi_n_at(void *model, int i);
 int specfx_dpi_input_codes(void *model, long long *min, long long *max, long long *one);
 
 // DPI: one per-n constant as `specfx_top`'s port takes it (`which`: `SPECFX_SLOPE`,
-// `SPECFX_OFFSET`, `SPECFX_THRESHOLD`, `SPECFX_COEF`).
+// `SPECFX_OFFSET`, `SPECFX_THRESHOLD`, `SPECFX_COEF`, `SPECFX_DEPTH`).
 int specfx_dpi_constant(void *model, int n, int which, long long *value);
 
 // DPI: `specfx_eval` (`int specfx_dpi_eval(chandle, longint c, int n, output longint out)`).

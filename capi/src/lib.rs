@@ -41,6 +41,9 @@ pub const SPECFX_OFFSET: c_int = 1;
 pub const SPECFX_THRESHOLD: c_int = 2;
 /// The coefficient's raw code.
 pub const SPECFX_COEF: c_int = 3;
+/// The per-n depth j(n), the squarings n uses (`specfx_top`'s `in_depth`; k for a fixed
+/// depth).
+pub const SPECFX_DEPTH: c_int = 4;
 
 /// A validated datapath: made by `specfx_open` or `specfx_from_toml`, freed by
 /// `specfx_free`.
@@ -71,6 +74,8 @@ pub struct specfx_constants {
     pub threshold: i64,
     /// Raw coefficient in the coefficient's format.
     pub coef: i64,
+    /// The depth j(n): the squarings n uses (k for a fixed depth).
+    pub depth: u32,
 }
 
 thread_local! {
@@ -307,6 +312,7 @@ pub extern "C" fn specfx_constants_of(
             has_threshold: i32::from(nc.threshold.is_some()),
             threshold: nc.threshold.unwrap_or(0),
             coef: nc.coef_raw,
+            depth: nc.depth,
         };
         put(out, c, "out")?;
         Ok(SPECFX_OK)
@@ -453,7 +459,7 @@ pub extern "C" fn specfx_dpi_input_codes(
 }
 
 /// DPI: one per-n constant as `specfx_top`'s port takes it (`which`: `SPECFX_SLOPE`,
-/// `SPECFX_OFFSET`, `SPECFX_THRESHOLD`, `SPECFX_COEF`).
+/// `SPECFX_OFFSET`, `SPECFX_THRESHOLD`, `SPECFX_COEF`, `SPECFX_DEPTH`).
 #[unsafe(no_mangle)]
 pub extern "C" fn specfx_dpi_constant(
     model: *mut c_void,
@@ -471,9 +477,10 @@ pub extern "C" fn specfx_dpi_constant(
             SPECFX_OFFSET => nc.offset_raw,
             SPECFX_THRESHOLD => nc.threshold.unwrap_or(0),
             SPECFX_COEF => nc.coef_raw,
+            SPECFX_DEPTH => i64::from(nc.depth),
             _ => {
                 return Err(format!(
-                    "which = {which}: expected 0 (slope), 1 (offset), 2 (threshold) or 3 (coef)"
+                    "which = {which}: expected 0 (slope), 1 (offset), 2 (threshold), 3 (coef) or 4 (depth)"
                 ))
             }
         };

@@ -81,8 +81,8 @@ fn evaluations_outside_the_domain_are_error_values() {
         SPECFX_ERROR
     );
     assert_eq!(last_error(), "n = -1 is not an exponent (expected n >= 0)");
-    assert_eq!(specfx_dpi_constant(m.cast(), 16, 4, &mut v), SPECFX_ERROR);
-    assert!(last_error().starts_with("which = 4: expected 0 (slope)"));
+    assert_eq!(specfx_dpi_constant(m.cast(), 16, 5, &mut v), SPECFX_ERROR);
+    assert!(last_error().starts_with("which = 5: expected 0 (slope)"));
     // A batch with one pair outside the domain writes nothing.
     let cs = [0i64, 1, 70_000];
     let mut outs = [-1i64; 3];
@@ -149,5 +149,12 @@ fn a_model_answers_what_a_testbench_asks() {
     );
     assert_eq!(out, coef);
     assert_eq!(coef, k.coef);
+    // A fixed depth: every n squares k = 4 times.
+    let mut depth = 0;
+    assert_eq!(
+        specfx_dpi_constant(m.cast(), 64, SPECFX_DEPTH, &mut depth),
+        SPECFX_OK
+    );
+    assert_eq!((depth, k.depth), (4, 4));
     specfx_free(m);
 }

@@ -40,7 +40,7 @@ from cocotb_compat import signal_at, start_clock
 RESET_EDGES = 4
 CLOCK_PERIOD_NS = 10
 MAX_SHOWN = 10
-PORTS = ("in_slope", "in_offset", "in_threshold", "in_coef")
+PORTS = ("in_slope", "in_offset", "in_threshold", "in_coef", "in_depth")
 # The core below specfx_top, by architecture.
 CORE = {"pipelined": "g_pipelined.u_core", "folded": "g_folded.u_core"}
 
@@ -71,7 +71,13 @@ class Stimulus:
         """The per-n constants as specfx_top's ports take them (a ROM addressed by n)."""
         if n not in self.constants:
             k = self.dp.constants(n)
-            self.constants[n] = (k["slope"], k["offset"], k["threshold"] or 0, k["coef"])
+            self.constants[n] = (
+                k["slope"],
+                k["offset"],
+                k["threshold"] or 0,
+                k["coef"],
+                k["depth"],
+            )
         return self.constants[n]
 
     def next(self):

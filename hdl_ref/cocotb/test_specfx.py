@@ -41,7 +41,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from cocotb_compat import start_clock
 
 # Ports of the vector directory the test reads, in manifest.json's names.
-DRIVEN_PORTS = ("in_c", "in_slope", "in_offset", "in_threshold", "in_coef")
+DRIVEN_PORTS = ("in_c", "in_slope", "in_offset", "in_threshold", "in_coef", "in_depth")
 VECTOR_PORTS = DRIVEN_PORTS + ("in_n", "expected_out")
 RESET_EDGES = 4  # rst is high for this many rising edges, as in tb_specfx.v
 CLOCK_PERIOD_NS = 10

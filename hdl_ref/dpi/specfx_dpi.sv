@@ -22,7 +22,7 @@ package specfx_dpi;
     import "DPI-C" function int specfx_dpi_input_codes(input chandle model, output longint min,
                                                        output longint max, output longint one);
     // One per-n constant as specfx_top's port takes it: which = 0 slope, 1 offset,
-    // 2 threshold, 3 coef.
+    // 2 threshold, 3 coef, 4 depth (j(n), in_depth).
     import "DPI-C" function int specfx_dpi_constant(input chandle model, input int n,
                                                     input int which, output longint value);
     // The first code of n the cutoff does not force to zero (a boundary worth aiming at).

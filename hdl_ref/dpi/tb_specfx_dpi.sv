@@ -19,7 +19,7 @@
 // interleaved. Random vectors draw n from the configuration's set on every input, and c uniformly over every
 // code, near 1.0 (above it included), on and next to the cutoff's boundary and the paper
 // threshold, at the ends of the code range, and below 1.0. A vector's per-n constants drive
-// in_slope, in_offset, in_threshold and in_coef, as a ROM addressed by n would.
+// in_slope, in_offset, in_threshold, in_coef and in_depth, as a ROM addressed by n would.
 //
 // The scoreboard: when an input transfers, its expected output (specfx_dpi_eval) is queued;
 // each output transfer is checked against the head of the queue. Every cycle, the cycle model
@@ -58,7 +58,8 @@ module tb_specfx_dpi #(
     parameter integer COEF_W = 24, parameter integer COEF_F = 16, parameter integer COEF_S = 0,
     parameter integer OUT_W = 24, parameter integer OUT_F = 16, parameter integer OUT_S = 0,
     parameter integer OUT_RND = 2, parameter integer OUT_OVF = 1, parameter integer LAT_SUB = 1,
-    parameter integer LAT_MUL = 1, parameter integer LAT_ADD = 1, parameter integer RESET_DATA = 0
+    parameter integer LAT_MUL = 1, parameter integer LAT_ADD = 1, parameter integer RESET_DATA = 0,
+    parameter integer DEPTH_MIN = 7
 );
     import specfx_dpi::*;
 
@@ -88,7 +89,7 @@ module tb_specfx_dpi #(
     int n_count;
     int n_values[];
     // The per-n constants as specfx_top's ports take them, by index into n_values (a ROM).
-    longint rom_slope[], rom_offset[], rom_threshold[], rom_coef[];
+    longint rom_slope[], rom_offset[], rom_threshold[], rom_coef[], rom_depth[];
     longint total;  // vectors to drive
     int n_directed = 0;
 
@@ -152,6 +153,7 @@ module tb_specfx_dpi #(
         rom_offset = new[n_count];
         rom_threshold = new[n_count];
         rom_coef = new[n_count];
+        rom_depth = new[n_count];
         seen_n = new[n_count];
         for (int i = 0; i < n_count; i++) begin
             n_values[i] = specfx_dpi_n_at(model, i);
@@ -163,6 +165,8 @@ module tb_specfx_dpi #(
             rom_threshold[i] = v;
             if (specfx_dpi_constant(model, n_values[i], 3, v) != 0) die("the coefficient");
             rom_coef[i] = v;
+            if (specfx_dpi_constant(model, n_values[i], 4, v) != 0) die("the depth");
+            rom_depth[i] = v;
         end
         if (exhaustive) begin
             if (longint'(c_one - c_min) >= 64'h1_0000_0000) begin
@@ -189,6 +193,7 @@ module tb_specfx_dpi #(
     reg [OFFSET_W-1:0] in_offset = '0;
     reg [C_W-1:0]      in_threshold = '0;
     reg [COEF_W-1:0]   in_coef = '0;
+    reg [2:0]          in_depth = '0;
     wire in_ready;
     wire out_valid;
     wire [OUT_W-1:0] out_data;
@@ -206,12 +211,13 @@ module tb_specfx_dpi #(
         .SQ6_F(SQ6_F), .SQ6_S(SQ6_S), .SQ6_RND(SQ6_RND), .SQ6_OVF(SQ6_OVF), .SQ7_W(SQ7_W),
         .SQ7_F(SQ7_F), .SQ7_S(SQ7_S), .SQ7_RND(SQ7_RND), .SQ7_OVF(SQ7_OVF), .COEF_W(COEF_W),
         .COEF_F(COEF_F), .COEF_S(COEF_S), .OUT_W(OUT_W), .OUT_F(OUT_F), .OUT_S(OUT_S), .OUT_RND(OUT_RND),
-        .OUT_OVF(OUT_OVF), .LAT_SUB(LAT_SUB), .LAT_MUL(LAT_MUL), .LAT_ADD(LAT_ADD), .RESET_DATA(RESET_DATA)
+        .OUT_OVF(OUT_OVF), .LAT_SUB(LAT_SUB), .LAT_MUL(LAT_MUL), .LAT_ADD(LAT_ADD), .RESET_DATA(RESET_DATA),
+        .DEPTH_MIN(DEPTH_MIN)
     ) dut (
         .clk(clk), .rst(rst),
         .in_valid(in_valid), .in_ready(in_ready),
         .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),
-        .in_threshold(in_threshold), .in_coef(in_coef),
+        .in_threshold(in_threshold), .in_coef(in_coef), .in_depth(in_depth),
         .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)
     );
 
@@ -254,6 +260,7 @@ module tb_specfx_dpi #(
         in_offset <= rom_offset[idx][OFFSET_W-1:0];
         in_threshold <= rom_threshold[idx][C_W-1:0];
         in_coef <= rom_coef[idx][COEF_W-1:0];
+        in_depth <= rom_depth[idx][2:0];
     endtask
 
     // ---- The scoreboard. ----

@@ -15,7 +15,10 @@
 // (K + 2) * LAT_MUL cycles.
 //
 // Parameters as specfx_pipelined (formats, packed squaring-stage vectors, mode codes,
-// RESET_DATA).
+// RESET_DATA, DEPTH_MIN). Per-n depth: step i > in_depth (held in depth_r) requantizes x
+// instead of x * x (specfx_sq_quant's bypass, on steps i > DEPTH_MIN only); the multiplier
+// still runs and the step takes its LAT_MUL cycles, so latency and initiation interval are the
+// same for every n.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -57,7 +60,8 @@ module specfx_folded #(
     parameter integer OUT_RND  = 2,
     parameter integer OUT_OVF  = 1,
     parameter integer LAT_MUL  = 1,
-    parameter integer RESET_DATA = 0
+    parameter integer RESET_DATA = 0,
+    parameter integer DEPTH_MIN = 7
 ) (
     input  wire                clk,
     input  wire                rst,
@@ -68,6 +72,7 @@ module specfx_folded #(
     input  wire [OFFSET_W-1:0] in_offset,
     input  wire [C_W-1:0]      in_threshold,
     input  wire [COEF_W-1:0]   in_coef,
+    input  wire [2:0]          in_depth,
     output reg                 out_valid,
     input  wire                out_ready,
     output reg  [OUT_W-1:0]    out_data
@@ -138,6 +143,7 @@ module specfx_folded #(
     reg [C_W-1:0]      threshold_r;
     reg [C_W-1:0]      c_cl_r;
     reg [COEF_W-1:0]   coef_r;
+    reg [2:0]          depth_r;
 
     // ---- Handshake. ----
     wire out_free = !out_valid || out_ready;
@@ -206,17 +212,21 @@ module specfx_folded #(
     );
     specfx_extend #(.IN_W(B_W), .IN_S(B_S), .OUT_W(X_W)) u_b_x (.x(b), .y(results[0 +: X_W]));
 
-    // Steps 1..K: sq_i = Q_i(x * x), x holding sq_{i-1}.
+    // Steps 1..K: sq_i = Q_i(x * x), x holding sq_{i-1}; Q_i(x) when i > depth_r.
     generate
         for (s = 1; s <= K; s = s + 1) begin : g_square
             wire [chain_w(s)-1:0] sq;
             localparam integer PS_W = 2 * chain_w(s - 1) + ((chain_s(s - 1) != 0) ? 0 : 1);
-            specfx_quant #(
-                .IN_W(PS_W), .IN_F(2 * chain_f(s - 1)), .IN_S(1),
-                .OUT_W(chain_w(s)), .OUT_F(chain_f(s)), .OUT_S(chain_s(s)),
-                .RND(sq_field(SQ_RND, s, 0)), .OVF(sq_field(SQ_OVF, s, 0))
+            localparam integer S_I = s;
+            localparam [2:0] S_CODE = S_I[2:0];
+            wire pass = (depth_r < S_CODE);
+            specfx_sq_quant #(
+                .P_W(PS_W), .X_W(X_W), .X_F(chain_f(s - 1)), .X_S(1),
+                .Y_W(chain_w(s)), .Y_F(chain_f(s)), .Y_S(chain_s(s)),
+                .Y_RND(sq_field(SQ_RND, s, 0)), .Y_OVF(sq_field(SQ_OVF, s, 0)),
+                .BYPASS((s > DEPTH_MIN) ? 1 : 0)
             ) u_q_sq (
-                .x(product[PS_W-1:0]), .y(sq)
+                .product(product[PS_W-1:0]), .x(x), .pass(pass), .y(sq)
             );
             specfx_extend #(.IN_W(chain_w(s)), .IN_S(chain_s(s)), .OUT_W(X_W)) u_sq_x (
                 .x(sq), .y(results[s*X_W +: X_W])
@@ -241,6 +251,9 @@ module specfx_folded #(
         for (j = 0; j <= K; j = j + 1)
             step_result = step_result | ({X_W{at_step[j]}} & results[j*X_W +: X_W]);
     end
+
+    // depth_r goes nowhere when no step has a bypass (synthesis removes it).
+    wire _unused_depth_ok = &{1'b0, depth_r};
 
     // ---- Control registers. ----
     always @(posedge clk) begin
@@ -282,6 +295,7 @@ module specfx_folded #(
             threshold_r <= {C_W{1'b0}};
             c_cl_r      <= {C_W{1'b0}};
             coef_r      <= {COEF_W{1'b0}};
+            depth_r     <= 3'd0;
         end else begin
             if (step_done) x <= step_result;
             if (out_load) out_data <= out_q;
@@ -292,6 +306,7 @@ module specfx_folded #(
                 threshold_r <= in_threshold;
                 c_cl_r      <= c_cl_in;
                 coef_r      <= in_coef;
+                depth_r     <= in_depth;
             end
         end
     end

@@ -17,6 +17,13 @@
 // 7 RND_CONV_ODD. Overflow codes: 0 WRAP, 1 SAT, 2 SAT_ZERO, 3 SAT_SYM. Cutoff codes: 0 clamp,
 // 1 paper, 2 none. RESET_DATA = 1 clears the data registers on rst too (else only the valid
 // bits reset).
+//
+// Per-n depth (docs/arithmetic.md, section 3.1.0): `in_depth` is j(n), the number of squarings
+// n uses; squaring stage i > j(n) passes its input through (specfx_sq_quant's bypass). Only
+// stages i > DEPTH_MIN (the smallest depth of any n) have the multiplexer, so DEPTH_MIN >= K
+// (the default, 7) is the fixed-depth datapath and in_depth is ignored. The depth rides down
+// beside the coefficient; a bypassed stage keeps its place and its LAT_MUL registers, so the
+// latency and the handshake are the same for every n.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -61,7 +68,8 @@ module specfx_pipelined #(
     parameter integer LAT_SUB  = 1,
     parameter integer LAT_MUL  = 1,
     parameter integer LAT_ADD  = 1,
-    parameter integer RESET_DATA = 0
+    parameter integer RESET_DATA = 0,
+    parameter integer DEPTH_MIN = 7
 ) (
     input  wire                clk,
     input  wire                rst,
@@ -72,6 +80,7 @@ module specfx_pipelined #(
     input  wire [OFFSET_W-1:0] in_offset,
     input  wire [C_W-1:0]      in_threshold,
     input  wire [COEF_W-1:0]   in_coef,
+    input  wire [2:0]          in_depth,
     output wire                out_valid,
     input  wire                out_ready,
     output wire [OUT_W-1:0]    out_data
@@ -123,12 +132,13 @@ module specfx_pipelined #(
     wire [OFFSET_W-1:0] offset_1;
     wire [C_W-1:0]      threshold_1;
     wire [COEF_W-1:0]   coef_1;
+    wire [2:0]          depth_1;
     specfx_delay #(
-        .W(D_W + 2 * C_W + SLOPE_W + OFFSET_W + COEF_W), .LAT(LAT_SUB), .RESET(RESET_DATA)
+        .W(3 + D_W + 2 * C_W + SLOPE_W + OFFSET_W + COEF_W), .LAT(LAT_SUB), .RESET(RESET_DATA)
     ) r_sub (
         .clk(clk), .rst(rst), .en(advance),
-        .d({in_coef, in_threshold, in_offset, in_slope, c_cl_0, d_0}),
-        .q({coef_1, threshold_1, offset_1, slope_1, c_cl_1, d_1})
+        .d({in_depth, in_coef, in_threshold, in_offset, in_slope, c_cl_0, d_0}),
+        .q({depth_1, coef_1, threshold_1, offset_1, slope_1, c_cl_1, d_1})
     );
 
     // ---- mul_t: t = Q_t(d * slope). ----
@@ -145,17 +155,19 @@ module specfx_pipelined #(
     wire [OFFSET_W-1:0] offset_2;
     wire [C_W-1:0]      threshold_2;
     wire [COEF_W-1:0]   coef_2;
-    specfx_delay #(.W(T_W + 2 * C_W + OFFSET_W + COEF_W), .LAT(LAT_MUL), .RESET(RESET_DATA)) r_mul_t (
+    wire [2:0]          depth_2;
+    specfx_delay #(.W(3 + T_W + 2 * C_W + OFFSET_W + COEF_W), .LAT(LAT_MUL), .RESET(RESET_DATA)) r_mul_t (
         .clk(clk), .rst(rst), .en(advance),
-        .d({coef_1, threshold_1, offset_1, c_cl_1, t_1}),
-        .q({coef_2, threshold_2, offset_2, c_cl_2, t_2})
+        .d({depth_1, coef_1, threshold_1, offset_1, c_cl_1, t_1}),
+        .q({depth_2, coef_2, threshold_2, offset_2, c_cl_2, t_2})
     );
 
     // ---- add_b: b = Q_b(cutoff(t + offset)). ----
     // chain[chain_off(i) +: chain_w(i)] is stage i's registered value (0: b, i: sq_i);
-    // coefs[i*COEF_W +: COEF_W] is the coefficient beside it.
+    // coefs[i*COEF_W +: COEF_W] is the coefficient beside it, depths[3*i +: 3] the depth.
     wire [chain_off(K + 1)-1:0] chain;
     wire [(K+1)*COEF_W-1:0]     coefs;
+    wire [3*(K+1)-1:0]          depths;
     wire [B_W-1:0] b_2;
     specfx_add_b #(
         .T_W(T_W), .T_F(T_F), .T_S(T_S),
@@ -168,17 +180,19 @@ module specfx_pipelined #(
     // Each register's output goes to wires of its own, assigned into the buses: a port
     // connected to slices of two buses at once makes Verilator 5.006 report MULTIDRIVEN when
     // the buses' widths are 16, 32 or 64 bits (a false positive, but a failed lint).
+    wire [2:0]        depth_b;
     wire [COEF_W-1:0] coef_b;
     wire [B_W-1:0]    b_q;
-    specfx_delay #(.W(B_W + COEF_W), .LAT(LAT_ADD), .RESET(RESET_DATA)) r_add_b (
+    specfx_delay #(.W(3 + B_W + COEF_W), .LAT(LAT_ADD), .RESET(RESET_DATA)) r_add_b (
         .clk(clk), .rst(rst), .en(advance),
-        .d({coef_2, b_2}),
-        .q({coef_b, b_q})
+        .d({depth_2, coef_2, b_2}),
+        .q({depth_b, coef_b, b_q})
     );
+    assign depths[0 +: 3] = depth_b;
     assign coefs[0 +: COEF_W] = coef_b;
     assign chain[0 +: B_W] = b_q;
 
-    // ---- square_i, i = 1..K: sq_i = Q_i(sq_{i-1}^2). ----
+    // ---- square_i, i = 1..K: sq_i = Q_i(sq_{i-1}^2), or Q_i(sq_{i-1}) when i > depth. ----
     genvar i;
     generate
         for (i = 1; i <= K; i = i + 1) begin : g_square
@@ -187,18 +201,25 @@ module specfx_pipelined #(
             wire [Y_W-1:0] y;
             wire [Y_W-1:0] y_q;
             wire [COEF_W-1:0] coef_q;
+            wire [2:0] depth_q;
+            wire [2:0] depth_x = depths[3*(i-1) +: 3];
+            localparam integer I_I = i;
+            localparam [2:0] I_CODE = I_I[2:0];
+            wire pass = (depth_x < I_CODE);
             specfx_square #(
                 .X_W(X_W), .X_F(chain_f(i - 1)), .X_S(chain_s(i - 1)),
                 .Y_W(Y_W), .Y_F(chain_f(i)), .Y_S(chain_s(i)),
-                .Y_RND(sq_field(SQ_RND, i, 0)), .Y_OVF(sq_field(SQ_OVF, i, 0))
+                .Y_RND(sq_field(SQ_RND, i, 0)), .Y_OVF(sq_field(SQ_OVF, i, 0)),
+                .BYPASS((i > DEPTH_MIN) ? 1 : 0)
             ) u_square (
-                .x(chain[chain_off(i - 1) +: X_W]), .y(y)
+                .x(chain[chain_off(i - 1) +: X_W]), .pass(pass), .y(y)
             );
-            specfx_delay #(.W(Y_W + COEF_W), .LAT(LAT_MUL), .RESET(RESET_DATA)) r_square (
+            specfx_delay #(.W(3 + Y_W + COEF_W), .LAT(LAT_MUL), .RESET(RESET_DATA)) r_square (
                 .clk(clk), .rst(rst), .en(advance),
-                .d({coefs[(i-1)*COEF_W +: COEF_W], y}),
-                .q({coef_q, y_q})
+                .d({depth_x, coefs[(i-1)*COEF_W +: COEF_W], y}),
+                .q({depth_q, coef_q, y_q})
             );
+            assign depths[3*i +: 3] = depth_q;
             assign coefs[i*COEF_W +: COEF_W] = coef_q;
             assign chain[chain_off(i) +: Y_W] = y_q;
         end
@@ -216,6 +237,9 @@ module specfx_pipelined #(
     specfx_delay #(.W(OUT_W), .LAT(LAT_MUL), .RESET(RESET_DATA)) r_mul_out (
         .clk(clk), .rst(rst), .en(advance), .d(out_k), .q(out_data)
     );
+    // The depth past the last stage, and all of it when no stage has a bypass, goes nowhere
+    // (synthesis removes its registers).
+    wire _unused_ok = &{1'b0, depths};
 endmodule
 
 `default_nettype wire

@@ -14,6 +14,12 @@
 // RESET_DATA = 1 also clears the data registers (and so out_data) on the synchronous,
 // active-high rst; with 0 (the default, cheaper) only the control registers and valid bits
 // reset, and out_data is unknown until the first result.
+//
+// Per-n depth (docs/arithmetic.md, section 3.1.0): in_depth is j(n), the squarings n uses (a
+// 3-bit field of the per-n ROM, beside the other constants); squaring stage i > j(n) passes its
+// input through. DEPTH_MIN is the smallest j(n) of the configuration: stages up to it have no
+// multiplexer, and DEPTH_MIN >= K (the default, 7) is the fixed-depth datapath, whose in_depth
+// is ignored.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -68,7 +74,8 @@ module specfx_top #(
     parameter integer LAT_SUB    = 1,
     parameter integer LAT_MUL    = 1,
     parameter integer LAT_ADD    = 1,
-    parameter integer RESET_DATA = 0
+    parameter integer RESET_DATA = 0,
+    parameter integer DEPTH_MIN  = 7
 ) (
     input  wire                clk,
     input  wire                rst,
@@ -79,6 +86,7 @@ module specfx_top #(
     input  wire [OFFSET_W-1:0] in_offset,
     input  wire [C_W-1:0]      in_threshold,
     input  wire [COEF_W-1:0]   in_coef,
+    input  wire [2:0]          in_depth,
     output wire                out_valid,
     input  wire                out_ready,
     output wire [OUT_W-1:0]    out_data
@@ -109,12 +117,12 @@ module specfx_top #(
                 .COEF_W(COEF_W), .COEF_F(COEF_F), .COEF_S(COEF_S),
                 .OUT_W(OUT_W), .OUT_F(OUT_F), .OUT_S(OUT_S), .OUT_RND(OUT_RND), .OUT_OVF(OUT_OVF),
                 .LAT_SUB(LAT_SUB), .LAT_MUL(LAT_MUL), .LAT_ADD(LAT_ADD),
-                .RESET_DATA(RESET_DATA)
+                .RESET_DATA(RESET_DATA), .DEPTH_MIN(DEPTH_MIN)
             ) u_core (
                 .clk(clk), .rst(rst),
                 .in_valid(in_valid), .in_ready(in_ready),
                 .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),
-                .in_threshold(in_threshold), .in_coef(in_coef),
+                .in_threshold(in_threshold), .in_coef(in_coef), .in_depth(in_depth),
                 .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)
             );
         end else begin : g_folded
@@ -129,12 +137,12 @@ module specfx_top #(
                 .COEF_W(COEF_W), .COEF_F(COEF_F), .COEF_S(COEF_S),
                 .OUT_W(OUT_W), .OUT_F(OUT_F), .OUT_S(OUT_S), .OUT_RND(OUT_RND), .OUT_OVF(OUT_OVF),
                 .LAT_MUL(LAT_MUL),
-                .RESET_DATA(RESET_DATA)
+                .RESET_DATA(RESET_DATA), .DEPTH_MIN(DEPTH_MIN)
             ) u_core (
                 .clk(clk), .rst(rst),
                 .in_valid(in_valid), .in_ready(in_ready),
                 .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),
-                .in_threshold(in_threshold), .in_coef(in_coef),
+                .in_threshold(in_threshold), .in_coef(in_coef), .in_depth(in_depth),
                 .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)
             );
             wire _unused_ok = &{1'b0, LAT_SUB[0], LAT_ADD[0], SLOPE_POW2[0]};

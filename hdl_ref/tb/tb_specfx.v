@@ -2,7 +2,7 @@
 // `specfx vectors` and the stimulus of `specfx hdl stimulus` (docs/cycle.md).
 //
 // Reads ($readmemh) in_c.hex, in_n.hex, in_slope.hex, in_offset.hex, in_threshold.hex,
-// in_coef.hex, expected_out.hex (one word per vector) from the directory of the plusarg
+// in_coef.hex, in_depth.hex, expected_out.hex (one word per vector) from the directory of the plusarg
 // +vectors=DIR, and stim_valid.hex, stim_ready.hex (one bit per cycle) and expected_cycle.hex
 // (one 32-bit word per vector) from that of +stimulus=DIR; each defaults to the current
 // directory (paths up to 500 characters). Parameters (set per run: iverilog -Ptb_specfx.<NAME>=<value>, verilator
@@ -51,7 +51,8 @@ module tb_specfx #(
     parameter integer COEF_W = 24, parameter integer COEF_F = 16, parameter integer COEF_S = 0,
     parameter integer OUT_W = 24, parameter integer OUT_F = 16, parameter integer OUT_S = 0,
     parameter integer OUT_RND = 2, parameter integer OUT_OVF = 1, parameter integer LAT_SUB = 1,
-    parameter integer LAT_MUL = 1, parameter integer LAT_ADD = 1, parameter integer RESET_DATA = 0
+    parameter integer LAT_MUL = 1, parameter integer LAT_ADD = 1, parameter integer RESET_DATA = 0,
+    parameter integer DEPTH_MIN = 7
 );
     localparam integer NVEC_MEM = (NVEC > 0) ? NVEC : 1;
     localparam integer NCYC_MEM = (NCYC > 0) ? NCYC : 1;
@@ -70,6 +71,7 @@ module tb_specfx #(
     reg [OFFSET_W-1:0] mem_offset    [0:NVEC_MEM-1];
     reg [C_W-1:0]      mem_threshold [0:NVEC_MEM-1];
     reg [COEF_W-1:0]   mem_coef      [0:NVEC_MEM-1];
+    reg [2:0]          mem_depth     [0:NVEC_MEM-1];
     reg [OUT_W-1:0]    mem_out       [0:NVEC_MEM-1];
     reg [31:0]         mem_cycle     [0:NVEC_MEM-1];
     reg                stim_valid    [0:NCYC_MEM-1];
@@ -88,6 +90,7 @@ module tb_specfx #(
             $sformat(path, "%0s/in_offset.hex", vec_dir);    $readmemh(path, mem_offset);
             $sformat(path, "%0s/in_threshold.hex", vec_dir); $readmemh(path, mem_threshold);
             $sformat(path, "%0s/in_coef.hex", vec_dir);      $readmemh(path, mem_coef);
+            $sformat(path, "%0s/in_depth.hex", vec_dir);     $readmemh(path, mem_depth);
             $sformat(path, "%0s/expected_out.hex", vec_dir); $readmemh(path, mem_out);
             $sformat(path, "%0s/expected_cycle.hex", stim_dir);
             $readmemh(path, mem_cycle);
@@ -120,6 +123,7 @@ module tb_specfx #(
     wire [OFFSET_W-1:0] in_offset    = (in_idx < NVEC) ? mem_offset[in_idx] : {OFFSET_W{1'b0}};
     wire [C_W-1:0]      in_threshold = (in_idx < NVEC) ? mem_threshold[in_idx] : {C_W{1'b0}};
     wire [COEF_W-1:0]   in_coef      = (in_idx < NVEC) ? mem_coef[in_idx] : {COEF_W{1'b0}};
+    wire [2:0]          in_depth     = (in_idx < NVEC) ? mem_depth[in_idx] : 3'd0;
     wire in_ready;
     wire out_valid;
     wire [OUT_W-1:0] out_data;
@@ -137,12 +141,13 @@ module tb_specfx #(
         .SQ6_F(SQ6_F), .SQ6_S(SQ6_S), .SQ6_RND(SQ6_RND), .SQ6_OVF(SQ6_OVF), .SQ7_W(SQ7_W),
         .SQ7_F(SQ7_F), .SQ7_S(SQ7_S), .SQ7_RND(SQ7_RND), .SQ7_OVF(SQ7_OVF), .COEF_W(COEF_W),
         .COEF_F(COEF_F), .COEF_S(COEF_S), .OUT_W(OUT_W), .OUT_F(OUT_F), .OUT_S(OUT_S), .OUT_RND(OUT_RND),
-        .OUT_OVF(OUT_OVF), .LAT_SUB(LAT_SUB), .LAT_MUL(LAT_MUL), .LAT_ADD(LAT_ADD), .RESET_DATA(RESET_DATA)
+        .OUT_OVF(OUT_OVF), .LAT_SUB(LAT_SUB), .LAT_MUL(LAT_MUL), .LAT_ADD(LAT_ADD), .RESET_DATA(RESET_DATA),
+        .DEPTH_MIN(DEPTH_MIN)
     ) dut (
         .clk(clk), .rst(rst),
         .in_valid(in_valid), .in_ready(in_ready),
         .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),
-        .in_threshold(in_threshold), .in_coef(in_coef),
+        .in_threshold(in_threshold), .in_coef(in_coef), .in_depth(in_depth),
         .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)
     );
 

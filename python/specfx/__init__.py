@@ -114,8 +114,9 @@ class Datapath:
     def constants(self, n: int) -> Dict[str, Any]:
         """The constants of exponent ``n`` as the datapath stores them (raw codes and their
         fraction bits; ``threshold`` is None unless the paper cutoff applies) and their values
-        before quantization (``*_value``)."""
-        s, sf, o, of, th, coef, sv, ov, cv = self._m.constants(int(n))
+        before quantization (``*_value``); ``depth`` is j(n), the squarings n uses (k for a
+        fixed depth; the RTL's ``in_depth``)."""
+        s, sf, o, of, th, coef, sv, ov, cv, depth = self._m.constants(int(n))
         return {
             "n": int(n),
             "slope": s,
@@ -127,6 +128,7 @@ class Datapath:
             "slope_value": sv,
             "offset_value": ov,
             "coef_value": cv,
+            "depth": depth,
         }
 
     def _pairs(self, c: IntOrArray, n: IntOrArray):

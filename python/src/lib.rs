@@ -100,9 +100,12 @@ impl Model {
     }
 
     /// The constants of `n`: (slope, slope_frac, offset, offset_frac, threshold or None,
-    /// coef, slope_value, offset_value, coef_value).
+    /// coef, slope_value, offset_value, coef_value, depth).
     #[allow(clippy::type_complexity)]
-    fn constants(&self, n: u32) -> PyResult<(i64, i32, i64, i32, Option<i64>, i64, f64, f64, f64)> {
+    fn constants(
+        &self,
+        n: u32,
+    ) -> PyResult<(i64, i32, i64, i32, Option<i64>, i64, f64, f64, f64, u32)> {
         let nc = self.dp.constants_checked(n, "n").map_err(value_error)?;
         Ok((
             nc.slope_raw,
@@ -114,6 +117,7 @@ impl Model {
             nc.slope,
             nc.offset,
             nc.coef,
+            nc.depth,
         ))
     }
 

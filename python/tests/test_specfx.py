@@ -62,6 +62,7 @@ class Vectors(unittest.TestCase):
                 self.assertEqual(k["offset"], col["in_offset"][first])
                 self.assertEqual(k["threshold"] or 0, col["in_threshold"][first])
                 self.assertEqual(k["coef"], col["in_coef"][first])
+                self.assertEqual(k["depth"], col["in_depth"][first])
             # One row by scalar call, and one n for a whole array.
             self.assertEqual(dp.eval(int(c[0]), int(n[0])), col["expected_out"][0])
             same = n == n[0]

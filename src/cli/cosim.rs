@@ -126,7 +126,6 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     let opened = specfx::input::open_vectors(&vectors)?;
     let dp = specfx::pipeline::Datapath::new(opened.config.clone())
         .context("the manifest's configuration")?;
-    specfx::hdl::check_rtl_support(&dp)?;
     // The --vcd directory is made with the model's trace, once the stimulus is known to fit.
     let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
     let stim = write_stimulus(&opened, args.run, wd, model_vcd.as_deref())?;
@@ -137,6 +136,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         "in_offset",
         "in_threshold",
         "in_coef",
+        "in_depth",
         "expected_out",
     ] {
         let from = vectors.join(format!("{port}.hex"));
@@ -249,7 +249,6 @@ fn vector_dir(args: &CosimArgs, wd: &std::path::Path) -> Result<PathBuf> {
         return Ok(dir.clone());
     }
     let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
-    specfx::hdl::check_rtl_support(&dp)?;
     let dir = wd.join("vectors");
     super::vectors::write_dir(
         &dp,

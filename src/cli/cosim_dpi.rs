@@ -90,7 +90,6 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         Some(v) => specfx::input::load_vectors(v)?,
         None => specfx::input::load_datapath(&args.config, args.n.as_ref())?,
     };
-    specfx::hdl::check_rtl_support(&dp)?;
     let work = tools::child::work_dir("cosim-dpi").context("cannot create a work directory")?;
     let wd = work.path();
     // The model the testbench opens is this datapath, --n and all, as TOML.

@@ -201,7 +201,6 @@ fn params(args: &ParamsArgs) -> Result<Outcome> {
         Some(dir) => specfx::input::load_vectors(dir)?,
         None => specfx::input::load_datapath(&args.config, None)?,
     };
-    specfx::hdl::check_rtl_support(&dp)?;
     let text = render_parameters(
         &dp,
         args.arch,

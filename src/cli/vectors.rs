@@ -54,7 +54,6 @@ pub struct VectorsArgs {
 /// Runs `specfx vectors`.
 pub fn run(args: &VectorsArgs) -> Result<Outcome> {
     let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
-    specfx::hdl::check_rtl_support(&dp)?;
     let (n, coverage) = write_dir(
         &dp,
         &args.out,

@@ -9,11 +9,13 @@
 //!
 //! - `pipelined`: the valid bits `u_valid.g_regs.g_stage[s].r`; then per operation the
 //!   delay line's output wires and its registers, each register holding the concatenation the
-//!   RTL gives its `specfx_delay`: `r_sub` `{coef_1, threshold_1, offset_1, slope_1, c_cl_1,
-//!   d_1}`, `r_mul_t` `{coef_2, threshold_2, offset_2, c_cl_2, t_2}`, `r_add_b` `{coef_b,
-//!   b_q}`, `g_square[i].r_square` `{coef_q, y_q}` (i = 1..k), `r_mul_out` `out_data`.
+//!   RTL gives its `specfx_delay`: `r_sub` `{depth_1, coef_1, threshold_1, offset_1, slope_1,
+//!   c_cl_1, d_1}`, `r_mul_t` `{depth_2, coef_2, threshold_2, offset_2, c_cl_2, t_2}`,
+//!   `r_add_b` `{depth_b, coef_b, b_q}`, `g_square[i].r_square` `{depth_q, coef_q, y_q}`
+//!   (i = 1..k), `r_mul_out` `out_data`. The 3-bit depth j(n) rides along in every
+//!   architecture and configuration (synthesis removes it where no stage reads it).
 //! - `folded`: `busy`, `step`, `count`, `x`, `slope_r`, `offset_r`, `threshold_r`, `c_cl_r`,
-//!   `coef_r` (and the output register, the ports `out_valid` and `out_data`).
+//!   `coef_r`, `depth_r` (and the output register, the ports `out_valid` and `out_data`).
 //!
 //! A register that holds no valid data has no value (`x` in a trace): the RTL's contents of an
 //! empty slot are unspecified. Values are derived from the items the model holds, the per-n
@@ -138,11 +140,14 @@ pub fn pipelined_registers(
         let slope: fn(&Datapath, &Token) -> i64 = |dp, t| dp.constants()[t.n_idx].slope_raw;
         let c_cl: fn(&Datapath, &Token) -> i64 = |_, t| t.c;
         let value: fn(&Datapath, &Token) -> i64 = |_, t| t.value;
+        let depth: fn(&Datapath, &Token) -> i64 = |dp, t| i64::from(dp.constants()[t.n_idx].depth);
+        let d_w = crate::pipeline::DEPTH_BITS;
         let (prefix, delay, fields): (String, &str, Vec<Field>) = match op {
             Op::Sub => (
                 String::new(),
                 "r_sub",
                 vec![
+                    ("depth_1", d_w, depth),
                     ("coef_1", w.coef, coef),
                     ("threshold_1", w.c, threshold),
                     ("offset_1", w.offset, offset),
@@ -155,6 +160,7 @@ pub fn pipelined_registers(
                 String::new(),
                 "r_mul_t",
                 vec![
+                    ("depth_2", d_w, depth),
                     ("coef_2", w.coef, coef),
                     ("threshold_2", w.c, threshold),
                     ("offset_2", w.offset, offset),
@@ -165,12 +171,20 @@ pub fn pipelined_registers(
             Op::AddB => (
                 String::new(),
                 "r_add_b",
-                vec![("coef_b", w.coef, coef), ("b_q", w.b, value)],
+                vec![
+                    ("depth_b", d_w, depth),
+                    ("coef_b", w.coef, coef),
+                    ("b_q", w.b, value),
+                ],
             ),
             Op::Square(i) => (
                 format!("g_square[{}].", i + 1),
                 "r_square",
-                vec![("coef_q", w.coef, coef), ("y_q", w.squares[i], value)],
+                vec![
+                    ("depth_q", d_w, depth),
+                    ("coef_q", w.coef, coef),
+                    ("y_q", w.squares[i], value),
+                ],
             ),
             // The output is the core's port out_data, which traces show with the ports.
             Op::MulOut => (String::new(), "r_mul_out", vec![("", w.out, value)]),
@@ -245,6 +259,9 @@ pub fn folded_registers(dp: &Datapath, state: &FoldedState) -> Vec<RegisterView>
         of_x("threshold_r", w.c, &|t| nc(t).threshold.unwrap_or(0)),
         of_x("c_cl_r", w.c, &|t| t.c),
         of_x("coef_r", w.coef, &|t| nc(t).coef_raw),
+        of_x("depth_r", crate::pipeline::DEPTH_BITS, &|t| {
+            i64::from(nc(t).depth)
+        }),
     ]
 }
 

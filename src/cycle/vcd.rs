@@ -7,7 +7,7 @@
 //! - `tb_specfx`: `clk`, `rst`, `cycle` (the testbench's 32-bit `integer`), `in_n` and the
 //!   DUT's ports;
 //! - `tb_specfx.dut`: the ports of `specfx_dut` (`clk rst in_valid in_ready in_c in_slope
-//!   in_offset in_threshold in_coef out_valid out_ready out_data`);
+//!   in_offset in_threshold in_coef in_depth out_valid out_ready out_data`);
 //! - `tb_specfx.dut.g_pipelined.u_core` or `tb_specfx.dut.g_folded.u_core`: the same ports,
 //!   `advance` (pipelined), and every register of the core ([`crate::cycle::rtl`]).
 //!
@@ -58,6 +58,7 @@ enum Source {
     InOffset,
     InThreshold,
     InCoef,
+    InDepth,
     OutValid,
     OutReady,
     OutData,
@@ -84,6 +85,7 @@ fn port_list(w: &Widths) -> Vec<(&'static str, u32, Source)> {
         ("in_offset", w.offset, Source::InOffset),
         ("in_threshold", w.c, Source::InThreshold),
         ("in_coef", w.coef, Source::InCoef),
+        ("in_depth", crate::pipeline::DEPTH_BITS, Source::InDepth),
         ("out_valid", 1, Source::OutValid),
         ("out_ready", 1, Source::OutReady),
         ("out_data", w.out, Source::OutData),
@@ -153,6 +155,7 @@ fn value(dp: &Datapath, t: &CycleTrace, source: Source, width: u32) -> Option<Wo
         Source::InOffset => nc.map_or(0, |nc| nc.offset_raw),
         Source::InThreshold => nc.map_or(0, |nc| nc.threshold.unwrap_or(0)),
         Source::InCoef => nc.map_or(0, |nc| nc.coef_raw),
+        Source::InDepth => nc.map_or(0, |nc| i64::from(nc.depth)),
         Source::OutValid => i64::from(t.out_valid),
         Source::OutReady => i64::from(t.out_ready),
         Source::OutData => t.out_data?,

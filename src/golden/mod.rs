@@ -31,6 +31,7 @@ enum Source {
     Slope,
     Offset,
     Threshold,
+    Depth,
     Stage(usize),
 }
 
@@ -78,9 +79,9 @@ pub fn n_format(config: &Config) -> Format {
 /// The ports of a datapath's vector files, in the order they are written.
 ///
 /// Inputs first: `in_c`, `in_n`, then the per-n constants a datapath reads from its ROM
-/// (`in_slope`, `in_offset`, `in_threshold`, `in_coef`; every configuration has all four,
-/// so one testbench serves them all), then one probe per stage before the coefficient, then
-/// `expected_out`.
+/// (`in_slope`, `in_offset`, `in_threshold`, `in_coef`, `in_depth`; every configuration has
+/// all five, so one testbench serves them all: `in_depth` is k for a fixed depth), then one
+/// probe per stage before the coefficient, then `expected_out`.
 pub fn ports(dp: &Datapath) -> Vec<Port> {
     let cfg = dp.config();
     let (slope_format, offset_format) = cfg.constant_formats();
@@ -110,6 +111,12 @@ pub fn ports(dp: &Datapath) -> Vec<Port> {
             cfg.coef.format,
             Source::Coef,
             "coef(n), the per-n coefficient constant",
+        ),
+        Port::new(
+            "in_depth",
+            Format::unsigned(crate::pipeline::DEPTH_BITS as i32, 0).expect("3 bits"),
+            Source::Depth,
+            "j(n): the squarings n uses (stages past it pass their input through; k for a fixed depth)",
         ),
     ];
     let coef_idx = dp.stage_coef();
@@ -328,6 +335,7 @@ pub fn write_vectors(
                     Source::Slope => nc.slope_raw,
                     Source::Offset => nc.offset_raw,
                     Source::Threshold => nc.threshold.unwrap_or(0),
+                    Source::Depth => i64::from(nc.depth),
                     Source::Stage(stage_idx) => row[stage_idx],
                 };
                 cell.clear();

@@ -17,27 +17,6 @@ use crate::fixed::{Format, Overflow, Rounding};
 use crate::pipeline::{Datapath, StageSpec};
 use crate::reference::lobe::Cutoff;
 
-/// Refuses a datapath the reference RTL does not implement yet: one with a per-n squaring
-/// depth (some n bypasses a squaring stage; the RTL has no bypass multiplexers or depth port
-/// yet). The model, the check and the analyses serve it; vectors, co-simulation, synthesis and
-/// place and route do not.
-///
-/// # Errors
-/// [`Error::Config`] naming the `depth` key.
-pub fn check_rtl_support(dp: &Datapath) -> Result<(), crate::error::Error> {
-    let k = dp.config().k as usize;
-    if dp.bypass_from() < k {
-        return Err(crate::error::Error::Config {
-            key: "depth".to_string(),
-            problem: format!(
-                "the reference RTL has no bypass multiplexers yet: this datapath's per-n depth (some exponents use {} of its k = {k} squarings) is modelled bit for bit, but its vectors, co-simulation, synthesis and place and route need depth = \"fixed\"",
-                dp.bypass_from()
-            ),
-        });
-    }
-    Ok(())
-}
-
 /// The Verilog code of a rounding mode (0 TRN .. 7 RND_CONV_ODD).
 pub fn rounding_code(r: Rounding) -> u32 {
     match r {
@@ -74,14 +53,13 @@ pub fn cutoff_code(c: Cutoff) -> u32 {
 /// The most squaring stages (`SQ1_*` .. `SQ7_*` parameters of `specfx_top`).
 pub const MAX_SQUARES: usize = 7;
 
-/// Width of the per-n depth field j(n) (1..=7) in the vectors, the ROM and the RTL's
-/// `in_depth` port.
-pub const DEPTH_BITS: u32 = 3;
+pub use crate::pipeline::DEPTH_BITS;
 
 /// The values of `hdl_ref/rtl/specfx_top.v`'s parameters for a configuration and an
 /// architecture, in the module's order: `ARCH`, `K`, `CUTOFF`, the formats (`<X>_W`, `<X>_F`,
 /// `<X>_S`), modes (`<X>_RND`, `<X>_OVF`), the seven squaring stages `SQ1_*` .. `SQ7_*` (stages
-/// above k are 0), `LAT_SUB`, `LAT_MUL`, `LAT_ADD` and `RESET_DATA` (1 when `reset_data`).
+/// above k are 0), `LAT_SUB`, `LAT_MUL`, `LAT_ADD`, `RESET_DATA` (1 when `reset_data`) and
+/// `DEPTH_MIN`, the smallest per-n depth j(n) (k for a fixed depth: no stage has a bypass).
 ///
 /// # Examples
 /// ```
@@ -151,6 +129,7 @@ pub fn top_parameters(dp: &Datapath, arch: Arch, reset_data: bool) -> Vec<(Strin
     def("LAT_MUL", i64::from(cfg.latency.mul));
     def("LAT_ADD", i64::from(cfg.latency.add));
     def("RESET_DATA", i64::from(reset_data));
+    def("DEPTH_MIN", dp.bypass_from() as i64);
     p
 }
 
@@ -284,7 +263,7 @@ pub fn render_parameters(
                 writeln!(s, "    .{name}({value}){sep}").expect("write to String");
             }
             s.push_str(
-                ") u_specfx (\n    .clk(clk), .rst(rst),\n    .in_valid(in_valid), .in_ready(in_ready),\n    .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),\n    .in_threshold(in_threshold), .in_coef(in_coef),\n    .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)\n);\n",
+                ") u_specfx (\n    .clk(clk), .rst(rst),\n    .in_valid(in_valid), .in_ready(in_ready),\n    .in_c(in_c), .in_slope(in_slope), .in_offset(in_offset),\n    .in_threshold(in_threshold), .in_coef(in_coef), .in_depth(in_depth),\n    .out_valid(out_valid), .out_ready(out_ready), .out_data(out_data)\n);\n",
             );
         }
     }

@@ -83,6 +83,10 @@ pub struct MinimaxSpec {
     pub rounding: Rounding,
 }
 
+/// Width of the per-n depth field j(n) (1..=7) in the vectors, the ROM and the RTL's
+/// `in_depth` port.
+pub const DEPTH_BITS: u32 = 3;
+
 /// How many of the k squaring stages square at each n: `j(n)`, with `m(n) = 2^j(n)`; the
 /// stages past `j(n)` pass their input through (a bypass multiplexer, then the stage's own
 /// quantization). See `docs/arithmetic.md` section 2.

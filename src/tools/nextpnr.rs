@@ -28,7 +28,6 @@ pub fn place_and_route(
     device: Device,
     hdl_ref: &Path,
 ) -> Result<Timing, Error> {
-    crate::hdl::check_rtl_support(dp)?;
     let work = work_dir("nextpnr-ice40", "pnr")?;
     let dir = work.path();
     // A missing nextpnr is reported before yosys spends seconds on synthesis.

@@ -35,7 +35,6 @@ pub fn synthesise(
     target: Target,
     hdl_ref: &Path,
 ) -> Result<Synthesis, Error> {
-    crate::hdl::check_rtl_support(dp)?;
     let work = work_dir("yosys", "yosys")?;
     write(
         "yosys",

@@ -193,7 +193,7 @@ fn vectors_are_complete_correct_deterministic_and_not_overwritten() {
     assert_eq!(
         lines.next().unwrap(),
         "in_c:u1.15,in_n:u11.0,in_slope:u7.4,in_offset:u1.0,in_threshold:u1.15,in_coef:u8.16,\
-         probe_d:s1.15,probe_t:s2.16,probe_b:u1.16,probe_sq1:u1.16,probe_sq2:u1.16,\
+         in_depth:u3.0,probe_d:s1.15,probe_t:s2.16,probe_b:u1.16,probe_sq1:u1.16,probe_sq2:u1.16,\
          probe_sq3:u1.16,probe_sq4:u1.16,expected_out:u8.16"
     );
     assert_eq!(manifest["order"], "interleaved");
@@ -201,11 +201,11 @@ fn vectors_are_complete_correct_deterministic_and_not_overwritten() {
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();
     assert_eq!(rows.len() as u64, n_vectors);
-    let (c, n, out) = (0, 1, 13);
+    let (c, n, out) = (0, 1, 14);
     for r in &rows {
         assert_eq!(r[out], baseline_out(r[c], r[n]), "row {r:?}");
-        // The constants: slope n, offset 1, threshold 0 (clamp cutoff).
-        assert_eq!((r[2], r[3], r[4]), (r[n], 1, 0), "row {r:?}");
+        // The constants: slope n, offset 1, threshold 0 (clamp cutoff), depth k = 4.
+        assert_eq!((r[2], r[3], r[4], r[6]), (r[n], 1, 0, 4), "row {r:?}");
     }
     // Corner cases are there: c = 0, 1.0, above 1.0 and the last code, for every n.
     for n in [16, 100, 1024] {
@@ -235,7 +235,7 @@ fn vectors_are_complete_correct_deterministic_and_not_overwritten() {
         // s2.16 is 18 bits: two's complement in 5 hex digits.
         let v = i64::from_str_radix(w, 16).unwrap();
         let v = if v >= 1 << 17 { v - (1 << 18) } else { v };
-        assert_eq!(v, r[7]);
+        assert_eq!(v, r[8]);
     }
 
     // The same command again replaces its own earlier result with the same bytes; a

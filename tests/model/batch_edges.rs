@@ -133,7 +133,7 @@ fn the_reproductions_through_vectors_and_check() {
         assert_eq!(json["monotonic"], true, "{name}");
         if name == "t" {
             // t = 0 at c = 0, so no base is cut.
-            assert_eq!(row(0)[7], 0); // probe_t
+            assert_eq!(row(0)[8], 0); // probe_t
             assert_eq!(json["n_cut"], 0);
         } else {
             assert_eq!(*row(32768).last().unwrap(), 4_611_686_018_427_387_903);

@@ -307,8 +307,8 @@ fn vcd_trace_parses_back() {
     let word = header
         .find_var(&[&core[..], &["r_mul_t", "g_regs", "g_stage[0]", "r"]].concat())
         .unwrap();
-    // {coef_2, threshold_2, offset_2, c_cl_2, t_2}: 24 + 16 + 1 + 16 + 18 bits.
-    assert_eq!(word.size, 75);
+    // {depth_2, coef_2, threshold_2, offset_2, c_cl_2, t_2}: 3 + 24 + 16 + 1 + 16 + 18 bits.
+    assert_eq!(word.size, 78);
     let n_commands = parser.count();
     assert!(n_commands > 100 * 8);
 }
