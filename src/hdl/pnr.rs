@@ -187,7 +187,7 @@ pub fn device_check(dsps: u64, luts: u64, ffs: u64, device: Device) -> Vec<Strin
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct HarnessBits {
     /// DUT input bits: `rst`, `in_valid`, `out_ready`, `in_c`, `in_slope`, `in_offset`,
-    /// `in_threshold`, `in_coef`.
+    /// `in_threshold`, `in_coef`, and `in_depth` when some n bypasses a squaring stage.
     pub inputs: u64,
     /// DUT output bits: `in_ready`, `out_valid`, `out_data`.
     pub outputs: u64,
@@ -216,7 +216,16 @@ pub fn harness_bits(dp: &Datapath) -> HarnessBits {
     let (slope, offset) = cfg.constant_formats();
     let w = |f: crate::fixed::Format| u64::from(f.width());
     HarnessBits {
-        inputs: 3 + 2 * w(cfg.c.format) + w(slope) + w(offset) + w(cfg.coef.format),
+        inputs: 3
+            + 2 * w(cfg.c.format)
+            + w(slope)
+            + w(offset)
+            + w(cfg.coef.format)
+            + if cfg.has_bypass() {
+                u64::from(crate::pipeline::DEPTH_BITS)
+            } else {
+                0
+            },
         outputs: 2 + w(cfg.out.format),
     }
 }
@@ -251,19 +260,31 @@ module specfx_pnr_top (
     localparam OFFSET_W = (`SPECFX_OFFSET_W);
     localparam COEF_W = (`SPECFX_COEF_W);
     localparam OUT_W = (`SPECFX_OUT_W);
+    // in_depth is a DUT input only when some n bypasses a squaring stage.
+    localparam DEPTH_W = ((`SPECFX_DEPTH_MIN) < (`SPECFX_K)) ? 3 : 0;
     // Input shift register: rst, in_valid, out_ready, in_c, in_slope, in_offset,
-    // in_threshold, in_coef (bit 0 first).
+    // in_threshold, in_coef, in_depth (bit 0 first).
     localparam P_C = 3;
     localparam P_SLOPE = P_C + C_W;
     localparam P_OFFSET = P_SLOPE + SLOPE_W;
     localparam P_THRESHOLD = P_OFFSET + OFFSET_W;
     localparam P_COEF = P_THRESHOLD + C_W;
-    localparam IN_BITS = P_COEF + COEF_W;
+    localparam P_DEPTH = P_COEF + COEF_W;
+    localparam IN_BITS = P_DEPTH + DEPTH_W;
     // Output shift register: out_data, out_valid, in_ready (bit 0 first).
     localparam OUT_BITS = OUT_W + 2;
 
     reg [IN_BITS-1:0] in_q;
     always @(posedge clk) in_q <= {in_q[IN_BITS-2:0], sin};
+
+    wire [2:0] in_depth;
+    generate
+        if (DEPTH_W > 0) begin : g_depth
+            assign in_depth = in_q[P_DEPTH +: 3];
+        end else begin : g_fixed_depth
+            assign in_depth = 3'd0;
+        end
+    endgenerate
 
     wire in_ready;
     wire out_valid;
@@ -273,7 +294,7 @@ module specfx_pnr_top (
         .in_valid(in_q[1]), .in_ready(in_ready),
         .in_c(in_q[P_C +: C_W]), .in_slope(in_q[P_SLOPE +: SLOPE_W]),
         .in_offset(in_q[P_OFFSET +: OFFSET_W]), .in_threshold(in_q[P_THRESHOLD +: C_W]),
-        .in_coef(in_q[P_COEF +: COEF_W]),
+        .in_coef(in_q[P_COEF +: COEF_W]), .in_depth(in_depth),
         .out_valid(out_valid), .out_ready(in_q[2]), .out_data(out_data)
     );
 

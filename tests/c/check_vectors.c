@@ -17,7 +17,7 @@
 static struct specfx_model *model;
 static long rows, ncols, stages;
 static int64_t *cells; /* rows x ncols */
-static int col_c, col_n, col_slope, col_offset, col_threshold, col_coef, col_out;
+static int col_c, col_n, col_slope, col_offset, col_threshold, col_coef, col_depth, col_out;
 static int col_probe[SPECFX_MAX_STAGES]; /* d, t, b, sq1.. */
 static int n_probes;
 
@@ -48,6 +48,7 @@ static void read_csv(const char *path) {
   col_offset = column(names, "in_offset");
   col_threshold = column(names, "in_threshold");
   col_coef = column(names, "in_coef");
+  col_depth = column(names, "in_depth");
   col_out = column(names, "expected_out");
   for (int i = 0; i < ncols; i++)
     if (strncmp(names[i], "probe_", 6) == 0) col_probe[n_probes++] = i;
@@ -78,7 +79,7 @@ static long check_rows(void) {
     if (ok && values[stages - 1] != out) ok = 0;
     if (specfx_constants_of(model, n, &k) != SPECFX_OK || k.slope != cell(r, col_slope) ||
         k.offset != cell(r, col_offset) || k.threshold != cell(r, col_threshold) ||
-        k.coef != cell(r, col_coef))
+        k.coef != cell(r, col_coef) || (int64_t)k.depth != cell(r, col_depth))
       ok = 0;
     if (!ok) {
       if (failed < 5) fprintf(stderr, "row %ld (c = %lld, n = %u) differs\n", r, (long long)c, n);

@@ -113,4 +113,9 @@ fn the_c_abi_gives_the_clis_vectors_bit_for_bit() {
         &config_path("lint_widest.toml"),
         &["--cases", "corner,random:20000"],
     );
+    // A per-n depth: SPECFX_DEPTH and specfx_constants.depth against the in_depth column.
+    check(
+        &config_path("depth_steps_signed.toml"),
+        &["--cases", "corner,random:20000"],
+    );
 }

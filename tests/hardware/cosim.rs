@@ -133,6 +133,47 @@ fn folded_matches_bit_and_cycle() {
     );
 }
 
+/// A per-n squaring depth: the bypass multiplexers and the depth riding the pipeline, bit and
+/// cycle exact in both simulators and both architectures (minimax with `depth = "best"`,
+/// stages 5 and 6 bypassed for small n; a plain step list on signed stages, stages 2 to 4
+/// bypassed for n < 9), and lint-clean in both.
+#[test]
+fn per_n_depth_matches_bit_and_cycle_in_both_architectures() {
+    let best = config_path("depth_best_k6.toml");
+    let steps = config_path("depth_steps_signed.toml");
+    for config in [&best, &steps] {
+        let header = specfx(&["hdl", "params", "--config", config, "--format", "json"]);
+        let params: serde_json::Value = serde_json::from_slice(&header.stdout).unwrap();
+        assert!(
+            params["DEPTH_MIN"].as_i64() < params["K"].as_i64(),
+            "{config}"
+        );
+    }
+    check_all(&best, "depth_best", "pipelined", "corner,random:400");
+    check_all(&steps, "depth_steps_folded", "folded", "corner,random:200");
+    // The other two pairings, and the lint, in Icarus only.
+    for (config, arch) in [(&best, "folded"), (&steps, "pipelined")] {
+        let (dir, n) = vectors(config, &format!("depth_{arch}"), "corner,random:200");
+        let o = specfx(&[
+            "cosim",
+            "--vectors",
+            dir.to_str().unwrap(),
+            "--sim",
+            "icarus",
+            "--arch",
+            arch,
+            "--lint",
+        ]);
+        assert_eq!(
+            summary(&o),
+            (n, 0),
+            "{config} {arch}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
 /// A corrupted expected value never reaches the simulator: the vector directory is verified
 /// against its manifest first (the testbench's own sensitivity to a wrong output is
 /// tests/hardware/mutation.rs's business).

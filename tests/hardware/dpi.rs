@@ -120,6 +120,7 @@ fn the_dpi_scoreboard_passes_on_generated_configurations() {
     let narrowest = config_path("lint_narrowest.toml");
     let sat = config_path("sat_out.toml");
     let minimax = config_path("minimax_folded.toml");
+    let depth = config_path("depth_best_k6.toml");
     let runs: Vec<Vec<&str>> = vec![
         vec!["--config", "baseline", "--arch", "folded"],
         vec!["--config", "baseline", "--reset-data"],
@@ -135,6 +136,8 @@ fn the_dpi_scoreboard_passes_on_generated_configurations() {
         ],
         vec!["--config", &sat],
         vec!["--config", &minimax, "--arch", "folded"],
+        // A per-n depth: in_depth from specfx_dpi_constant's SPECFX_DEPTH.
+        vec!["--config", &depth],
     ];
     let next = std::sync::atomic::AtomicUsize::new(0);
     std::thread::scope(|s| {

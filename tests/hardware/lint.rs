@@ -151,6 +151,8 @@ struct Candidate {
     coef_rounding: &'static str,
     out: Stage,
     latency: [u32; 3],
+    /// The `depth` key's TOML value, when not the fixed default.
+    depth: Option<String>,
 }
 
 impl Candidate {
@@ -175,6 +177,9 @@ impl Candidate {
             self.cutoff,
             self.n.text
         );
+        if let Some(depth) = &self.depth {
+            t += &format!("depth = {depth}\n");
+        }
         t += &format!(
             "[c]\nformat = \"{}\"\n[d]\nformat = \"{}\"\n",
             self.c, self.d
@@ -445,6 +450,17 @@ impl Generator {
         }
         let out = self.stage(MAX_W, 512);
         let latency = [self.latency(), mul, self.latency()];
+        // A per-n depth on one candidate in three each way, chosen by count (not drawn, so
+        // the random stream, and every other choice, is the same with or without it).
+        let depth = match self.count % 6 {
+            1 if k >= 2 && n.max <= MINIMAX_N_MAX => Some("\"best\"".to_string()),
+            3 | 5 if k >= 2 && n.max > 1 => Some(format!(
+                "[{{ from = 1, j = {} }}, {{ from = {}, j = {k} }}]",
+                1 + self.count % (k - 1),
+                n.max
+            )),
+            _ => None,
+        };
         Candidate {
             shape,
             name: format!("gen{}", self.count),
@@ -463,6 +479,7 @@ impl Generator {
             coef_rounding: self.pick(&ROUNDINGS),
             out,
             latency,
+            depth,
         }
     }
 
@@ -630,11 +647,14 @@ const CLASSES: [(Shape, usize, usize); 11] = [
     (Shape::Widest, 5, 3),
 ];
 
-/// The committed configurations linted every run: the co-simulation ones, and the explicit
+/// The committed configurations linted every run: the co-simulation ones (two with a per-n
+/// depth), and the explicit
 /// edge shapes (packed chain bus of 16, 32, 64 bits; one-bit d; one-bit last square; one-bit
 /// coefficient; every format one bit; the widest formats).
-const FIXED: [&str; 12] = [
+const FIXED: [&str; 14] = [
     "narrow_trn_wrap.toml",
+    "depth_best_k6.toml",
+    "depth_steps_signed.toml",
     "conv_sym_k5.toml",
     "minimax_folded.toml",
     "pow2_shift.toml",
@@ -825,6 +845,12 @@ fn assert_coverage(kept: &[Candidate]) {
             c.n.kind == kind
         });
     }
+    has("a per-n depth from a step list", &|c| {
+        c.depth.as_deref().is_some_and(|d| d.starts_with('['))
+    });
+    has("a per-n depth = \"best\"", &|c| {
+        c.depth.as_deref() == Some("\"best\"")
+    });
     has("the plain variant", &|c| c.minimax.is_none());
     has("the minimax variant", &|c| c.minimax.is_some());
     has("a plain variant with every n a power of two", &|c| {

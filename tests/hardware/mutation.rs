@@ -5,8 +5,8 @@
 //! longer found exactly once, so the set follows the RTL as it changes), and is run on a
 //! configuration whose vectors exercise the broken part: the per-n constants' routing (which a
 //! stream sorted by n exercised only at n boundaries), timing, handshake, rounding, overflow
-//! and clamping, and a rounding constant one LSB off in one stage (caught by the vectors on
-//! and next to every stage's rounding boundary). The unmutated RTL passes on every
+//! and clamping, a rounding constant one LSB off in one stage (caught by the vectors on
+//! and next to every stage's rounding boundary), and the per-n depth's routing and bypass. The unmutated RTL passes on every
 //! configuration used.
 
 use crate::common;
@@ -162,6 +162,24 @@ const MUTANTS: &[Mutant] = &[
         from: "at_step[K+1] ? coef_y : x_y;",
         to: "at_step[K] ? coef_y : x_y;",
         config: "tests/configs/minimax_folded.toml",
+        arch: "folded",
+        flags: &[],
+    },
+    Mutant {
+        name: "pipelined add_b stage takes the depth of the next input, not its own",
+        file: "rtl/specfx_pipelined.v",
+        from: ".d({depth_2, coef_2, b_2}),",
+        to: ".d({in_depth, coef_2, b_2}),",
+        config: "tests/configs/depth_best_k6.toml",
+        arch: "pipelined",
+        flags: &[],
+    },
+    Mutant {
+        name: "a bypassed stage squares anyway (the multiplexer stuck on the product)",
+        file: "rtl/specfx_sq_quant.v",
+        from: "wire [A_W-1:0] aligned = pass ? (x_e << X_SH) : (p_e << P_SH);",
+        to: "wire [A_W-1:0] aligned = 1'b0 ? (x_e << X_SH) : (p_e << P_SH);",
+        config: "tests/configs/depth_steps_signed.toml",
         arch: "folded",
         flags: &[],
     },

@@ -204,6 +204,7 @@ fn expected_registers(arch: &str, k: u32, lat: (u32, u32, u32)) -> Vec<String> {
             "threshold_r",
             "c_cl_r",
             "coef_r",
+            "depth_r",
         ] {
             v.push(r.into());
         }
@@ -221,13 +222,16 @@ fn expected_registers(arch: &str, k: u32, lat: (u32, u32, u32)) -> Vec<String> {
         "offset_1",
         "threshold_1",
         "coef_1",
+        "depth_1",
         "t_2",
         "c_cl_2",
         "offset_2",
         "threshold_2",
         "coef_2",
+        "depth_2",
         "b_q",
         "coef_b",
+        "depth_b",
     ] {
         v.push(name.into());
     }
@@ -236,6 +240,7 @@ fn expected_registers(arch: &str, k: u32, lat: (u32, u32, u32)) -> Vec<String> {
         delay(&mut v, &prefix, "r_square", mul);
         v.push(format!("{prefix}y_q"));
         v.push(format!("{prefix}coef_q"));
+        v.push(format!("{prefix}depth_q"));
     }
     v
 }
@@ -296,7 +301,9 @@ fn check_agree_with(
             "{name}: {full} not in the model"
         );
     }
-    for tb in ["clk", "rst", "cycle", "in_n", "in_c", "in_coef", "out_data"] {
+    for tb in [
+        "clk", "rst", "cycle", "in_n", "in_c", "in_coef", "in_depth", "out_data",
+    ] {
         assert!(model_vars.contains(&format!("tb_specfx.{tb}")));
     }
     // Every register Icarus dumps in the core (but the combinational `always @*` result of
@@ -353,6 +360,15 @@ fn deep_latency_traces_agree_in_both_architectures() {
     let config = config_path("conv_sym_k5.toml");
     check_agree(&config, "k5-p", "pipelined", 5, (2, 2, 1));
     check_agree(&config, "k5-f", "folded", 5, (2, 2, 1));
+}
+
+/// A per-n depth (stages 2 to 4 bypassed for n < 9): the depth rides the delay lines beside
+/// the coefficient, and the folded core holds it in `depth_r`.
+#[test]
+fn per_n_depth_traces_agree_in_both_architectures() {
+    let config = config_path("depth_steps_signed.toml");
+    check_agree(&config, "depth-p", "pipelined", 4, (2, 1, 2));
+    check_agree(&config, "depth-f", "folded", 4, (2, 1, 2));
 }
 
 /// The minimax variant (its own slope and offset formats), a 3-cycle multiplier.
