@@ -76,6 +76,8 @@ class Vectors(unittest.TestCase):
         self.check_dir(config("conv_sym_k5.toml"), "--cases", "exhaustive", "--n", "32,1000")
         self.check_dir(config("wide_signed_out64.toml"), "--cases", "corner,random:5000")
         self.check_dir(config("lint_widest.toml"), "--cases", "corner,random:5000")
+        # A per-n depth: constants(n)["depth"] is the in_depth column.
+        self.check_dir(config("depth_steps_signed.toml"), "--cases", "corner,random:5000")
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "signed_in.toml")
             with open(path, "w") as f:

@@ -109,6 +109,21 @@ fn minimax_folded_passes_every_vector() {
     );
 }
 
+/// A per-n depth (stages 2 to 4 bypassed for n < 9): the vector test drives `in_depth.hex`.
+#[test]
+fn per_n_depth_passes_every_vector() {
+    check(
+        "depth_steps",
+        &[
+            "--config",
+            &config_path("depth_steps_signed.toml"),
+            "--cases",
+            "corner,random:150",
+        ],
+        &["--seed", "5", "--bubble", "0.3", "--stall", "0.3"],
+    );
+}
+
 /// Latencies of 2, the paper cutoff and a signed output.
 #[test]
 fn conv_sym_k5_pipelined_passes_every_vector() {
@@ -278,6 +293,7 @@ fn run_verilator(args: &[&str]) -> Output {
 fn the_live_scoreboard_passes() {
     let every_mode = config_path("every_mode.toml");
     let conv = config_path("conv_sym_k5.toml");
+    let depth = config_path("depth_best_k6.toml");
     for (config, args) in [
         (
             "baseline",
@@ -288,6 +304,8 @@ fn the_live_scoreboard_passes() {
             vec!["--n", "8..=12,40", "--stall", "0.4"],
         ),
         (conv.as_str(), vec!["--n", "32,33,1000", "--bubble", "0.4"]),
+        // A per-n depth: in_depth from the Python package's constants(n)["depth"].
+        (depth.as_str(), vec!["--n", "16,17,31,64,1024"]),
     ] {
         let o = run_live(
             config,
