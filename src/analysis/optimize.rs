@@ -678,6 +678,62 @@ pub struct Algorithm {
     pub per_n: bool,
 }
 
+/// Which squaring depths the optimiser searches (`specfx optimize --depth`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DepthSearch {
+    /// Every n squares k times.
+    Fixed,
+    /// Each n squares to its best depth ([`Depth::Best`]).
+    Best,
+    /// Both, every algorithm in each.
+    Both,
+    /// The fixed depth first; the per-n depth only when no fixed-depth answer exists (the
+    /// bypass multiplexers are paid for only where they are what reaches the budget).
+    Auto,
+}
+
+impl DepthSearch {
+    /// The per-n flags of the algorithms searched ([`Algorithm::all`]).
+    pub fn per_n(self) -> &'static [bool] {
+        match self {
+            DepthSearch::Fixed => &[false],
+            DepthSearch::Best => &[true],
+            DepthSearch::Both | DepthSearch::Auto => &[false, true],
+        }
+    }
+
+    /// The name `--depth` takes: `fixed`, `best`, `fixed,best` or `auto`.
+    pub fn name(self) -> &'static str {
+        match self {
+            DepthSearch::Fixed => "fixed",
+            DepthSearch::Best => "best",
+            DepthSearch::Both => "fixed,best",
+            DepthSearch::Auto => "auto",
+        }
+    }
+}
+
+impl std::str::FromStr for DepthSearch {
+    type Err = String;
+
+    /// `fixed`, `best`, `fixed,best` (either order) or `auto`.
+    fn from_str(s: &str) -> Result<DepthSearch, String> {
+        let mut items: Vec<&str> = s.split(',').map(str::trim).collect();
+        items.sort_unstable();
+        items.dedup();
+        match items[..] {
+            ["fixed"] => Ok(DepthSearch::Fixed),
+            ["best"] => Ok(DepthSearch::Best),
+            ["best", "fixed"] => Ok(DepthSearch::Both),
+            ["auto"] => Ok(DepthSearch::Auto),
+            _ => Err(format!(
+                "expected fixed, best, fixed,best or auto, got '{}'",
+                s.trim()
+            )),
+        }
+    }
+}
+
 /// The depth rule of a choice: [`Depth::Best`] per n, [`Depth::Fixed`] otherwise.
 fn depth_of_choice(per_n: bool) -> Depth {
     if per_n {
@@ -968,7 +1024,8 @@ impl DeviceFit {
 /// not fit it is no answer (it becomes the closest point, and a line of the minimality); when
 /// no algorithm's answer fits and `fit` allows it, the algorithms are searched again in the
 /// folded architecture (one shared multiplier, an initiation interval of k + 2 cycles), whose
-/// answers then compete.
+/// answers then compete. With [`DepthSearch::Auto`], the per-n algorithms among the floors are
+/// searched (in the same way) only when no fixed-depth one has an answer.
 #[allow(clippy::too_many_arguments)]
 pub fn optimize_all(
     base: &Config,
@@ -978,6 +1035,7 @@ pub fn optimize_all(
     cost: &(dyn Fn(&Datapath, Arch) -> Result<f64, Error> + Sync),
     synth: Option<Synthesise>,
     fit: Option<DeviceFit>,
+    depth: DepthSearch,
     done: &(dyn Fn(Algorithm, &SearchResult) + Sync),
 ) -> Result<OptimizeAll, Error> {
     use rayon::prelude::*;
@@ -1044,24 +1102,37 @@ pub fn optimize_all(
             })
             .collect()
     };
-    let reachable: Vec<Algorithm> = floors
-        .iter()
-        .filter(|f| f.reachable)
-        .map(|f| f.algorithm)
-        .collect();
-    let mut results = phase(&reachable, budget.arch)?;
-    // No answer fits: the folded architecture (one shared multiplier) for the algorithms
-    // whose answers did not.
-    if fit.is_some_and(|f| f.fold_when_needed) && budget.arch == Arch::Pipelined {
-        let unfit: Vec<Algorithm> = reachable
-            .iter()
-            .zip(&results)
-            .filter(|(_, (_, note))| note.is_some())
-            .map(|(&a, _)| a)
-            .collect();
-        if results.iter().all(|(r, _)| r.best.is_none()) && !unfit.is_empty() {
-            results.extend(phase(&unfit, Arch::Folded)?);
+    // One group of algorithms in the budget's architecture; when no answer fits, the folded
+    // architecture (one shared multiplier) for the algorithms whose answers did not.
+    let group = |reachable: &[Algorithm]| -> Result<Vec<(SearchResult, Option<String>)>, Error> {
+        let mut results = phase(reachable, budget.arch)?;
+        if fit.is_some_and(|f| f.fold_when_needed) && budget.arch == Arch::Pipelined {
+            let unfit: Vec<Algorithm> = reachable
+                .iter()
+                .zip(&results)
+                .filter(|(_, (_, note))| note.is_some())
+                .map(|(&a, _)| a)
+                .collect();
+            if results.iter().all(|(r, _)| r.best.is_none()) && !unfit.is_empty() {
+                results.extend(phase(&unfit, Arch::Folded)?);
+            }
         }
+        Ok(results)
+    };
+    let reachable = |per_n: &[bool]| -> Vec<Algorithm> {
+        floors
+            .iter()
+            .filter(|f| f.reachable && per_n.contains(&f.algorithm.per_n))
+            .map(|f| f.algorithm)
+            .collect()
+    };
+    let mut results = if depth == DepthSearch::Auto {
+        group(&reachable(&[false]))?
+    } else {
+        group(&reachable(&[false, true]))?
+    };
+    if depth == DepthSearch::Auto && results.iter().all(|(r, _)| r.best.is_none()) {
+        results.extend(group(&reachable(&[true]))?);
     }
     let notes: Vec<String> = results.iter().filter_map(|(_, n)| n.clone()).collect();
     let results: Vec<SearchResult> = results.into_iter().map(|(r, _)| r).collect();

@@ -16,12 +16,3 @@ pub fn parse_k_set(s: &str) -> std::result::Result<NSet, String> {
         Err(bad())
     }
 }
-
-/// Parses one squaring depth choice of `--depth`: `fixed` (false) or `best` (true, per n).
-pub fn parse_depth_choice(s: &str) -> std::result::Result<bool, String> {
-    match s.trim() {
-        "fixed" => Ok(false),
-        "best" => Ok(true),
-        other => Err(format!("expected fixed or best, got '{other}'")),
-    }
-}

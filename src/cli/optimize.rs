@@ -9,7 +9,7 @@ use super::Outcome;
 use specfx::analysis::budget_expr::{Budget, Metric};
 use specfx::analysis::check::check;
 use specfx::analysis::optimize::{
-    algorithm_floors, optimize_all, Algorithm, DeviceFit, Objective, SearchResult,
+    algorithm_floors, optimize_all, Algorithm, DepthSearch, DeviceFit, Objective, SearchResult,
 };
 use specfx::cycle::Arch;
 use specfx::hdl::cost::{analytic_cost, dsp_weight, objective_value, Target};
@@ -53,12 +53,11 @@ pub struct OptimizeArgs {
           value_parser = |v: &str| v.trim().parse::<Variant>())]
     variants: Vec<Variant>,
     /// Squaring depths to try: fixed (every n squares k times), best (each n squares to the
-    /// depth j(n) <= k with the smallest f64 floor, the later stages bypassed) or both. The
-    /// per-n depth is modelled and checked bit for bit, but the reference RTL does not
-    /// implement it yet, so fixed is the default.
-    #[arg(long, default_value = "fixed", value_delimiter = ',',
-          value_parser = super::datapath::parse_depth_choice)]
-    depth: Vec<bool>,
+    /// depth j(n) <= k with the smallest f64 floor, the later stages bypassed), fixed,best
+    /// (both, every algorithm) or auto (fixed first; the per-n depth only when no fixed-depth
+    /// datapath meets the budget and fits).
+    #[arg(long, default_value = "auto", value_parser = |v: &str| v.parse::<DepthSearch>())]
+    depth: DepthSearch,
     /// Fraction bits every searched stage starts from (must meet the budget).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=48))]
     start_frac: i32,
@@ -152,7 +151,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         }
     };
     let variants = &args.variants;
-    let algorithms = Algorithm::all(&base, args.k.values(), variants, &args.depth);
+    let algorithms = Algorithm::all(&base, args.k.values(), variants, args.depth.per_n());
     log::info!(
         "optimize: f64 floor of {} algorithms (k in {}, {}; depth {})",
         algorithms.len(),
@@ -162,11 +161,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             .map(|v| v.name())
             .collect::<Vec<_>>()
             .join(", "),
-        args.depth
-            .iter()
-            .map(|&p| if p { "best" } else { "fixed" })
-            .collect::<Vec<_>>()
-            .join(", ")
+        args.depth.name()
     );
     let mut budget = args.budget.clone();
     budget.arch = arch;
@@ -209,6 +204,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         &cost,
         Some(&synth),
         fit,
+        args.depth,
         &done,
     )?;
     bar.finish();
@@ -275,13 +271,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             .option("k", canonical_nset(&args.k))
             .option("variants", variant_names)
             .option("start_frac", args.start_frac)
-            .option(
-                "depth",
-                args.depth
-                    .iter()
-                    .map(|&p| if p { "best" } else { "fixed" })
-                    .collect::<Vec<_>>(),
-            )
+            .option("depth", args.depth.name())
             .option(
                 "arch",
                 args.arch.map_or("auto".to_string(), |a| a.to_string()),

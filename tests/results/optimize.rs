@@ -265,6 +265,66 @@ fn the_goal_alone_finds_a_datapath_within_one_lsb8() {
     }
 }
 
+/// Half a display step: no fixed-depth k = 6 minimax datapath can meet 0.5 lsb8 over
+/// n = 16..40 (its f64 floor is 1.33 lsb8: m = 64 squarings are too many for n < 64), so the
+/// default `--depth auto` goes on to the per-n depth, whose answer (m = 16 up to n = 21, 32
+/// above: the minimax table's best depths) `specfx check` confirms; `--depth fixed` stops at
+/// the floor.
+#[test]
+fn auto_depth_reaches_half_an_lsb8_with_a_per_n_depth() {
+    let out = temp("half.toml");
+    let args = [
+        "optimize",
+        "--n",
+        "16..=40",
+        "--k",
+        "6",
+        "--variants",
+        "minimax",
+        "--budget",
+        "shape_total <= 0.5 lsb8",
+    ];
+    let o = specfx(&[&args[..], &["--out", out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("per-n depth (m = 16 for n = 16..=21, m = 32 for n = 22..=40)"),
+        "{stdout}"
+    );
+    let cfg = Config::from_toml(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let dp = Datapath::new(cfg).unwrap();
+    assert_eq!(dp.bypass_from(), 4);
+    let r = check(&dp).unwrap();
+    assert!(
+        r.shape_total_max_abs <= 0.5 / 256.0,
+        "{}",
+        r.shape_total_max_abs
+    );
+    let o = specfx(
+        &[
+            &args[..],
+            &[
+                "--depth",
+                "fixed",
+                "--out",
+                temp("half-fixed.toml").to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("6 minimax fixed"), "{stdout}");
+    let o = specfx(&[&args[..], &["--depth", "deep"]].concat());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&o.stderr)
+            .contains("expected fixed, best, fixed,best or auto, got 'deep'"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
 /// Cost ceilings: every datapath has k + 2 >= 3 products (t = slope d, the k squarings, the
 /// coefficient), and on iCE40 each takes at least one SB_MAC16, so no datapath fits in 2 DSPs
 /// whatever its error (the ceiling alone decides, so a few exponents show it); a LUT ceiling
