@@ -7,8 +7,9 @@ use crate::reference::lobe::Cutoff;
 use crate::reference::method::Method;
 use crate::reference::minimax::sup_abs_error;
 
-/// The methods the main report compares: cs_m (clamp) and minimax for k = 2..=7, cs16 with the
-/// paper's cutoff, Schlick and the exponential limit.
+/// The methods the main report compares: cs_m (clamp) and minimax for k = 2..=7, minimax with
+/// a per-n depth up to m = 32, 64 and 128 (each n at its best m(n), `depth = "best"`), cs16 with
+/// the paper's cutoff, Schlick and the exponential limit.
 pub fn report_methods() -> Vec<Method> {
     let mut v: Vec<Method> = (2..=7)
         .map(|k| Method::CsM {
@@ -21,6 +22,7 @@ pub fn report_methods() -> Vec<Method> {
         cutoff: Cutoff::Paper,
     });
     v.extend((2..=7).map(|k| Method::Minimax { k }));
+    v.extend((5..=7).map(|k| Method::MinimaxPerN { k }));
     v.push(Method::Schlick);
     v.push(Method::ExpLimit);
     v

@@ -65,7 +65,8 @@ pub struct YosysFigures {
 }
 
 /// The f64 methods compared: powf, repeated-squaring powi, Schlick, exp(-n(1-c)), cs_m with
-/// every cutoff for k = 2..7, and minimax for k = 2..7.
+/// every cutoff for k = 2..7, minimax for k = 2..7, and minimax with a per-n depth (each n at
+/// its best m(n) <= 2^k) for k = 5..7.
 pub fn f64_methods() -> Vec<(String, Method)> {
     let mut v = vec![
         ("powf".to_string(), Method::CosPow),
@@ -78,6 +79,10 @@ pub fn f64_methods() -> Vec<(String, Method)> {
             v.push((m.name(), m));
         }
         let m = Method::Minimax { k };
+        v.push((m.name(), m));
+    }
+    for k in 5..=7 {
+        let m = Method::MinimaxPerN { k };
         v.push((m.name(), m));
     }
     v
@@ -117,7 +122,9 @@ pub fn f64_figures(name: &str, method: Method, ns: &[u32], time: Timer) -> Metho
     })
     .max(1e-9);
     let (multipliers, latency) = match method {
-        Method::CsM { k, .. } | Method::Minimax { k } => (Some(k + 2), Some(u64::from(k) + 4)),
+        Method::CsM { k, .. } | Method::Minimax { k } | Method::MinimaxPerN { k } => {
+            (Some(k + 2), Some(u64::from(k) + 4))
+        }
         _ => (None, None),
     };
     MethodFigures {

@@ -335,21 +335,8 @@ impl Config {
         match &self.depth {
             Depth::Fixed => self.k,
             Depth::Best => {
-                let floor = |j: u32| {
-                    crate::reference::minimax::constants(n, j).map(|f| match self.variant {
-                        Variant::Plain => f.plain_max_abs_err,
-                        Variant::Minimax => f.max_abs_err,
-                    })
-                };
-                let mut best = (self.k, f64::INFINITY);
-                for j in 1..=self.k {
-                    match floor(j) {
-                        Ok(e) if e < best.1 => best = (j, e),
-                        Ok(_) => {}
-                        Err(_) => return self.k,
-                    }
-                }
-                best.0
+                crate::reference::minimax::best_depth(n, self.k, self.variant == Variant::Plain)
+                    .unwrap_or(self.k)
             }
             Depth::Steps(steps) => steps
                 .iter()

@@ -24,6 +24,12 @@ pub enum Method {
         /// Number of squarings.
         k: u32,
     },
+    /// Minimax with a per-n depth: `max(0, A(n) c + B(n))^(2^j)`, j = j(n) <= k the depth
+    /// with the smallest floor ([`minimax::best_depth`], `depth = "best"`).
+    MinimaxPerN {
+        /// The most squarings.
+        k: u32,
+    },
     /// Schlick's rational `c / (n - n c + c)`.
     Schlick,
     /// The exponential limit `exp(-n (1 - c))`.
@@ -52,17 +58,25 @@ impl Method {
                 Ok(fit) => affine_lobe(c, fit.a, fit.b, k),
                 Err(_) => f64::NAN,
             },
+            Method::MinimaxPerN { k } => {
+                match minimax::best_depth(n, k, false).and_then(|j| minimax::constants(n, j).ok()) {
+                    Some(fit) => affine_lobe(c, fit.a, fit.b, fit.k),
+                    None => f64::NAN,
+                }
+            }
             Method::Schlick => schlick(c, nf),
             Method::ExpLimit => exp_limit(c, nf),
         }
     }
 
-    /// A short stable name, e.g. `cs16_clamp`, `minimax16`, `schlick`.
+    /// A short stable name, e.g. `cs16_clamp`, `minimax16`, `minimax64_per_n` (per-n depth up
+    /// to m = 64), `schlick`.
     pub fn name(self) -> String {
         match self {
             Method::CosPow => "cos_pow".to_string(),
             Method::CsM { k, cutoff } => format!("cs{}_{}", m_of_k(k), cutoff),
             Method::Minimax { k } => format!("minimax{}", m_of_k(k)),
+            Method::MinimaxPerN { k } => format!("minimax{}_per_n", m_of_k(k)),
             Method::Schlick => "schlick".to_string(),
             Method::ExpLimit => "exp_limit".to_string(),
         }

@@ -371,6 +371,58 @@ pub fn constants(n: u32, k: u32) -> Result<MinimaxFit, Error> {
         })
 }
 
+/// The best squaring depth of `n` up to `k` (`depth = "best"`, `docs/arithmetic.md` 3.1.0):
+/// the j in 1..=k whose table floor is smallest (`max_abs_err` for minimax, `plain_max_abs_err`
+/// for the plain slope n / 2^j), ties going to the smaller j; None outside the table.
+///
+/// # Examples
+/// ```
+/// use specfx::reference::minimax::best_depth;
+/// // Minimax: m = 16 up to n = 21, 32 up to 42, 64 up to 85, then 128.
+/// assert_eq!([21, 22, 42, 43, 85, 86].map(|n| best_depth(n, 7, false)), [4, 5, 5, 6, 6, 7].map(Some));
+/// assert_eq!(best_depth(1024, 5, false), Some(5));
+/// assert_eq!(best_depth(5000, 5, false), None);
+/// ```
+pub fn best_depth(n: u32, k: u32, plain: bool) -> Option<u32> {
+    // Computed once for every (variant, k, n) of the table: eval-time callers look it up.
+    static BEST: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    let kmax = *crate::reference::lobe::K_RANGE.end();
+    if !(1..=TABLE_N_MAX).contains(&n) || !crate::reference::lobe::K_RANGE.contains(&k) {
+        return None;
+    }
+    let best = BEST.get_or_init(|| {
+        let mut v = Vec::with_capacity(2 * kmax as usize * TABLE_N_MAX as usize);
+        for plain in [false, true] {
+            for k in 1..=kmax {
+                for n in 1..=TABLE_N_MAX {
+                    v.push(best_depth_uncached(n, k, plain).map_or(0, |j| j as u8));
+                }
+            }
+        }
+        v
+    });
+    let idx = (usize::from(plain) * kmax as usize + (k - 1) as usize) * TABLE_N_MAX as usize
+        + (n - 1) as usize;
+    best.get(idx).copied().filter(|&j| j > 0).map(u32::from)
+}
+
+/// [`best_depth`] from the table's floors.
+fn best_depth_uncached(n: u32, k: u32, plain: bool) -> Option<u32> {
+    let mut best = (k, f64::INFINITY);
+    for j in 1..=k {
+        let f = constants(n, j).ok()?;
+        let e = if plain {
+            f.plain_max_abs_err
+        } else {
+            f.max_abs_err
+        };
+        if e < best.1 {
+            best = (j, e);
+        }
+    }
+    Some(best.0)
+}
+
 /// The minimax lobe `max(0, A(n) c + B(n))^m` with the cached constants.
 pub fn minimax_lobe(c: f64, n: u32, k: u32) -> Result<f64, Error> {
     let f = constants(n, k)?;

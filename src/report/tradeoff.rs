@@ -313,6 +313,7 @@ pub fn tradeoff_files(
             "exp_limit",
             "fixed_sq12",
             "cs128_clamp",
+            "minimax64_per_n",
         ],
     );
     files.extend(chart_files("error_vs_n", &per_n)?.1);

@@ -33,6 +33,7 @@ fn tradeoff_lists_every_method_with_figures_that_hold() {
         "cs128_none",
         "minimax4",
         "minimax128",
+        "minimax64_per_n",
         "fixed_sq8",
         "fixed_sq16",
     ] {
@@ -44,6 +45,31 @@ fn tradeoff_lists_every_method_with_figures_that_hold() {
         }
         // Measured speed is a property of this run, kept out of the JSON.
         assert!(m.get("evals_per_s").is_none());
+    }
+    // The per-n depth up to m = 64 takes, at each n, the least error of minimax m <= 64 (m = 2
+    // is never the best at these n).
+    let per_n = |name: &str| -> Vec<f64> {
+        let m = list.iter().find(|m| m["method"] == name).unwrap();
+        m["per_n_max_abs_err"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e.as_f64().unwrap())
+            .collect()
+    };
+    let best = per_n("minimax64_per_n");
+    for (i, &e) in best.iter().enumerate() {
+        let least = [
+            "minimax4",
+            "minimax8",
+            "minimax16",
+            "minimax32",
+            "minimax64",
+        ]
+        .iter()
+        .map(|m| per_n(m)[i])
+        .fold(f64::INFINITY, f64::min);
+        assert!((e - least).abs() <= 1e-12, "n #{i}: {e} vs {least}");
     }
     // Brute force: exp(-n(1-c)) against c^n on a fine uniform grid, n = 64 and 256.
     let mut brute: f64 = 0.0;

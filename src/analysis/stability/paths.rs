@@ -98,6 +98,16 @@ impl FloatPath {
                 },
                 Err(_) => Prepared::Missing,
             },
+            FloatPath::Method(Method::MinimaxPerN { k }) => {
+                match minimax::best_depth(n, k, false).and_then(|j| minimax::constants(n, j).ok()) {
+                    Some(fit) => Prepared::Minimax {
+                        a: fit.a,
+                        b: fit.b,
+                        k: fit.k,
+                    },
+                    None => Prepared::Missing,
+                }
+            }
         }
     }
 }
