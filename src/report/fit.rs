@@ -5,7 +5,7 @@ use std::io::Write;
 
 use crate::error::Error;
 use crate::hdl::rom::rom_verilog;
-use crate::pipeline::Config;
+use crate::pipeline::{Config, Datapath};
 use crate::provenance::Provenance;
 use crate::report::scene::{heatmap_png, path_png, write_inputs_csv};
 use crate::report::table::{Align, TextTable};
@@ -106,7 +106,7 @@ pub fn summary(r: &FitReport) -> String {
         r.inputs,
         r.pixels,
         cfg.k,
-        cfg.variant.name(),
+        variant_depth(&cfg),
         cfg.n,
         cfg.c.format,
         cfg.t.format,
@@ -143,6 +143,28 @@ pub fn summary(r: &FitReport) -> String {
     )
 }
 
+/// A configuration's variant, with its depths when some exponent bypasses a squaring stage:
+/// `minimax`, or `minimax, per-n depth (m = 16 for n = 16, m = 64 for n = 64..=1024)`.
+fn variant_depth(cfg: &Config) -> String {
+    match Datapath::new(cfg.clone()) {
+        Ok(dp) if cfg.has_bypass() => format!(
+            "{}, per-n depth ({})",
+            cfg.variant.name(),
+            crate::report::optimize::depth_text(&dp)
+        ),
+        _ => cfg.variant.name().to_string(),
+    }
+}
+
+/// A floor's variant cell: `minimax`, or `minimax, per-n depth`.
+fn variant_cell(f: &Floor) -> String {
+    format!(
+        "{}{}",
+        f.variant.name(),
+        if f.per_n { ", per-n depth" } else { "" }
+    )
+}
+
 /// The floors table (Markdown).
 fn floors_markdown(floors: &[Floor]) -> String {
     let mut s = "| k | variant | f64 floor: max LSB | mean LSB | differing | FLIP | meets the budget |\n|---:|---|---:|---:|---:|---:|---|\n".to_string();
@@ -151,7 +173,7 @@ fn floors_markdown(floors: &[Floor]) -> String {
             (Some(e), _) => s.push_str(&format!(
                 "| {} | {} | {} | {:.4} | {:.2}% | {:.5} | {} |\n",
                 f.k,
-                f.variant.name(),
+                variant_cell(f),
                 e.max_lsb,
                 e.mean_lsb,
                 100.0 * e.differing,
@@ -161,7 +183,7 @@ fn floors_markdown(floors: &[Floor]) -> String {
             (None, reason) => s.push_str(&format!(
                 "| {} | {} | - | - | - | - | not valid: {} |\n",
                 f.k,
-                f.variant.name(),
+                variant_cell(f),
                 reason.as_deref().unwrap_or("").replace('|', "/")
             )),
         }
@@ -181,7 +203,7 @@ pub fn floors_table(floors: &[Floor]) -> TextTable {
         ("meets the budget", Align::Left),
     ]);
     for f in floors {
-        let (k, variant) = (f.k.to_string(), f.variant.name().to_string());
+        let (k, variant) = (f.k.to_string(), variant_cell(f));
         match (f.figures.as_ref().map(|e| &e.all), &f.reason) {
             (Some(e), _) => t.row([
                 k,
@@ -215,20 +237,27 @@ pub fn write_no_fit(w: &mut impl Write, no: &NoFit, width: Option<u16>) -> std::
         "the f64 floor of each algorithm (its image without quantization, against cos^n):"
     )?;
     floors_table(&no.floors).write(w, width)?;
-    if let Some((f, excess)) = &no.closest_floor {
-        writeln!(
+    match &no.closest_floor {
+        Some((f, excess)) if *excess > 1.0 => writeln!(
             w,
             "the closest algorithm is k = {}, {}, whose f64 floor alone is {excess:.2}x the budget: no quantization can do better; loosen the budget to its floor's figures (see the table) or lower the scene's exponents",
             f.k,
-            f.variant.name(),
-        )?;
+            variant_cell(f),
+        )?,
+        Some((f, excess)) => writeln!(
+            w,
+            "the closest algorithm is k = {}, {}, whose f64 floor is {excess:.2}x the budget, but none of its datapaths searched (from --start-frac fraction bits down) met it: quantization adds to the floor; raise --start-frac or loosen the budget",
+            f.k,
+            variant_cell(f),
+        )?,
+        None => {}
     }
     if let Some((c, e)) = &no.closest {
         writeln!(
             w,
             "closest datapath searched: k = {}, {}: max {} LSB, {:.2}% differing, FLIP {:.5} ({:.2}x the budget)",
             c.config.k,
-            c.config.variant.name(),
+            variant_depth(&c.config),
             e.max_lsb,
             100.0 * e.differing,
             e.flip_mean,

@@ -408,6 +408,9 @@ pub struct Floor {
     pub k: u32,
     /// Variant.
     pub variant: Variant,
+    /// Each exponent at its own best depth (`depth = "best"`; the twin of a fixed-depth
+    /// algorithm, listed only when some exponent of the scene squares fewer than k times).
+    pub per_n: bool,
     /// The f64 model image's figures against cos^n (`None`: the algorithm is not valid for
     /// the scene's exponents; `reason` says why).
     pub figures: Option<SceneFigures>,
@@ -417,30 +420,31 @@ pub struct Floor {
     pub meets: bool,
 }
 
-/// The f64 floor of every algorithm (k = 1..=7, plain and minimax) on the scene.
+/// The f64 floor of every algorithm (k = 1..=7, plain and minimax, fixed and per-n depth:
+/// [`Algorithm::all`]) on the scene.
 pub fn floors(
     judge: &SceneJudge<'_>,
     base: &Config,
     budget: &ImageBudget,
     start_frac: i32,
 ) -> Vec<Floor> {
+    let ks: Vec<u32> = crate::reference::lobe::K_RANGE.collect();
+    let algorithms = Algorithm::all(
+        base,
+        &ks,
+        &[Variant::Plain, Variant::Minimax],
+        &[false, true],
+    );
     let mut v = Vec::new();
-    for k in crate::reference::lobe::K_RANGE {
-        for variant in [Variant::Plain, Variant::Minimax] {
-            let dp = start_of(
-                base,
-                Algorithm {
-                    k,
-                    variant,
-                    per_n: false,
-                },
-                start_frac,
-            )
-            .and_then(Datapath::new);
+    for a in algorithms {
+        let Algorithm { k, variant, per_n } = a;
+        {
+            let dp = start_of(base, a, start_frac).and_then(Datapath::new);
             let floor = match dp {
                 Err(e) => Floor {
                     k,
                     variant,
+                    per_n,
                     figures: None,
                     reason: Some(e.to_string()),
                     meets: false,
@@ -451,6 +455,7 @@ pub fn floors(
                     Floor {
                         k,
                         variant,
+                        per_n,
                         meets: budget.met_by(judge.scene, &e),
                         figures: Some(e),
                         reason: None,
@@ -467,7 +472,7 @@ pub fn floors(
 /// then the input's fraction bits, the coefficient's integer and fraction bits and the
 /// output's; TRN or RND everywhere, then per-stage rounding moves; overflow modes are kept
 /// (a scene proves nothing about inputs it does not produce).
-pub fn fit_space(k: u32, variant: Variant, start_frac: i32) -> Space {
+pub fn fit_space(k: u32, variant: Variant, per_n: bool, start_frac: i32) -> Space {
     let mut extra_knobs = vec![
         Knob::InputFrac,
         Knob::CoefInt,
@@ -482,7 +487,7 @@ pub fn fit_space(k: u32, variant: Variant, start_frac: i32) -> Space {
         choices: Choices {
             k: vec![k],
             variants: vec![variant],
-            per_n: vec![false],
+            per_n: vec![per_n],
             roundings: vec![Rounding::Trn, Rounding::Rnd],
         },
         start_frac,
@@ -513,9 +518,11 @@ pub struct FitSearch {
     pub minimality: Vec<String>,
 }
 
-/// Searches every algorithm whose floor meets the budget (in parallel, results combined in
-/// the floors' order), then the base itself: the cheapest datapath by [`objective`] whose
-/// image meets `budget` on every input of the scene.
+/// Searches every fixed-depth algorithm whose floor meets the budget (in parallel, results
+/// combined in the floors' order), then, when none has an answer, the per-n-depth ones
+/// (each of the scene's exponents at its own best depth: bypass multiplexers are paid for only
+/// where they are what meets the budget), then the base itself: the cheapest datapath by
+/// [`objective`] whose image meets `budget` on every input of the scene.
 ///
 /// FLIP is the costly metric (a full-image filter); each algorithm is first searched with
 /// the budget's other bounds, and its answer checked with FLIP too; only when that fails is
@@ -532,57 +539,71 @@ pub fn fit_search(
 ) -> Result<FitSearch, Error> {
     use rayon::prelude::*;
     let cheap = budget.without_flip();
-    let results: Vec<Result<(SearchResult, u64), Error>> = floors
-        .par_iter()
-        .filter(|f| f.meets)
-        .map(|f| {
-            let name = format!("k = {}, {}", f.k, f.variant.name());
-            let space = fit_space(f.k, f.variant, start_frac);
-            let mut cost =
-                |dp: &Datapath| -> Result<f64, Error> { Ok(objective(dp, target) as f64) };
-            let mut lines = |line: &str| progress(&format!("{name}: {line}"));
-            let run = |b: &ImageBudget,
-                       cost: &mut dyn FnMut(&Datapath) -> Result<f64, Error>,
-                       lines: &mut dyn FnMut(&str)| {
-                let mut j = |dp: &Datapath| -> Result<Verdict, Error> {
-                    Ok(judge.verdict(&judge.datapath_image(dp), b))
+    let group = |per_n: bool| -> Vec<Result<(SearchResult, u64), Error>> {
+        floors
+            .par_iter()
+            .filter(|f| f.meets && f.per_n == per_n)
+            .map(|f| {
+                let name = format!(
+                    "k = {}, {}{}",
+                    f.k,
+                    f.variant.name(),
+                    if f.per_n { ", per-n depth" } else { "" }
+                );
+                let space = fit_space(f.k, f.variant, f.per_n, start_frac);
+                let mut cost =
+                    |dp: &Datapath| -> Result<f64, Error> { Ok(objective(dp, target) as f64) };
+                let mut lines = |line: &str| progress(&format!("{name}: {line}"));
+                let run = |b: &ImageBudget,
+                           cost: &mut dyn FnMut(&Datapath) -> Result<f64, Error>,
+                           lines: &mut dyn FnMut(&str)| {
+                    let mut j = |dp: &Datapath| -> Result<Verdict, Error> {
+                        Ok(judge.verdict(&judge.datapath_image(dp), b))
+                    };
+                    search(base, &space, &mut j, cost, lines)
                 };
-                search(base, &space, &mut j, cost, lines)
-            };
-            let mut r = run(&cheap, &mut cost, &mut lines)?;
-            let mut extra = 0;
-            if budget.needs_flip() {
-                if let Some(b) = &r.best {
-                    extra += 1;
-                    let dp = Datapath::new(b.config.clone())?;
-                    if !judge.verdict(&judge.datapath_image(&dp), budget).feasible {
-                        progress(&format!(
-                            "{name}: FLIP breaks the budget, searching again with it"
-                        ));
-                        let n = r.n_evaluations;
-                        r = run(budget, &mut cost, &mut lines)?;
-                        extra += n;
+                let mut r = run(&cheap, &mut cost, &mut lines)?;
+                let mut extra = 0;
+                if budget.needs_flip() {
+                    if let Some(b) = &r.best {
+                        extra += 1;
+                        let dp = Datapath::new(b.config.clone())?;
+                        if !judge.verdict(&judge.datapath_image(&dp), budget).feasible {
+                            progress(&format!(
+                                "{name}: FLIP breaks the budget, searching again with it"
+                            ));
+                            let n = r.n_evaluations;
+                            r = run(budget, &mut cost, &mut lines)?;
+                            extra += n;
+                        }
                     }
                 }
-            }
-            progress(&format!(
-                "{name}: {}",
-                r.best
-                    .as_ref()
-                    .map_or("nothing fits".to_string(), |b| format!(
-                        "{:.0} LUTs",
-                        b.cost
-                    ))
-            ));
-            Ok((r, extra))
-        })
-        .collect();
+                progress(&format!(
+                    "{name}: {}",
+                    r.best
+                        .as_ref()
+                        .map_or("nothing fits".to_string(), |b| format!(
+                            "{:.0} LUTs",
+                            b.cost
+                        ))
+                ));
+                Ok((r, extra))
+            })
+            .collect()
+    };
     let mut searched = Vec::new();
     let mut extra = 0;
-    for r in results {
+    for r in group(false) {
         let (r, e) = r?;
         searched.push(r);
         extra += e;
+    }
+    if searched.iter().all(|r| r.best.is_none()) {
+        for r in group(true) {
+            let (r, e) = r?;
+            searched.push(r);
+            extra += e;
+        }
     }
     let c = combine(searched);
     let mut out = FitSearch {

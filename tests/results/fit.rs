@@ -283,7 +283,15 @@ fn the_fitted_datapath_meets_its_budget_by_the_oracle_and_is_cheaper() {
         .parse()
         .unwrap();
     let fl = floors(&judge, base.config(), &budget, 20);
-    assert_eq!(fl.len(), 14);
+    // k = 1..7, plain and minimax, and the per-n twins of those where n = 32 squares fewer
+    // than k times (its best m is 32: k = 6 and 7).
+    assert_eq!(fl.iter().filter(|f| !f.per_n).count(), 14);
+    let twins: Vec<(u32, bool)> = fl
+        .iter()
+        .filter(|f| f.per_n)
+        .map(|f| (f.k, f.variant == specfx::pipeline::Variant::Minimax))
+        .collect();
+    assert_eq!(twins, [(6, false), (6, true), (7, false), (7, true)]);
     let found = fit_search(
         &judge,
         base.config(),
@@ -325,6 +333,46 @@ fn the_fitted_datapath_meets_its_budget_by_the_oracle_and_is_cheaper() {
             assert!(!meets(&dp), "{t_line}");
         }
     }
+}
+
+/// Few differing pixels: no fixed-depth algorithm's f64 floor meets 2% on this scene (k = 5
+/// is the best, 2.45%: fewer squarings fit n = 32, more fit n = 512), so the fit goes on to
+/// the per-n depth, whose answer gives each exponent its own m, and meets the budget by the
+/// oracle's image.
+#[test]
+fn a_scene_s_exponents_each_get_their_own_depth_when_the_budget_needs_it() {
+    let scene = Scene::from_toml(SCENE).unwrap();
+    let frags = trace(&scene, &|_, _| {});
+    let base = scene_datapath(&scene);
+    let judge = SceneJudge::new(&scene, &frags, base.config().coef.form);
+    let budget: ImageBudget = "differing <= 2%".parse().unwrap();
+    let fl = floors(&judge, base.config(), &budget, 20);
+    assert!(fl.iter().filter(|f| !f.per_n).all(|f| !f.meets));
+    assert!(fl.iter().any(|f| f.per_n && f.meets));
+    let found = fit_search(
+        &judge,
+        base.config(),
+        &budget,
+        &fl,
+        20,
+        Target::Ice40,
+        &|_| {},
+    )
+    .unwrap();
+    let best = found.best.expect("a per-n datapath meets the budget");
+    let fitted = Datapath::new(best.config.clone()).unwrap();
+    assert!(best.config.has_bypass(), "{}", best.config.to_toml());
+    // n = 32 squares 5 times (m = 32), n = 512 every time.
+    let depths: Vec<u32> = fitted.constants().iter().map(|nc| nc.depth).collect();
+    assert_eq!(depths, [5, best.config.k]);
+    let reference = oracle_image(&frags, &oracle_cos_n(&scene));
+    let image = oracle_image(&frags, &oracle_datapath(&fitted, &scene));
+    let (_, d0) = oracle_figures(&frags, &image, &reference, 0);
+    let (_, d1) = oracle_figures(&frags, &image, &reference, 1);
+    let pixels0 = frags.material.iter().filter(|m| **m == Some(0)).count() as f64;
+    let pixels1 = frags.material.iter().filter(|m| **m == Some(1)).count() as f64;
+    let differing = (d0 * pixels0 + d1 * pixels1) / (pixels0 + pixels1);
+    assert!(differing <= 0.02, "{differing}");
 }
 
 /// An impossible budget: every floor fails it, nothing is searched, nothing fits.
