@@ -213,7 +213,7 @@ pub enum ParamsFormat {
 /// let dp = Datapath::new(Config::baseline()).unwrap();
 /// let flags = render_parameters(&dp, Arch::Pipelined, true, ParamsFormat::Iverilog, "tb");
 /// assert!(flags.starts_with("-Ptb.ARCH=0\n-Ptb.K=4\n"));
-/// assert!(flags.ends_with("-Ptb.RESET_DATA=1\n"));
+/// assert!(flags.ends_with("-Ptb.RESET_DATA=1\n-Ptb.DEPTH_MIN=4\n"));
 /// ```
 pub fn render_parameters(
     dp: &Datapath,
