@@ -133,6 +133,15 @@ fn oracle_figures(f: &Fragments, a: &[[u16; 3]], b: &[[u16; 3]], m: u16) -> (u32
     (max, differing as f64 / pixels as f64)
 }
 
+/// The share of the scene's pixels (materials 0 and 1) whose codes differ between `a` and `b`.
+fn oracle_differing(f: &Fragments, a: &[[u16; 3]], b: &[[u16; 3]]) -> f64 {
+    let (_, d0) = oracle_figures(f, a, b, 0);
+    let (_, d1) = oracle_figures(f, a, b, 1);
+    let pixels0 = f.material.iter().filter(|m| **m == Some(0)).count() as f64;
+    let pixels1 = f.material.iter().filter(|m| **m == Some(1)).count() as f64;
+    (d0 * pixels0 + d1 * pixels1) / (pixels0 + pixels1)
+}
+
 fn scene_datapath(scene: &Scene) -> Datapath {
     let mut cfg = Config::baseline();
     cfg.n = NSet::from_values(&scene.exponents()).unwrap();
@@ -307,11 +316,9 @@ fn the_fitted_datapath_meets_its_budget_by_the_oracle_and_is_cheaper() {
     let reference = oracle_image(&frags, &oracle_cos_n(&scene));
     let meets = |dp: &Datapath| {
         let image = oracle_image(&frags, &oracle_datapath(dp, &scene));
-        let (max0, d0) = oracle_figures(&frags, &image, &reference, 0);
-        let (max1, d1) = oracle_figures(&frags, &image, &reference, 1);
-        let pixels0 = frags.material.iter().filter(|m| **m == Some(0)).count() as f64;
-        let pixels1 = frags.material.iter().filter(|m| **m == Some(1)).count() as f64;
-        let differing = (d0 * pixels0 + d1 * pixels1) / (pixels0 + pixels1);
+        let (max0, _) = oracle_figures(&frags, &image, &reference, 0);
+        let (max1, _) = oracle_figures(&frags, &image, &reference, 1);
+        let differing = oracle_differing(&frags, &image, &reference);
         max0.max(max1) <= 3 && differing <= 0.20 && max1 <= 2
     };
     assert!(meets(&fitted), "{}", best.config.to_toml());
@@ -367,11 +374,7 @@ fn a_scene_s_exponents_each_get_their_own_depth_when_the_budget_needs_it() {
     assert_eq!(depths, [5, best.config.k]);
     let reference = oracle_image(&frags, &oracle_cos_n(&scene));
     let image = oracle_image(&frags, &oracle_datapath(&fitted, &scene));
-    let (_, d0) = oracle_figures(&frags, &image, &reference, 0);
-    let (_, d1) = oracle_figures(&frags, &image, &reference, 1);
-    let pixels0 = frags.material.iter().filter(|m| **m == Some(0)).count() as f64;
-    let pixels1 = frags.material.iter().filter(|m| **m == Some(1)).count() as f64;
-    let differing = (d0 * pixels0 + d1 * pixels1) / (pixels0 + pixels1);
+    let differing = oracle_differing(&frags, &image, &reference);
     assert!(differing <= 0.02, "{differing}");
 }
 
