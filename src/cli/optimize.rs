@@ -66,10 +66,11 @@ pub struct OptimizeArgs {
     #[arg(long)]
     arch: Option<Arch>,
     /// The device every answer must fit (its DSP blocks, LUTs and flip-flops, by the analytic
-    /// model): up5k or hx8k (iCE40), or none to lift the limit. Left out: the iCE40 UP5K when
-    /// the target is ice40, none otherwise.
-    #[arg(long, value_parser = parse_device)]
-    device: Option<Option<Device>>,
+    /// model): up5k (iCE40), or none to lift the limit (hx8k, without DSP blocks, is refused:
+    /// the model maps every multiplier to one). Left out: the iCE40 UP5K when the target is
+    /// ice40, none otherwise.
+    #[arg(long)]
+    device: Option<DeviceLimit>,
     /// Where to write the configuration found (TOML).
     #[arg(long, default_value = "specfx-optimized.toml")]
     out: PathBuf,
@@ -78,14 +79,22 @@ pub struct OptimizeArgs {
     force: bool,
 }
 
-/// Parses `--device`: a device, or `none`.
-fn parse_device(s: &str) -> std::result::Result<Option<Device>, String> {
-    match s.trim() {
-        "none" => Ok(None),
-        other => other
-            .parse::<Device>()
-            .map(Some)
-            .map_err(|e| format!("{e}, or none to lift the limit")),
+/// The value of `--device`: a device every answer must fit, or `none` (no limit). A type of
+/// its own, because clap reads `Option<Option<T>>` as a flag whose value may be left out.
+#[derive(Debug, Clone, Copy)]
+struct DeviceLimit(Option<Device>);
+
+impl std::str::FromStr for DeviceLimit {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<DeviceLimit, String> {
+        match s.trim() {
+            "none" => Ok(DeviceLimit(None)),
+            other => other
+                .parse::<Device>()
+                .map(|d| DeviceLimit(Some(d)))
+                .map_err(|e| format!("{e}, or none to lift the limit")),
+        }
     }
 }
 
@@ -113,7 +122,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     let arch = args.arch.unwrap_or(Arch::Pipelined);
     let target = args.target;
     let device = match args.device {
-        Some(d) => d,
+        Some(DeviceLimit(d)) => d,
         None => (target == Target::Ice40).then_some(Device::Up5k),
     };
     if device.is_some() && target != Target::Ice40 {
@@ -121,6 +130,13 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             "--device: the devices are iCE40s, costed on --target ice40 (got --target {}); give --device none to cost on {} without a device",
             target.name(),
             target.name()
+        );
+    }
+    if let Some(d) = device.filter(|d| d.limits().dsps == 0) {
+        bail!(
+            "--device {}: the {} has no DSP blocks, and the analytic iCE40 model maps every multiplier to one, so no datapath can fit it; give --device up5k, or none to lift the limit",
+            d.name(),
+            d.full_name()
         );
     }
     let fit = device.map(|device| DeviceFit {

@@ -218,6 +218,47 @@ fn defaults_budget_and_output_file() {
     assert!(r.shape_total_max_abs <= 1.0 / 256.0);
 }
 
+/// `--device none` lifts the device limit (the pipelined answer, 5 DSP blocks for k = 5
+/// minimax, is kept though it needs more than the folded one); a device without DSP blocks, on
+/// which the analytic model can fit nothing, and an unknown device are refused with one line.
+#[test]
+fn the_device_limit_is_lifted_or_refused() {
+    let out = temp("nodevice.toml");
+    let o = specfx(&[
+        "optimize",
+        "--n",
+        "64",
+        "--k",
+        "5",
+        "--variants",
+        "minimax",
+        "--device",
+        "none",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("best: k = 5, minimax, pipelined"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("UP5K"), "{stdout}");
+    for (device, expected) in [
+        ("hx8k", "--device hx8k: the iCE40 HX8K has no DSP blocks"),
+        (
+            "ecp5",
+            "unknown device 'ecp5': expected up5k or hx8k, or none",
+        ),
+    ] {
+        let o = specfx(&["optimize", "--device", device, "--out", "/tmp/x.toml"]);
+        assert_eq!(o.status.code(), Some(2), "{device}");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(stderr.contains(expected), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    }
+}
+
 /// With no flag but the goal, the default search (every k and both variants, pruned by their
 /// f64 floors) finds a datapath within 1 lsb8 of cos^n over n = 16..1024, which `specfx check`
 /// confirms; with only plain k = 3..5 (the old default) none exists, and the floors say why.
