@@ -380,12 +380,16 @@ struct CosRow {
 /// not in `c` or its codes): each row is computed once, by the first check that needs it,
 /// from that check's first live code on (a later check with more live codes computes the
 /// extra ones itself). At most `capacity` values are kept (8 bytes each); past that, rows are
-/// computed and not kept. Shared by threads.
+/// computed and not kept. The figures of every configuration checked through the cache are
+/// kept too (a few hundred bytes each, keyed by the whole configuration), so that a search
+/// that meets a candidate again (the optimiser's frontier, one search per budget) does not
+/// check it twice. Shared by threads.
 #[derive(Debug)]
 pub struct CosCache {
     format: std::sync::OnceLock<crate::fixed::Format>,
     rows: std::sync::Mutex<std::collections::BTreeMap<u32, std::sync::Arc<CosRow>>>,
     floors: std::sync::Mutex<std::collections::BTreeMap<FloorKey, (f64, f64)>>,
+    figures: std::sync::Mutex<std::collections::HashMap<String, OutputFigures>>,
     capacity: usize,
     kept: std::sync::atomic::AtomicUsize,
 }
@@ -397,6 +401,7 @@ impl CosCache {
             format: std::sync::OnceLock::new(),
             rows: std::sync::Mutex::new(std::collections::BTreeMap::new()),
             floors: std::sync::Mutex::new(std::collections::BTreeMap::new()),
+            figures: std::sync::Mutex::new(std::collections::HashMap::new()),
             capacity,
             kept: std::sync::atomic::AtomicUsize::new(0),
         }
@@ -495,9 +500,25 @@ pub fn check_outputs_cached(
     dp: &Datapath,
     cache: Option<&CosCache>,
 ) -> Result<OutputFigures, Error> {
-    let shared = code_columns(dp)?;
-    let cache = cache.filter(|c| c.serves(dp));
-    let per_n = map_n(dp, |nc| outputs_one_n(dp, nc, &shared, cache));
+    let Some(cache) = cache.filter(|c| c.serves(dp)) else {
+        return outputs_of(dp, &code_columns(dp)?, None);
+    };
+    let key = dp.config().to_toml();
+    if let Some(&f) = cache.figures.lock().expect("not poisoned").get(&key) {
+        return Ok(f);
+    }
+    let f = outputs_of(dp, &code_columns(dp)?, Some(cache))?;
+    cache.figures.lock().expect("not poisoned").insert(key, f);
+    Ok(f)
+}
+
+/// The output figures of [`check_outputs_cached`], computed.
+fn outputs_of(
+    dp: &Datapath,
+    shared: &CodeColumns,
+    cache: Option<&CosCache>,
+) -> Result<OutputFigures, Error> {
+    let per_n = map_n(dp, |nc| outputs_one_n(dp, nc, shared, cache));
     let mut f = OutputsOfN {
         quant: -1.0,
         approx: -1.0,

@@ -298,10 +298,12 @@ pub fn tradeoff(
     Ok(figures)
 }
 
-/// What determines a trade-off, for its provenance: the exponents and the yosys target.
-pub fn inputs(ns: &NSet, yosys: Option<Target>) -> crate::provenance::Inputs {
+/// What determines a trade-off, for its provenance: the exponents, the frontier's budgets
+/// (lsb8; empty: no frontier) and the yosys target.
+pub fn inputs(ns: &NSet, yosys: Option<Target>, ladder_lsb8: &[f64]) -> crate::provenance::Inputs {
     let inputs = crate::provenance::Inputs::new("tradeoff")
-        .option("n", crate::provenance::canonical_nset(ns));
+        .option("n", crate::provenance::canonical_nset(ns))
+        .option("ladder", ladder_lsb8.to_vec());
     match yosys {
         Some(target) => inputs.option("yosys", target.name()),
         None => inputs,

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use super::Outcome;
@@ -34,6 +34,11 @@ pub struct ReportArgs {
     /// run with the same --out reuses those still true for this build and these tools.
     #[arg(long)]
     restart: bool,
+    /// The error budgets of the trade-off's frontier charts (shape_total, in lsb8): at each,
+    /// every algorithm's cheapest datapath found by the optimiser. A shorter ladder is a
+    /// quicker report.
+    #[arg(long, default_value = "8,4,2,1,0.75,0.5", value_parser = super::tradeoff::parse_ladder)]
+    ladder: super::tradeoff::Ladder,
 }
 
 /// Renders into a buffer and writes it atomically to `dir/name`; returns the path.
@@ -54,6 +59,9 @@ const STEPS: u64 = 12;
 
 /// Runs `specfx report`.
 pub fn run(args: &ReportArgs) -> Result<Outcome> {
+    if args.ladder.0.is_empty() {
+        bail!("--ladder: the report charts the frontier; expected at least one budget in lsb8 (e.g. 1)");
+    }
     let (out_dir, resumed) = specfx::output::OutDir::begin_resumable(
         &args.out,
         "report",
@@ -69,7 +77,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     let sims = r.simulate(&dp)?;
     let costs = r.costs(&dp)?;
     let budget = r.budget(&dp)?;
-    let figures = r.tradeoff()?;
+    let figures = r.tradeoff(&args.ladder.0)?;
     let stability = r.stability()?;
     let scene = specfx::scene::Scene::default_scene();
     let render = r.render(&scene)?;
@@ -79,8 +87,9 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     r.resume.finish()?;
     // Everything the report computes is built in: its inputs are the command alone (and the
     // version, which fixes the built-in configurations, scene and settings).
-    let provenance =
-        specfx::provenance::Provenance::new(&specfx::provenance::Inputs::new("report"));
+    let provenance = specfx::provenance::Provenance::new(
+        &specfx::provenance::Inputs::new("report").option("ladder", args.ladder.0.clone()),
+    );
     super::output::write_provenance(r.dir, &provenance)?;
     r.written.push(r.dir.join(INPUTS_FILE));
     r.written.push(r.dir.join(PROVENANCE_FILE));
@@ -154,8 +163,9 @@ impl<'a> Report<'a> {
         let nextpnr_version = specfx::tools::version("nextpnr-ice40", "--version");
         let hdl = super::hdl_ref::hdl_ref_dir(None);
         let key = super::resume::run_key(&format!(
-            "yosys {yosys_version:?}\nnextpnr-ice40 {nextpnr_version:?}\nhdl_ref {}",
-            hdl.display()
+            "yosys {yosys_version:?}\nnextpnr-ice40 {nextpnr_version:?}\nhdl_ref {}\nladder {:?}",
+            hdl.display(),
+            args.ladder.0
         ));
         let resume = super::resume::Resume::open(dir, key, resumed)?;
         if resumed {
@@ -339,7 +349,7 @@ impl<'a> Report<'a> {
         Ok(budget)
     }
 
-    fn tradeoff(&mut self) -> Result<Vec<FigureRow>> {
+    fn tradeoff(&mut self, ladder: &[f64]) -> Result<Vec<FigureRow>> {
         self.steps
             .start("speed against accuracy of every method (the trade-off charts)");
         let tradeoff_dir = self.dir.join("tradeoff");
@@ -349,6 +359,7 @@ impl<'a> Report<'a> {
                 &tradeoff_dir,
                 &specfx::nset::NSet::range(16, 1024)?,
                 yosys.then_some(specfx::hdl::cost::Target::Ice40),
+                ladder,
             )?;
             Ok(figures
                 .into_iter()
@@ -365,6 +376,7 @@ impl<'a> Report<'a> {
             "tradeoff",
             [
                 "tradeoff.csv",
+                "frontier.csv",
                 "measured_speed_accuracy.png",
                 "error_vs_n.png",
             ]

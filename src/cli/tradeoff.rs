@@ -8,6 +8,7 @@ use clap::Args;
 
 use super::output::print_json;
 use super::Outcome;
+use specfx::analysis::frontier::{self as fr, Frontier};
 use specfx::analysis::tradeoff::{inputs, method_count, MethodFigures, YosysFigures};
 use specfx::cycle::Arch;
 use specfx::nset::NSet;
@@ -33,18 +34,69 @@ pub struct TradeoffArgs {
     /// generic, generic-fast): a few seconds each.
     #[arg(long)]
     yosys: Option<specfx::hdl::cost::Target>,
+    /// The error budgets of the frontier (shape_total, in lsb8): at each, every algorithm's
+    /// cheapest datapath found by the optimiser (pipelined, no device limit), charted against
+    /// its cost; none skips the frontier and its charts (minutes on 2 cores for the default
+    /// over n = 16..1024).
+    #[arg(long, default_value = "8,4,2,1,0.75,0.5", value_parser = parse_ladder)]
+    ladder: Ladder,
     /// Print the figures as JSON on stdout.
     #[arg(long)]
     json: bool,
 }
 
-/// Computes every method's figures (with yosys figures of the datapaths for `yosys`) and
-/// writes CSV, JSON and charts into `dir`.
+/// The budgets of `--ladder`, in lsb8 (empty: no frontier).
+#[derive(Debug, Clone)]
+pub struct Ladder(pub Vec<f64>);
+
+/// Parses `--ladder`: budgets in lsb8 joined by commas, each positive, or `none`.
+pub fn parse_ladder(s: &str) -> std::result::Result<Ladder, String> {
+    if s.trim() == "none" {
+        return Ok(Ladder(Vec::new()));
+    }
+    s.split(',')
+        .map(|b| match b.trim().parse::<f64>() {
+            Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
+            _ => Err(format!(
+                "expected budgets in lsb8 joined by commas, each a positive number (e.g. 8,4,2,1), or none; got '{}'",
+                b.trim()
+            )),
+        })
+        .collect::<std::result::Result<Vec<f64>, String>>()
+        .map(Ladder)
+}
+
+/// The frontier of the optimiser's cheapest datapaths over `ladder` (none when it is empty),
+/// with a progress bar.
+pub fn frontier(ns: &NSet, ladder: &[f64]) -> Result<Option<Frontier>> {
+    if ladder.is_empty() {
+        return Ok(None);
+    }
+    let base = fr::tradeoff_base(ns);
+    let floors = fr::frontier_floors(&base, ladder)?;
+    let bar = super::progress::Progress::new(
+        "tradeoff frontier",
+        "searches",
+        fr::rung_count(&floors, ladder) as u64,
+    );
+    let f = fr::frontier(&base, floors, ladder, Arch::Pipelined, &|a, b| {
+        log::debug!("tradeoff frontier: {a} at {b} lsb8 searched");
+        bar.inc(1);
+    })?;
+    bar.finish();
+    Ok(Some(f))
+}
+
+/// Computes every method's figures (with yosys figures of the datapaths for `yosys`) and the
+/// frontier over `ladder` (none when it is empty), and writes CSV, JSON and charts into
+/// `dir`.
 pub fn tradeoff(
     dir: &std::path::Path,
     ns: &NSet,
     yosys: Option<specfx::hdl::cost::Target>,
+    ladder: &[f64],
 ) -> Result<Vec<MethodFigures>> {
+    let frontier = frontier(ns, ladder)?;
     // The wall clock the library leaves to its callers.
     let mut time_it = |work: &mut dyn FnMut()| {
         let start = std::time::Instant::now();
@@ -78,15 +130,18 @@ pub fn tradeoff(
         },
     )?;
     bar.finish();
-    let provenance = Provenance::new(&inputs(ns, yosys));
-    write_all_in(dir, &tradeoff_files(&figures, ns.values(), &provenance)?)?;
+    let provenance = Provenance::new(&inputs(ns, yosys, ladder));
+    write_all_in(
+        dir,
+        &tradeoff_files(&figures, frontier.as_ref(), ns.values(), &provenance)?,
+    )?;
     Ok(figures)
 }
 
 /// Runs `specfx tradeoff`.
 pub fn run(args: &TradeoffArgs) -> Result<Outcome> {
     let out_dir = specfx::output::OutDir::begin(&args.out, "tradeoff", args.force, &[])?;
-    let figures = tradeoff(out_dir.path(), &args.n, args.yosys)?;
+    let figures = tradeoff(out_dir.path(), &args.n, args.yosys, &args.ladder.0)?;
     out_dir.commit()?;
     if args.json {
         print_json(&figures)?;

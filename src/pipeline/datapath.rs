@@ -978,7 +978,9 @@ impl Datapath {
             &mut s.sums,
             &mut counts,
         );
-        if let Some(table) = self.chain_table(nc.depth).filter(|_| tabulate) {
+        // Only where tabulating is asked for: building the table costs a pass over every b
+        // code and squaring stage, which an untabulated evaluation exists to avoid.
+        if let Some(table) = tabulate.then(|| self.chain_table(nc.depth)).flatten() {
             for (sq, &b) in s.b.iter_mut().zip(&s.a) {
                 *sq = table.last[(b - table.b_min) as usize];
             }

@@ -4,11 +4,13 @@
 
 use std::io::{self, Write};
 
+use crate::analysis::frontier::{algorithm_name, Frontier, FrontierPoint};
 use crate::analysis::tradeoff::MethodFigures;
 use crate::analysis::LSB8;
 use crate::csv_dialect::CsvWriter;
 use crate::error::Error;
 use crate::hdl::cost::{CostFigures, Target};
+use crate::hdl::pnr::Device;
 use crate::provenance::Provenance;
 use crate::report::chart::{front_2d, Chart, Dash, Marker, RefLine, Series};
 use crate::report::table::{Align, TextTable};
@@ -124,6 +126,9 @@ pub fn write_table(
 /// A hardware cost axis of the trade-off.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CostAxis {
+    /// What the optimiser minimises on iCE40: LUTs plus each DSP block weighed as the logic
+    /// its product would take ([`crate::hdl::cost::objective_value`]).
+    Objective,
     /// Logic cells on a target (LUTs; gates for generic).
     Logic(Target),
     /// DSP blocks on a target.
@@ -136,7 +141,8 @@ pub enum CostAxis {
 
 impl CostAxis {
     /// The cost charts the trade-off draws, and their file stems.
-    pub const CHARTS: [(CostAxis, &'static str); 6] = [
+    pub const CHARTS: [(CostAxis, &'static str); 7] = [
+        (CostAxis::Objective, "error_vs_cost_ice40"),
         (CostAxis::Logic(Target::Ice40), "error_vs_luts_ice40"),
         (CostAxis::Dsps(Target::Ice40), "error_vs_dsps_ice40"),
         (CostAxis::Logic(Target::Xilinx), "error_vs_luts_xilinx"),
@@ -145,19 +151,48 @@ impl CostAxis {
         (CostAxis::Latency, "error_vs_latency"),
     ];
 
-    fn of(self, f: &MethodFigures) -> Option<f64> {
-        let on =
-            |t: Target| -> Option<CostFigures> { f.costs.iter().find(|c| c.target == t).copied() };
+    fn of(self, p: &FrontierPoint) -> Option<f64> {
         match self {
-            CostAxis::Logic(t) => on(t).map(|c| c.luts as f64),
-            CostAxis::Dsps(t) => on(t).map(|c| c.dsps as f64),
-            CostAxis::Ffs(t) => on(t).map(|c| c.ffs as f64),
-            CostAxis::Latency => f.latency.map(|l| l as f64),
+            CostAxis::Objective => Some(p.objective),
+            CostAxis::Logic(t) => p.cost_on(t).map(|c| c.luts as f64),
+            CostAxis::Dsps(t) => p.cost_on(t).map(|c| c.dsps as f64),
+            CostAxis::Ffs(t) => p.cost_on(t).map(|c| c.ffs as f64),
+            CostAxis::Latency => Some(p.latency as f64),
         }
+    }
+
+    /// The axis in a few words, for a title.
+    fn short(self) -> String {
+        match self {
+            CostAxis::Objective => "iCE40 LUT-equivalents".into(),
+            CostAxis::Logic(t) => format!("{} {}", t.name(), t.logic_unit()),
+            CostAxis::Dsps(t) => format!("{} DSP blocks", t.name()),
+            CostAxis::Ffs(t) => format!("{} flip-flops", t.name()),
+            CostAxis::Latency => "latency".into(),
+        }
+    }
+
+    /// The device limit drawn on the axis: the iCE40 UP5K's resources on the iCE40 axes.
+    fn device_limit(self) -> Option<RefLine> {
+        let l = Device::Up5k.limits();
+        let (at, what) = match self {
+            CostAxis::Logic(Target::Ice40) => (l.luts, "LUTs"),
+            CostAxis::Dsps(Target::Ice40) => (l.dsps, "DSPs"),
+            CostAxis::Ffs(Target::Ice40) => (l.ffs, "flip-flops"),
+            _ => return None,
+        };
+        Some(RefLine {
+            at: at as f64,
+            label: format!("{}: {at} {what}", Device::Up5k.full_name()),
+        })
     }
 
     fn label(self) -> String {
         match self {
+            CostAxis::Objective => format!(
+                "analytic LUT-equivalents on ice40 (LUTs + {:.0} per DSP block: what the optimiser minimises)",
+                crate::hdl::cost::dsp_weight(Target::Ice40)
+            ),
             CostAxis::Logic(t) => format!(
                 "analytic {} on {} (calibrated against yosys)",
                 t.logic_unit(),
@@ -170,22 +205,42 @@ impl CostAxis {
     }
 }
 
-/// Chart of error (lsb8, log) against one hardware cost: one labelled point per fixed-point
-/// datapath, the Pareto front (no datapath both cheaper and more accurate) as a line, and the
-/// 1 lsb8 line.
-pub fn cost_chart(figures: &[MethodFigures], axis: CostAxis) -> Chart {
-    let pts: Vec<(&str, f64, f64)> = figures
-        .iter()
-        .filter_map(|f| {
-            axis.of(f)
-                .map(|x| (f.method.as_str(), x, f.max_abs_err / LSB8))
-        })
-        .collect();
-    let front = front_2d(&pts.iter().map(|&(_, x, y)| (x, y)).collect::<Vec<_>>());
-    let mut series: Vec<Series> = pts
-        .iter()
+/// Chart of the reachable frontier against one hardware cost: for each algorithm, a line
+/// through the optimiser's cheapest datapath at each budget of the ladder (its achieved error,
+/// lsb8, log scale), the Pareto front across every algorithm (no point both cheaper and more
+/// accurate), the 1 lsb8 line and, on the iCE40 axes, the UP5K's limit.
+pub fn cost_chart(frontier: &Frontier, axis: CostAxis) -> Chart {
+    let mut curves: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for p in &frontier.points {
+        let Some(x) = axis.of(p) else { continue };
+        let name = algorithm_name(p.algorithm);
+        let y = p.shape_total / LSB8;
+        match curves.last_mut() {
+            Some((n, pts)) if *n == name => pts.push((x, y)),
+            _ => curves.push((name, vec![(x, y)])),
+        }
+    }
+    let all: Vec<(f64, f64)> = curves.iter().flat_map(|(_, p)| p.iter().copied()).collect();
+    let front = front_2d(&all);
+    // The device's limit as a line where it is within reach of the points; said in the
+    // axis's label where it would squeeze them against the left edge.
+    let widest = all.iter().map(|p| p.0).fold(0.0, f64::max);
+    let mut x_label = axis.label();
+    let mut x_ref_lines = Vec::new();
+    if let Some(limit) = axis.device_limit() {
+        if limit.at <= 2.0 * widest {
+            x_ref_lines.push(limit);
+        } else {
+            x_label = format!("{x_label}; {}, far right", limit.label);
+        }
+    }
+    let mut series: Vec<Series> = curves
+        .into_iter()
         .enumerate()
-        .map(|(i, &(name, x, y))| Series::styled(name, vec![(x, y)], false, i + 1))
+        .map(|(i, (name, mut points))| {
+            points.dedup();
+            Series::styled(&name, points, true, i + 1)
+        })
         .collect();
     series.push(Series {
         label: "Pareto front".into(),
@@ -197,26 +252,86 @@ pub fn cost_chart(figures: &[MethodFigures], axis: CostAxis) -> Chart {
         ..Series::default()
     });
     Chart {
-        title: format!("Error against {}", axis.label()),
-        x_label: axis.label(),
-        y_label: "max |fixed lobe - cos^n| over n = 16..1024 (lsb8 = 2^-8, log scale)".into(),
+        title: format!(
+            "Least hardware reaching each accuracy, {} ({})",
+            axis.short(),
+            frontier.arch
+        ),
+        x_label,
+        y_label: format!(
+            "max |fixed lobe - cos^n| (lsb8 = 2^-8, log); budgets {} lsb8",
+            frontier
+                .ladder_lsb8
+                .iter()
+                .map(|b| b.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
         log_y: true,
         x_integer: true,
-        direct_labels: true,
+        direct_labels: false,
         ref_lines: vec![RefLine {
             at: 1.0,
             label: "1 lsb8".into(),
         }],
-        x_ref_lines: match axis {
-            CostAxis::Dsps(Target::Ice40) => vec![RefLine {
-                at: 8.0,
-                label: "iCE40 UP5K has 8".into(),
-            }],
-            _ => Vec::new(),
-        },
+        x_ref_lines,
         series,
         ..Chart::default()
     }
+}
+
+/// Writes `frontier.csv`: one row per point of the frontier (algorithm, budget, the budget
+/// whose search found it, its error, the optimiser's objective, its analytic cost on every
+/// target and its latency).
+pub fn write_frontier_csv(w: &mut impl Write, frontier: &Frontier) -> io::Result<()> {
+    let mut csv = CsvWriter::new(w);
+    csv.record([
+        "algorithm",
+        "k",
+        "variant",
+        "depth",
+        "arch",
+        "budget_lsb8",
+        "found_at_lsb8",
+        "shape_total",
+        "shape_total_lsb8",
+        "objective_ice40",
+        "ice40_luts",
+        "ice40_dsps",
+        "ice40_ffs",
+        "xilinx_luts",
+        "xilinx_dsps",
+        "xilinx_ffs",
+        "generic_gates",
+        "generic_ffs",
+        "latency",
+    ])?;
+    let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
+    for p in &frontier.points {
+        let a = p.algorithm;
+        csv.record([
+            algorithm_name(a),
+            a.k.to_string(),
+            a.variant.name().to_string(),
+            a.depth().name().to_string(),
+            frontier.arch.to_string(),
+            p.budget_lsb8.to_string(),
+            p.found_at_lsb8.to_string(),
+            format!("{:e}", p.shape_total),
+            format!("{:.4}", p.shape_total / LSB8),
+            format!("{:.0}", p.objective),
+            opt(p.cost_on(Target::Ice40).map(|c| c.luts)),
+            opt(p.cost_on(Target::Ice40).map(|c| c.dsps)),
+            opt(p.cost_on(Target::Ice40).map(|c| c.ffs)),
+            opt(p.cost_on(Target::Xilinx).map(|c| c.luts)),
+            opt(p.cost_on(Target::Xilinx).map(|c| c.dsps)),
+            opt(p.cost_on(Target::Xilinx).map(|c| c.ffs)),
+            opt(p.cost_on(Target::Generic).map(|c| c.luts)),
+            opt(p.cost_on(Target::Generic).map(|c| c.ffs)),
+            p.latency.to_string(),
+        ])?;
+    }
+    csv.finish().map(drop)
 }
 
 /// Chart of accuracy against speed: one point per method.
@@ -284,10 +399,11 @@ pub fn per_n_chart(figures: &[MethodFigures], ns: &[u32], names: &[&str]) -> Cha
 }
 
 /// Every file of a trade-off's directory, provenance included, rendered in memory: the table
-/// (CSV, JSON), the cost charts, and apart the wall-clock measurements of this run (every
-/// other file is the same on every run).
+/// (CSV, JSON), the frontier (CSV, JSON) and its cost charts when it was computed, and apart
+/// the wall-clock measurements of this run (every other file is the same on every run).
 pub fn tradeoff_files(
     figures: &[MethodFigures],
+    frontier: Option<&Frontier>,
     ns: &[u32],
     provenance: &Provenance,
 ) -> Result<Vec<File>, Error> {
@@ -295,8 +411,15 @@ pub fn tradeoff_files(
         ("tradeoff.csv".into(), in_memory(|w| write_csv(w, figures))),
         json_file("tradeoff.json", &figures)?,
     ];
-    for (axis, stem) in CostAxis::CHARTS {
-        files.extend(chart_files(stem, &cost_chart(figures, axis))?.1);
+    if let Some(frontier) = frontier {
+        files.push((
+            "frontier.csv".into(),
+            in_memory(|w| write_frontier_csv(w, frontier)),
+        ));
+        files.push(json_file("frontier.json", frontier)?);
+        for (axis, stem) in CostAxis::CHARTS {
+            files.extend(chart_files(stem, &cost_chart(frontier, axis))?.1);
+        }
     }
     files.push((
         "measured_speed.csv".into(),
