@@ -252,11 +252,19 @@ pub fn cost_chart(frontier: &Frontier, axis: CostAxis) -> Chart {
         ..Series::default()
     });
     Chart {
-        title: format!(
-            "Least hardware reaching each accuracy, {} ({})",
-            axis.short(),
-            frontier.arch
-        ),
+        title: match axis {
+            CostAxis::Objective => format!(
+                "Least hardware reaching each accuracy, {} ({})",
+                axis.short(),
+                frontier.arch
+            ),
+            // The points minimise the LUT-equivalents: on another axis a curve may turn back.
+            _ => format!(
+                "The same cheapest datapaths (by LUT-equivalents) against {} ({})",
+                axis.short(),
+                frontier.arch
+            ),
+        },
         x_label,
         y_label: format!(
             "max |fixed lobe - cos^n| (lsb8 = 2^-8, log); budgets {} lsb8",

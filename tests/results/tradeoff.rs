@@ -20,7 +20,7 @@ fn tradeoff_json(tag: &str, args: &[&str]) -> (serde_json::Value, std::path::Pat
 
 #[test]
 fn tradeoff_lists_every_method_with_figures_that_hold() {
-    let (v, dir) = tradeoff_json("all", &["--n", "64,256"]);
+    let (v, dir) = tradeoff_json("all", &["--n", "64,256", "--ladder", "none"]);
     let list = v.as_array().unwrap();
     let names: Vec<&str> = list.iter().map(|m| m["method"].as_str().unwrap()).collect();
     for want in [
@@ -85,6 +85,7 @@ fn tradeoff_lists_every_method_with_figures_that_hold() {
         got >= brute - 1e-12 && got - brute < 1e-6,
         "{got} vs {brute}"
     );
+    assert!(!dir.join("frontier.csv").exists());
     for file in [
         "tradeoff.csv",
         "tradeoff.json",
@@ -109,7 +110,10 @@ fn tradeoff_lists_every_method_with_figures_that_hold() {
 fn tradeoff_synthesises_the_datapaths_with_yosys_on_request() {
     // `./scripts/test` installs yosys. Wider squares cost more logic: the 16-bit squares'
     // datapath needs more iCE40 LUTs than the 8-bit one, and only datapaths are synthesised.
-    let (v, dir) = tradeoff_json("yosys", &["--n", "64", "--yosys", "ice40"]);
+    let (v, dir) = tradeoff_json(
+        "yosys",
+        &["--n", "64", "--yosys", "ice40", "--ladder", "none"],
+    );
     let list = v.as_array().unwrap();
     let luts = |name: &str| {
         let m = list.iter().find(|m| m["method"] == name).unwrap();
@@ -166,4 +170,143 @@ fn tradeoff_files_are_the_same_bytes_on_every_run() {
     for (x, y) in a.iter().zip(&b) {
         assert!(x.1 == y.1, "{} differs between runs", x.0);
     }
+}
+
+/// The frontier: every point is proved within its budget by the test oracle's own evaluation
+/// (the cheapest point within 1 lsb8) and by `specfx check` (every point), is what
+/// `specfx optimize` answers for its algorithm and budget (or a tighter budget's cheaper
+/// answer), never costs more for a looser budget, and is missing exactly where the
+/// algorithm's f64 floor is above the budget or no datapath was found.
+#[test]
+fn the_frontier_is_the_optimisers_answer_within_each_budget() {
+    use specfx::pipeline::{Config, Datapath};
+    let (_, dir) = tradeoff_json("frontier", &["--n", "64,256", "--ladder", "2,1"]);
+    let f: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("frontier.json")).unwrap()).unwrap();
+    let points = f["points"].as_array().unwrap();
+    let csv = std::fs::read_to_string(dir.join("frontier.csv")).unwrap();
+    assert_eq!(csv.lines().count(), points.len() + 1);
+    for stem in [
+        "error_vs_cost_ice40",
+        "error_vs_dsps_ice40",
+        "error_vs_luts_ice40",
+    ] {
+        assert!(dir.join(format!("{stem}.png")).is_file(), "{stem}");
+    }
+    let lsb8 = 1.0 / 256.0;
+    let name = |a: &serde_json::Value| {
+        format!(
+            "{}{}{}",
+            a["variant"].as_str().unwrap().to_lowercase(),
+            a["k"],
+            if a["per_n"].as_bool().unwrap() {
+                "_per_n"
+            } else {
+                ""
+            }
+        )
+    };
+    // Present exactly where the floor allows (every algorithm with a floor within 2 lsb8
+    // has some datapath within the budget at n = 64, 256: at least its start point).
+    for floor in f["floors"].as_array().unwrap() {
+        let Some(x) = floor["shape_total"].as_f64() else {
+            continue;
+        };
+        for b in [2.0, 1.0] {
+            let has = points.iter().any(|p| {
+                name(&p["algorithm"]) == name(&floor["algorithm"]) && p["budget_lsb8"] == b
+            });
+            assert_eq!(
+                has,
+                x <= b * lsb8,
+                "{} at {b}: floor {x}",
+                name(&floor["algorithm"])
+            );
+        }
+    }
+    let mut cheapest: Option<(f64, &serde_json::Value)> = None;
+    for p in points {
+        let b = p["budget_lsb8"].as_f64().unwrap();
+        let total = p["shape_total"].as_f64().unwrap();
+        assert!(total <= b * lsb8, "{p}");
+        let cfg = Config::from_toml(p["config_toml"].as_str().unwrap()).unwrap();
+        let r = specfx::analysis::check::check(&Datapath::new(cfg).unwrap()).unwrap();
+        assert_eq!(r.shape_total_max_abs, total, "{}", name(&p["algorithm"]));
+        let cost = p["objective"].as_f64().unwrap();
+        if b == 1.0 && cheapest.is_none_or(|(c, _)| cost < c) {
+            cheapest = Some((cost, p));
+        }
+        // A looser budget never costs more.
+        if b == 2.0 {
+            if let Some(tighter) = points
+                .iter()
+                .find(|q| q["algorithm"] == p["algorithm"] && q["budget_lsb8"] == 1.0)
+            {
+                assert!(cost <= tighter["objective"].as_f64().unwrap(), "{p}");
+            }
+        }
+    }
+    // The cheapest point within 1 lsb8, evaluated by the oracle on every code of both n.
+    let (cost, p) = cheapest.expect("a point within 1 lsb8");
+    let cfg = Config::from_toml(p["config_toml"].as_str().unwrap()).unwrap();
+    let dp = Datapath::new(cfg.clone()).unwrap();
+    let k = cfg.k as usize;
+    let lsb_c = cfg.c.format.lsb();
+    let lsb_s = cfg.square[k - 1].format.lsb();
+    let mut worst: f64 = 0.0;
+    for n in [64u32, 256] {
+        let nc = dp.constants_for(n).unwrap();
+        for c in 0..=dp.one_code() {
+            let lobe = crate::common::oracle::oracle_eval(&cfg, nc, c).values[2 + k] as f64 * lsb_s;
+            let cos = (c as f64 * lsb_c).powi(n as i32);
+            worst = worst.max((lobe - cos).abs());
+        }
+    }
+    assert!(worst <= lsb8, "{worst}");
+    assert!(
+        (worst - p["shape_total"].as_f64().unwrap()).abs() < 1e-12,
+        "{worst} vs {p}"
+    );
+    // `specfx optimize` for that algorithm and budget answers the same cost (or a dearer one
+    // when the point is a tighter budget's answer).
+    let a = &p["algorithm"];
+    let out = dir.join("opt.toml");
+    let o = crate::common::specfx(&[
+        "optimize",
+        "--n",
+        "64,256",
+        "--budget",
+        "shape_total <= 1 lsb8",
+        "--k",
+        &a["k"].to_string(),
+        "--variants",
+        &a["variant"].as_str().unwrap().to_lowercase(),
+        "--depth",
+        if a["per_n"].as_bool().unwrap() {
+            "best"
+        } else {
+            "fixed"
+        },
+        "--arch",
+        "pipelined",
+        "--device",
+        "none",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let answered: f64 = stdout
+        .split("pipelined, ")
+        .nth(1)
+        .and_then(|rest| rest.split(": ").nth(1))
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no cost in {stdout}"));
+    if p["found_at_lsb8"] == p["budget_lsb8"] {
+        assert_eq!(answered, cost.round(), "{stdout}");
+    } else {
+        assert!(answered >= cost.round(), "{stdout}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

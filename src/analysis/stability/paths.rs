@@ -49,12 +49,14 @@ impl FloatPath {
     }
 
     /// The float paths the map covers by default: powf (f64 and f32), powi, Schlick,
-    /// exp(-n(1-c)), cs_m for k = 1..7 with every cutoff, minimax for k = 1..7.
+    /// exp(-n(1-c)), cs_m for k = 1..7 with every cutoff, minimax for k = 1..7, and minimax
+    /// with a per-n depth up to m = 64 (each n at its best m(n): the 0.5 lsb8 family; missing
+    /// past the minimax table's last n).
     ///
     /// # Examples
     /// ```
     /// use specfx::analysis::stability::FloatPath;
-    /// assert_eq!(FloatPath::default_set().len(), 5 + 7 * 3 + 7);
+    /// assert_eq!(FloatPath::default_set().len(), 5 + 7 * 3 + 7 + 1);
     /// ```
     pub fn default_set() -> Vec<FloatPath> {
         let mut v = vec![
@@ -72,6 +74,7 @@ impl FloatPath {
         for k in crate::reference::lobe::K_RANGE {
             v.push(FloatPath::Method(Method::Minimax { k }));
         }
+        v.push(FloatPath::Method(Method::MinimaxPerN { k: 6 }));
         v
     }
 
