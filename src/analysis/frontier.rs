@@ -15,7 +15,7 @@ use crate::cycle::Arch;
 use crate::error::Error;
 use crate::hdl::cost::{analytic_cost, figures_on_targets, objective_value, CostFigures, Target};
 use crate::nset::NSet;
-use crate::pipeline::{Config, Datapath, Variant};
+use crate::pipeline::{Config, Datapath};
 
 /// The budgets of the frontier, in lsb8 of `shape_total` (the lobe against cos^n): from
 /// eight display steps down to half of one.
@@ -106,13 +106,7 @@ pub fn tradeoff_base(ns: &NSet) -> Config {
 /// ([`rung_count`]).
 pub fn frontier_floors(base: &Config, ladder_lsb8: &[f64]) -> Result<Vec<AlgorithmFloor>, Error> {
     let loosest = ladder_lsb8.iter().copied().fold(0.0, f64::max);
-    let ks: Vec<u32> = crate::reference::lobe::K_RANGE.collect();
-    let algorithms = Algorithm::all(
-        base,
-        &ks,
-        &[Variant::Plain, Variant::Minimax],
-        &[false, true],
-    );
+    let algorithms = Algorithm::every(base);
     Ok(algorithm_floors(
         base,
         &rung_budget(loosest, Arch::Pipelined)?,

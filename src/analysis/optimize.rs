@@ -782,6 +782,20 @@ impl Algorithm {
     }
 }
 
+impl Algorithm {
+    /// Every algorithm of the library: plain and minimax, k = 1..7, fixed and per-n depth
+    /// ([`Algorithm::all`], per-n ones left out where they would be their fixed twin).
+    pub fn every(base: &Config) -> Vec<Algorithm> {
+        let ks: Vec<u32> = crate::reference::lobe::K_RANGE.collect();
+        Algorithm::all(
+            base,
+            &ks,
+            &[Variant::Plain, Variant::Minimax],
+            &[false, true],
+        )
+    }
+}
+
 impl fmt::Display for Algorithm {
     /// `k = 6 minimax`, or `k = 6 minimax, per-n depth`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -21,55 +21,75 @@ fn cost_on(f: &MethodFigures, t: Target) -> Option<CostFigures> {
     f.costs.iter().find(|c| c.target == t).copied()
 }
 
+/// The analytic cost columns of the trade-off's CSV files, [`cost_cells`]'s order.
+const COST_COLUMNS: [&str; 8] = [
+    "ice40_luts",
+    "ice40_dsps",
+    "ice40_ffs",
+    "xilinx_luts",
+    "xilinx_dsps",
+    "xilinx_ffs",
+    "generic_gates",
+    "generic_ffs",
+];
+
+/// The cells of [`COST_COLUMNS`] for analytic figures on the targets (empty where a target has
+/// none).
+fn cost_cells(costs: &[CostFigures]) -> [String; 8] {
+    let on = |t: Target| costs.iter().find(|c| c.target == t);
+    let cell =
+        |t: Target, v: fn(&CostFigures) -> u64| on(t).map_or(String::new(), |c| v(c).to_string());
+    [
+        cell(Target::Ice40, |c| c.luts),
+        cell(Target::Ice40, |c| c.dsps),
+        cell(Target::Ice40, |c| c.ffs),
+        cell(Target::Xilinx, |c| c.luts),
+        cell(Target::Xilinx, |c| c.dsps),
+        cell(Target::Xilinx, |c| c.ffs),
+        cell(Target::Generic, |c| c.luts),
+        cell(Target::Generic, |c| c.ffs),
+    ]
+}
+
 /// Writes `tradeoff.csv`: one row per method, its errors (also in lsb8), multipliers, the
 /// analytic cost on each target, the latency and yosys's figures (empty cells where a method
 /// has none). Nothing measured: the same bytes on every run.
 pub fn write_csv(w: &mut impl Write, figures: &[MethodFigures]) -> io::Result<()> {
     let mut csv = CsvWriter::new(w);
-    csv.record([
+    let head = [
         "method",
         "kind",
         "max_abs_err",
         "max_err_lsb8",
         "mean_abs_err",
         "multipliers",
-        "ice40_luts",
-        "ice40_dsps",
-        "ice40_ffs",
-        "xilinx_luts",
-        "xilinx_dsps",
-        "xilinx_ffs",
-        "generic_gates",
-        "generic_ffs",
+    ];
+    let tail = [
         "latency",
         "yosys_target",
         "yosys_luts",
         "yosys_dsps",
         "yosys_ffs",
-    ])?;
+    ];
+    csv.record(head.into_iter().chain(COST_COLUMNS).chain(tail))?;
     let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
     for f in figures {
-        csv.record([
+        let head = [
             f.method.clone(),
             f.kind.to_string(),
             format!("{:e}", f.max_abs_err),
             format!("{:e}", f.max_abs_err / LSB8),
             format!("{:e}", f.mean_abs_err),
             opt(f.multipliers.map(u64::from)),
-            opt(cost_on(f, Target::Ice40).map(|c| c.luts)),
-            opt(cost_on(f, Target::Ice40).map(|c| c.dsps)),
-            opt(cost_on(f, Target::Ice40).map(|c| c.ffs)),
-            opt(cost_on(f, Target::Xilinx).map(|c| c.luts)),
-            opt(cost_on(f, Target::Xilinx).map(|c| c.dsps)),
-            opt(cost_on(f, Target::Xilinx).map(|c| c.ffs)),
-            opt(cost_on(f, Target::Generic).map(|c| c.luts)),
-            opt(cost_on(f, Target::Generic).map(|c| c.ffs)),
+        ];
+        let tail = [
             opt(f.latency),
             f.yosys.as_ref().map_or(String::new(), |y| y.target.clone()),
             opt(f.yosys.as_ref().map(|y| y.luts)),
             opt(f.yosys.as_ref().map(|y| y.dsps)),
             opt(f.yosys.as_ref().map(|y| y.ffs)),
-        ])?;
+        ];
+        csv.record(head.into_iter().chain(cost_cells(&f.costs)).chain(tail))?;
     }
     csv.finish().map(drop)
 }
@@ -293,51 +313,42 @@ pub fn cost_chart(frontier: &Frontier, axis: CostAxis) -> Chart {
 /// target and its latency).
 pub fn write_frontier_csv(w: &mut impl Write, frontier: &Frontier) -> io::Result<()> {
     let mut csv = CsvWriter::new(w);
-    csv.record([
-        "algorithm",
-        "k",
-        "variant",
-        "depth",
-        "arch",
-        "budget_lsb8",
-        "found_at_lsb8",
-        "shape_total",
-        "shape_total_lsb8",
-        "objective_ice40",
-        "ice40_luts",
-        "ice40_dsps",
-        "ice40_ffs",
-        "xilinx_luts",
-        "xilinx_dsps",
-        "xilinx_ffs",
-        "generic_gates",
-        "generic_ffs",
-        "latency",
-    ])?;
-    let opt = |x: Option<u64>| x.map_or(String::new(), |v| v.to_string());
+    csv.record(
+        [
+            "algorithm",
+            "k",
+            "variant",
+            "depth",
+            "arch",
+            "budget_lsb8",
+            "found_at_lsb8",
+            "shape_total",
+            "shape_total_lsb8",
+            "objective_ice40",
+        ]
+        .into_iter()
+        .chain(COST_COLUMNS)
+        .chain(["latency"]),
+    )?;
     for p in &frontier.points {
         let a = p.algorithm;
-        csv.record([
-            algorithm_name(a),
-            a.k.to_string(),
-            a.variant.name().to_string(),
-            a.depth().name().to_string(),
-            frontier.arch.to_string(),
-            p.budget_lsb8.to_string(),
-            p.found_at_lsb8.to_string(),
-            format!("{:e}", p.shape_total),
-            format!("{:.4}", p.shape_total / LSB8),
-            format!("{:.0}", p.objective),
-            opt(p.cost_on(Target::Ice40).map(|c| c.luts)),
-            opt(p.cost_on(Target::Ice40).map(|c| c.dsps)),
-            opt(p.cost_on(Target::Ice40).map(|c| c.ffs)),
-            opt(p.cost_on(Target::Xilinx).map(|c| c.luts)),
-            opt(p.cost_on(Target::Xilinx).map(|c| c.dsps)),
-            opt(p.cost_on(Target::Xilinx).map(|c| c.ffs)),
-            opt(p.cost_on(Target::Generic).map(|c| c.luts)),
-            opt(p.cost_on(Target::Generic).map(|c| c.ffs)),
-            p.latency.to_string(),
-        ])?;
+        csv.record(
+            [
+                algorithm_name(a),
+                a.k.to_string(),
+                a.variant.name().to_string(),
+                a.depth().name().to_string(),
+                frontier.arch.to_string(),
+                p.budget_lsb8.to_string(),
+                p.found_at_lsb8.to_string(),
+                format!("{:e}", p.shape_total),
+                format!("{:.4}", p.shape_total / LSB8),
+                format!("{:.0}", p.objective),
+            ]
+            .into_iter()
+            .chain(cost_cells(&p.costs))
+            .chain([p.latency.to_string()]),
+        )?;
     }
     csv.finish().map(drop)
 }

@@ -428,13 +428,7 @@ pub fn floors(
     budget: &ImageBudget,
     start_frac: i32,
 ) -> Vec<Floor> {
-    let ks: Vec<u32> = crate::reference::lobe::K_RANGE.collect();
-    let algorithms = Algorithm::all(
-        base,
-        &ks,
-        &[Variant::Plain, Variant::Minimax],
-        &[false, true],
-    );
+    let algorithms = Algorithm::every(base);
     let mut v = Vec::new();
     for a in algorithms {
         let Algorithm { k, variant, per_n } = a;
