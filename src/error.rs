@@ -106,6 +106,15 @@ pub enum Error {
         /// What was given.
         got: String,
     },
+    /// A sharding that cannot be resolved: `--shard`, `--shards-per-task`, a scheduler's
+    /// array variables, an output path without its `{shard}` placeholder.
+    #[error("{option}: {problem}")]
+    Cluster {
+        /// The option or variable at fault.
+        option: String,
+        /// What is wrong, with what was expected and what was given.
+        problem: String,
+    },
     /// Sweep shards that do not form one complete sweep.
     #[error("{problem}")]
     Merge {

@@ -4,6 +4,7 @@ mod accumulate;
 pub mod budget;
 pub mod budget_expr;
 pub mod check;
+pub mod cluster;
 pub mod frontier;
 pub mod furnace;
 pub mod gappa;

@@ -10,9 +10,12 @@ use clap::{Args, Subcommand};
 use serde::{Deserialize, Serialize};
 
 use super::Outcome;
+use specfx::analysis::cluster::{
+    assign, parse_shard_spec, shard_path, ShardSpec, SHARD_PLACEHOLDER,
+};
 use specfx::analysis::sweep::{
-    check_shard_complete, check_shards, evaluate, mark_pareto, parse_shard, same_space, GivenShard,
-    LogUse, PointResult, Space, SweepInfo,
+    check_shard_complete, check_shards, evaluate, mark_pareto, same_space, GivenShard, LogUse,
+    PointResult, Space, SweepInfo,
 };
 use specfx::output::OutDir;
 use specfx::provenance::{Inputs, Provenance};
@@ -28,11 +31,20 @@ pub struct SweepArgs {
     #[arg(long)]
     space: Option<PathBuf>,
     /// Output directory; an unfinished sweep of the same space and shard there is resumed.
+    /// `{shard}` in it stands for the shard's index (zero-padded), and is required with
+    /// `--shard auto` and with several shards per task: each shard writes its own directory.
     #[arg(long, default_value = "specfx-sweep")]
     out: PathBuf,
-    /// Evaluate only the points whose index is I modulo N (written I/N).
-    #[arg(long, value_parser = parse_shard)]
-    shard: Option<(u64, u64)>,
+    /// Evaluate only the points whose index is I modulo N: `I/N`; `auto/N` takes I from the
+    /// scheduler's array task (SLURM_ARRAY_TASK_ID, LSB_JOBINDEX, SGE_TASK_ID, PBS_ARRAYID or
+    /// JOB_COMPLETION_INDEX); `auto` takes N from it too (docs/cluster.md).
+    #[arg(long, value_parser = parse_shard_spec)]
+    shard: Option<ShardSpec>,
+    /// Shards per array task (with `--shard auto`): task t of T = ceil(N / S) evaluates shards
+    /// t, t + T, t + 2T, ... in turn, so that a large N needs no more tasks than the
+    /// scheduler's array allows.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    shards_per_task: u64,
     /// Also synthesise the Pareto points with yosys, on the space's target (`target` in the
     /// space file, ice40 by default); naming the target is allowed and must match it.
     #[arg(long, num_args = 0..=1, default_missing_value = "space")]
@@ -105,7 +117,36 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
             Space::from_toml(&text).with_context(|| format!("space {}", space_path.display()))?
         }
     };
-    let (shard_index, shard_count) = args.shard.unwrap_or((0, 1));
+    let spec = args
+        .shard
+        .unwrap_or(ShardSpec::Given { index: 0, count: 1 });
+    let env = |var: &str| std::env::var(var).ok();
+    let assignment = assign(spec, args.shards_per_task, &env)?;
+    // Every directory is known before the first point: a missing placeholder is refused first.
+    let required = assignment.task.is_some() || assignment.shards.len() > 1;
+    let dirs: Vec<PathBuf> = assignment
+        .shards
+        .iter()
+        .map(|&i| {
+            let template = match args.out.to_str() {
+                Some(t) => t,
+                None if required => bail!(
+                    "--out {}: expected a UTF-8 path holding {SHARD_PLACEHOLDER}",
+                    args.out.display()
+                ),
+                None => return Ok(args.out.clone()),
+            };
+            Ok(PathBuf::from(shard_path(
+                template,
+                i,
+                assignment.count,
+                required,
+            )?))
+        })
+        .collect::<Result<_>>()?;
+    if matches!(spec, ShardSpec::Auto { .. }) || assignment.shards.len() > 1 {
+        log::info!("sweep: {}", assignment.describe());
+    }
     let target = space.target;
     if let Some(named) = &args.yosys {
         if named != "space" && named.parse::<specfx::hdl::cost::Target>()? != target {
@@ -114,8 +155,23 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
             );
         }
     }
+    for (&shard_index, dir) in assignment.shards.iter().zip(&dirs) {
+        sweep_shard(args, space.clone(), shard_index, assignment.count, dir)?;
+    }
+    Ok(Outcome::Ok)
+}
+
+/// Evaluates shard `shard_index` of `shard_count` into `dir` (resuming what is there), writes
+/// its results and prints its summary line.
+fn sweep_shard(
+    args: &SweepArgs,
+    space: Space,
+    shard_index: u64,
+    shard_count: u64,
+    dir: &Path,
+) -> Result<()> {
+    let target = space.target;
     let info = SweepInfo::new(space, shard_index, shard_count);
-    let dir = &args.out;
     if dir.join("space.json").exists() || dir.join("space.json").is_symlink() {
         let old = read_info(dir)?;
         if old.sweep_sha256 != info.sweep_sha256 || old.shard_index != shard_index {
@@ -201,7 +257,7 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
         dir.display(),
         points.iter().filter(|p| p.pareto).count()
     )?;
-    Ok(Outcome::Ok)
+    Ok(())
 }
 
 /// Runs yosys on every Pareto point, keeping results in `yosys-<target>.jsonl` so that a

@@ -485,7 +485,13 @@ fn tradeoff_replaces_only_its_own_earlier_result() {
     let dir = work.path();
     std::fs::create_dir(dir.join("mine")).unwrap();
     std::fs::write(dir.join("mine/notes.txt"), "keep me\n").unwrap();
-    let o = run_in(dir, &["tradeoff", "--n", "16..=32", "--out", "mine"]);
+    // (`--ladder none`: what is replaced is the question, not the frontier's minutes.)
+    let o = run_in(
+        dir,
+        &[
+            "tradeoff", "--n", "16..=32", "--ladder", "none", "--out", "mine",
+        ],
+    );
     assert_refused(
         &o,
         "mine already exists and is not an earlier `specfx tradeoff` result",
@@ -493,7 +499,12 @@ fn tradeoff_replaces_only_its_own_earlier_result() {
     );
     assert_eq!(std::fs::read_dir(dir.join("mine")).unwrap().count(), 1);
     for _ in 0..2 {
-        let o = run_in(dir, &["tradeoff", "--n", "16..=32", "--out", "t"]);
+        let o = run_in(
+            dir,
+            &[
+                "tradeoff", "--n", "16..=32", "--ladder", "none", "--out", "t",
+            ],
+        );
         assert!(o.status.success(), "{}", stderr(&o));
     }
     assert!(dir.join("t/tradeoff.csv").is_file());

@@ -251,7 +251,11 @@ fn every_result_directory_records_version_and_inputs() {
             ],
             Some("fit.md"),
         ),
-        ("tradeoff", vec!["tradeoff", "--n", "64", "--out"], None),
+        (
+            "tradeoff",
+            vec!["tradeoff", "--n", "64", "--ladder", "2", "--out"],
+            None,
+        ),
         (
             "vectors",
             vec![

@@ -3,7 +3,8 @@
 //! sharding, a shard twice or missing, a point of another shard or outside the space); merge
 //! never writes over its inputs or an existing result; a full disk (a file size limit, a
 //! device) fails with one line and exit code 2 and leaves nothing half-written; an
-//! interrupted sweep resumes to the same bytes.
+//! interrupted sweep resumes to the same bytes; each scheduler's array tasks (`--shard auto/N`,
+//! several shards per task) write shards that merge into the one-shot sweep.
 
 use crate::common::{limited, run_guarded, specfx};
 
@@ -447,4 +448,106 @@ fn a_resumed_sweep_keeps_only_points_of_its_own_shard() {
         "exists and is not a sweep directory (no space.json)",
     );
     assert_eq!(names(&other), ["notes.txt"]);
+}
+
+/// The schedulers' array-task variables, and the value of each for the first task (Slurm,
+/// PBS and Kubernetes count from 0, LSF and SGE from 1).
+const SCHEDULER_VARS: [(&str, u64); 5] = [
+    ("SLURM_ARRAY_TASK_ID", 0),
+    ("LSB_JOBINDEX", 1),
+    ("SGE_TASK_ID", 1),
+    ("PBS_ARRAYID", 0),
+    ("JOB_COMPLETION_INDEX", 0),
+];
+
+/// `specfx sweep ARGS` as array task `task` (0-based) of the scheduler whose index variable is
+/// `var`: every other scheduler's variable removed (the test may itself run in a job).
+fn as_task(var: &str, first: u64, task: u64, args: &[&str]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_specfx"));
+    cmd.arg("sweep").args(args);
+    for (v, _) in SCHEDULER_VARS {
+        cmd.env_remove(v);
+    }
+    cmd.env(var, (first + task).to_string());
+    cmd.output().expect("specfx runs")
+}
+
+#[test]
+fn each_schedulers_array_tasks_take_their_shards_and_merge_to_the_one_shot_sweep() {
+    let root = temp("auto");
+    let space = root.join("space.toml");
+    std::fs::write(&space, SPACE).unwrap();
+    let one = root.join("one");
+    ok(sweep(&space, &one, None));
+    let without_marker = |d: &Path| {
+        let mut v = snapshot(d);
+        v.retain(|(p, _)| p != Path::new(".specfx-result"));
+        v
+    };
+    for (var, first) in SCHEDULER_VARS {
+        // Four shards, two per task: tasks 0 and 1 take shards {0, 2} and {1, 3}.
+        let template = root.join(var).join("shard-{shard}");
+        for task in 0..2 {
+            let o = ok(as_task(
+                var,
+                first,
+                task,
+                &[
+                    "--space",
+                    s(&space),
+                    "--shard",
+                    "auto/4",
+                    "--shards-per-task",
+                    "2",
+                ]
+                .into_iter()
+                .chain(["--out", s(&template)])
+                .collect::<Vec<_>>(),
+            ));
+            let log = stderr(&o);
+            let said = format!(
+                "array task {task} of 2 ({var}={}): shards {task}, {} of 4",
+                first + task,
+                task + 2
+            );
+            assert!(log.contains(&said), "{var}: {log}");
+        }
+        let dirs: Vec<PathBuf> = (0..4)
+            .map(|i| root.join(var).join(format!("shard-{i}")))
+            .collect();
+        let out = root.join(format!("{var}-merged"));
+        ok(merge(
+            &out,
+            &dirs.iter().map(PathBuf::as_path).collect::<Vec<_>>(),
+            &[],
+        ));
+        assert!(
+            without_marker(&out) == without_marker(&one),
+            "{var}: not the one-shot sweep"
+        );
+    }
+    // Refused in one line before anything is written: no task index, a task beyond the array, a
+    // directory without its placeholder.
+    let out = root.join("refused-{shard}");
+    let plain = ["--space", s(&space), "--shard", "auto/4", "--out", s(&out)];
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_specfx"));
+    cmd.arg("sweep").args(plain);
+    for (v, _) in SCHEDULER_VARS {
+        cmd.env_remove(v);
+    }
+    refused(
+        &cmd.output().unwrap(),
+        "no scheduler's array task index is set",
+    );
+    refused(
+        &as_task("SGE_TASK_ID", 1, 4, &plain),
+        "SGE_TASK_ID=5 is array task 4 (counted from 0), but 4 shards make 4 tasks (0..=3)",
+    );
+    let no_placeholder = ["--space", s(&space), "--shard", "auto/4", "--out", s(&root)];
+    refused(
+        &as_task("SLURM_ARRAY_TASK_ID", 0, 0, &no_placeholder),
+        "--out: expected a {shard} placeholder",
+    );
+    assert!(!root.join("refused-0").exists() && !root.join("refused-4").exists());
+    std::fs::remove_dir_all(&root).unwrap();
 }

@@ -1,0 +1,480 @@
+//! Array jobs on a cluster: which shards of a sharded run (a sweep, a calibration) one array
+//! task takes, from the index its scheduler hands it (Slurm, LSF, SGE, PBS, Kubernetes) or
+//! from `--shard I/N` given by hand, and the `{shard}` placeholder that names each shard's
+//! directory.
+
+use crate::error::Error;
+
+/// How a run is sharded, as `--shard` gives it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShardSpec {
+    /// `I/N`: shard `index` of `count`, given by hand.
+    Given {
+        /// `I`, in `0..count`.
+        index: u64,
+        /// `N`, at least 1.
+        count: u64,
+    },
+    /// `auto/N` (`count` given) or `auto` (the scheduler's task count times the shards per
+    /// task): the task index comes from the scheduler's environment.
+    Auto {
+        /// `N`, when given.
+        count: Option<u64>,
+    },
+}
+
+const SHARD_EXPECTED: &str = "expected I/N with 0 <= I < N, auto/N (the index from the scheduler's array task) or auto (the count too)";
+
+/// Parses `--shard`: `I/N`, `auto/N` or `auto`.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::cluster::{parse_shard_spec, ShardSpec};
+/// assert_eq!(parse_shard_spec("1/4").unwrap(), ShardSpec::Given { index: 1, count: 4 });
+/// assert_eq!(parse_shard_spec("auto/8").unwrap(), ShardSpec::Auto { count: Some(8) });
+/// assert_eq!(parse_shard_spec("auto").unwrap(), ShardSpec::Auto { count: None });
+/// assert!(parse_shard_spec("4/4").is_err());
+/// assert!(parse_shard_spec("auto/0").is_err());
+/// ```
+pub fn parse_shard_spec(s: &str) -> Result<ShardSpec, Error> {
+    let bad = || Error::Cluster {
+        option: "--shard".into(),
+        problem: format!("{SHARD_EXPECTED}, got '{}'", crate::error::OneLine(s)),
+    };
+    let count = |n: &str| match n.trim().parse::<u64>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(bad()),
+    };
+    match s.trim().split_once('/') {
+        None if s.trim() == "auto" => Ok(ShardSpec::Auto { count: None }),
+        None => Err(bad()),
+        Some((i, n)) if i.trim() == "auto" => Ok(ShardSpec::Auto {
+            count: Some(count(n)?),
+        }),
+        Some((i, n)) => {
+            let count = count(n)?;
+            match i.trim().parse::<u64>() {
+                Ok(index) if index < count => Ok(ShardSpec::Given { index, count }),
+                _ => Err(bad()),
+            }
+        }
+    }
+}
+
+/// One scheduler's array-task variables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Scheduler {
+    /// Its name in messages.
+    pub name: &'static str,
+    /// The variable holding the task's index.
+    pub index_var: &'static str,
+    /// The index of the first task (0 or 1).
+    pub first: u64,
+    /// The variable holding the number of tasks, or the last index when counting from 1,
+    /// where the scheduler sets one.
+    pub count_var: Option<&'static str>,
+    /// A value of `index_var` that means "not an array task" (SGE's `undefined`, LSF's 0).
+    pub not_an_array: Option<&'static str>,
+}
+
+/// The schedulers whose array index `--shard auto` reads, in the order they are looked up.
+pub const SCHEDULERS: [Scheduler; 5] = [
+    Scheduler {
+        name: "Slurm",
+        index_var: "SLURM_ARRAY_TASK_ID",
+        first: 0,
+        count_var: Some("SLURM_ARRAY_TASK_COUNT"),
+        not_an_array: None,
+    },
+    Scheduler {
+        name: "LSF",
+        index_var: "LSB_JOBINDEX",
+        first: 1,
+        count_var: Some("LSB_JOBINDEX_END"),
+        not_an_array: Some("0"),
+    },
+    Scheduler {
+        name: "SGE",
+        index_var: "SGE_TASK_ID",
+        first: 1,
+        count_var: Some("SGE_TASK_LAST"),
+        not_an_array: Some("undefined"),
+    },
+    Scheduler {
+        name: "PBS",
+        index_var: "PBS_ARRAYID",
+        first: 0,
+        count_var: None,
+        not_an_array: None,
+    },
+    Scheduler {
+        name: "Kubernetes",
+        index_var: "JOB_COMPLETION_INDEX",
+        first: 0,
+        count_var: None,
+        not_an_array: None,
+    },
+];
+
+/// The array task a scheduler says this process is.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Task {
+    /// The scheduler that set it.
+    pub scheduler: &'static str,
+    /// The variable read, and its value as given.
+    pub variable: &'static str,
+    /// The value of the variable.
+    pub value: String,
+    /// The task's index counted from 0.
+    pub index: u64,
+    /// The number of tasks, where the scheduler says it.
+    pub count: Option<u64>,
+}
+
+fn env_error(problem: String) -> Error {
+    Error::Cluster {
+        option: "--shard auto".into(),
+        problem,
+    }
+}
+
+/// The array task of this process, from the environment `env` gives (a lookup, so tests pass
+/// their own): `None` when no scheduler's index is set; an error when a value is not a
+/// number, or two schedulers' variables name different tasks.
+pub fn task_from_env(env: &dyn Fn(&str) -> Option<String>) -> Result<Option<Task>, Error> {
+    let mut found: Option<Task> = None;
+    for s in &SCHEDULERS {
+        let Some(value) = env(s.index_var) else {
+            continue;
+        };
+        let value = value.trim().to_string();
+        if s.not_an_array == Some(value.as_str()) {
+            continue;
+        }
+        let number = |var: &str, v: &str, what: &str| {
+            v.trim().parse::<u64>().map_err(|_| {
+                env_error(format!(
+                    "{var}={}: expected a whole number ({}'s {what})",
+                    crate::error::OneLine(v),
+                    s.name
+                ))
+            })
+        };
+        let given = number(s.index_var, &value, "array task index")?;
+        if given < s.first {
+            return Err(env_error(format!(
+                "{}={value}: expected {} or more ({} counts array tasks from {})",
+                s.index_var, s.first, s.name, s.first
+            )));
+        }
+        let count = match s.count_var.and_then(|var| env(var).map(|v| (var, v))) {
+            Some((var, v)) => Some(number(var, &v, "number of array tasks")?),
+            None => None,
+        };
+        let task = Task {
+            scheduler: s.name,
+            variable: s.index_var,
+            value,
+            index: given - s.first,
+            count,
+        };
+        match &found {
+            Some(other) if other.index != task.index => {
+                return Err(env_error(format!(
+                    "{}={} ({}) and {}={} ({}) name different array tasks: expected one scheduler's index",
+                    other.variable,
+                    other.value,
+                    other.scheduler,
+                    task.variable,
+                    task.value,
+                    task.scheduler
+                )))
+            }
+            Some(_) => {}
+            None => found = Some(task),
+        }
+    }
+    Ok(found)
+}
+
+/// The shards one process runs: `shards` of `count`, and the array task it is, if any.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Assignment {
+    /// The number of shards of the whole run (`N`).
+    pub count: u64,
+    /// The shards this process runs, ascending: task `t` of `T` takes `t`, `t + T`, ...
+    pub shards: Vec<u64>,
+    /// The number of array tasks the run is spread over.
+    pub tasks: u64,
+    /// The array task this process is (none for a shard given by hand).
+    pub task: Option<Task>,
+}
+
+impl Assignment {
+    /// One line for the log: which task this is and which shards it takes.
+    pub fn describe(&self) -> String {
+        let shards = self
+            .shards
+            .iter()
+            .map(u64::to_string)
+            .collect::<Vec<_>>()
+            .join(", ");
+        let which = if self.shards.len() == 1 {
+            format!("shard {shards} of {}", self.count)
+        } else {
+            format!("shards {shards} of {}", self.count)
+        };
+        match &self.task {
+            Some(t) => format!(
+                "{} array task {} of {} ({}={}): {which}",
+                t.scheduler, t.index, self.tasks, t.variable, t.value
+            ),
+            None => which,
+        }
+    }
+}
+
+/// The shards this process runs under `spec`, with `per_task` shards per array task (task `t`
+/// of `T = ceil(N / per_task)` takes shards `t, t + T, t + 2T, ...`), the task read from
+/// `env` for `auto`. Refused in one line: `auto` with no scheduler's index set, `auto` without
+/// a count where the scheduler gives none, a task index out of range, and several shards per
+/// task with a shard given by hand.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::cluster::{assign, ShardSpec};
+/// let env = |var: &str| (var == "SLURM_ARRAY_TASK_ID").then(|| "2".to_string());
+/// let a = assign(ShardSpec::Auto { count: Some(10) }, 3, &env).unwrap();
+/// assert_eq!((a.tasks, a.shards), (4, vec![2, 6]));
+/// ```
+pub fn assign(
+    spec: ShardSpec,
+    per_task: u64,
+    env: &dyn Fn(&str) -> Option<String>,
+) -> Result<Assignment, Error> {
+    if per_task == 0 {
+        return Err(Error::Cluster {
+            option: "--shards-per-task".into(),
+            problem: "expected 1 or more, got 0".into(),
+        });
+    }
+    match spec {
+        ShardSpec::Given { index, count } => {
+            if per_task != 1 {
+                return Err(Error::Cluster {
+                    option: "--shards-per-task".into(),
+                    problem: format!(
+                        "takes --shard auto/N (the task index from a scheduler), not a shard given by hand ({index}/{count})"
+                    ),
+                });
+            }
+            Ok(Assignment {
+                count,
+                shards: vec![index],
+                tasks: count,
+                task: None,
+            })
+        }
+        ShardSpec::Auto { count } => {
+            let names = SCHEDULERS.map(|s| s.index_var).join(", ");
+            let task = task_from_env(env)?.ok_or_else(|| {
+                env_error(format!(
+                    "no scheduler's array task index is set: expected one of {names} (or --shard I/N)"
+                ))
+            })?;
+            let count = match (count, task.count) {
+                (Some(n), _) => n,
+                (None, Some(tasks)) => tasks.checked_mul(per_task).ok_or_else(|| {
+                    env_error(format!("{tasks} tasks of {per_task} shards: too many shards"))
+                })?,
+                (None, None) => {
+                    return Err(env_error(format!(
+                        "{} does not say how many array tasks there are ({} only): expected --shard auto/N",
+                        task.scheduler, task.variable
+                    )))
+                }
+            };
+            let tasks = count.div_ceil(per_task);
+            if task.index >= tasks {
+                let spread = if per_task == 1 {
+                    String::new()
+                } else {
+                    format!(" at {per_task} shards per task")
+                };
+                return Err(env_error(format!(
+                    "{}={} is array task {} (counted from 0), but {count} shards{spread} make {tasks} tasks (0..={})",
+                    task.variable,
+                    task.value,
+                    task.index,
+                    tasks - 1
+                )));
+            }
+            Ok(Assignment {
+                count,
+                shards: (task.index..count).step_by(tasks as usize).collect(),
+                tasks,
+                task: Some(task),
+            })
+        }
+    }
+}
+
+/// The placeholder of a shard's index in an output path.
+pub const SHARD_PLACEHOLDER: &str = "{shard}";
+
+/// The output directory of shard `index` of `count`: `{shard}` in `template` replaced by the
+/// index, zero-padded to the width of the largest (so that the shards' directories sort in
+/// order). Refused when the run takes its shard from a scheduler or takes several and the
+/// template has no placeholder: every task would write one directory.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::cluster::shard_path;
+/// assert_eq!(shard_path("out/shard-{shard}", 7, 100, true).unwrap(), "out/shard-07");
+/// assert_eq!(shard_path("out", 7, 100, false).unwrap(), "out");
+/// assert!(shard_path("out", 7, 100, true).is_err());
+/// ```
+pub fn shard_path(template: &str, index: u64, count: u64, required: bool) -> Result<String, Error> {
+    if !template.contains(SHARD_PLACEHOLDER) {
+        if required {
+            return Err(Error::Cluster {
+                option: "--out".into(),
+                problem: format!(
+                    "expected a {SHARD_PLACEHOLDER} placeholder in '{}' (each shard writes its own directory; for example --out sweep/shard-{SHARD_PLACEHOLDER})",
+                    crate::error::OneLine(template)
+                ),
+            });
+        }
+        return Ok(template.to_string());
+    }
+    let width = (count - 1).max(1).to_string().len();
+    Ok(template.replace(SHARD_PLACEHOLDER, &format!("{index:0width$}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn env_of<'a>(vars: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<String> + 'a {
+        move |k| {
+            vars.iter()
+                .find(|(n, _)| *n == k)
+                .map(|(_, v)| v.to_string())
+        }
+    }
+
+    #[test]
+    fn every_schedulers_index_is_read_from_its_first_task() {
+        // Each scheduler's documented numbering: the first task of an array is shard 0.
+        type Vars<'a> = &'a [(&'a str, &'a str)];
+        let cases: [(Vars, u64, Option<u64>); 6] = [
+            (
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "0"),
+                    ("SLURM_ARRAY_TASK_COUNT", "8"),
+                ],
+                0,
+                Some(8),
+            ),
+            (
+                &[("LSB_JOBINDEX", "1"), ("LSB_JOBINDEX_END", "8")],
+                0,
+                Some(8),
+            ),
+            (&[("SGE_TASK_ID", "1"), ("SGE_TASK_LAST", "8")], 0, Some(8)),
+            (&[("PBS_ARRAYID", "0")], 0, None),
+            (&[("JOB_COMPLETION_INDEX", "0")], 0, None),
+            (&[("SGE_TASK_ID", "8")], 7, None),
+        ];
+        for (vars, index, count) in cases {
+            let t = task_from_env(&env_of(vars)).unwrap().unwrap();
+            assert_eq!((t.index, t.count), (index, count), "{vars:?}");
+        }
+    }
+
+    #[test]
+    fn not_an_array_job_is_no_task() {
+        assert_eq!(task_from_env(&env_of(&[])).unwrap(), None);
+        assert_eq!(
+            task_from_env(&env_of(&[("LSB_JOBINDEX", "0")])).unwrap(),
+            None
+        );
+        assert_eq!(
+            task_from_env(&env_of(&[("SGE_TASK_ID", "undefined")])).unwrap(),
+            None
+        );
+    }
+
+    #[test]
+    fn bad_or_disagreeing_indexes_are_refused_in_one_line() {
+        for (vars, needle) in [
+            (
+                &[("SLURM_ARRAY_TASK_ID", "x")][..],
+                "SLURM_ARRAY_TASK_ID=x: expected a whole number",
+            ),
+            (&[("SGE_TASK_ID", "-1")][..], "SGE_TASK_ID=-1"),
+            (
+                &[("SLURM_ARRAY_TASK_ID", "2"), ("JOB_COMPLETION_INDEX", "3")][..],
+                "name different array tasks",
+            ),
+            (
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "1"),
+                    ("SLURM_ARRAY_TASK_COUNT", "many"),
+                ][..],
+                "SLURM_ARRAY_TASK_COUNT=many",
+            ),
+        ] {
+            let e = task_from_env(&env_of(vars)).unwrap_err().to_string();
+            assert!(e.contains(needle), "{e}");
+            assert!(!e.contains('\n'), "{e}");
+        }
+        // Two schedulers naming the same task (0-based Slurm 2, 1-based SGE 3) agree.
+        let both = [("SLURM_ARRAY_TASK_ID", "2"), ("SGE_TASK_ID", "3")];
+        assert_eq!(task_from_env(&env_of(&both)).unwrap().unwrap().index, 2);
+    }
+
+    #[test]
+    fn tasks_take_strided_shards_and_cover_each_once() {
+        for (count, per_task) in [(10u64, 1u64), (10, 3), (10, 10), (7, 4), (1, 5)] {
+            let tasks = count.div_ceil(per_task);
+            let mut seen = Vec::new();
+            for t in 0..tasks {
+                let v = t.to_string();
+                let vars = [("JOB_COMPLETION_INDEX", v.as_str())];
+                let env = env_of(&vars);
+                let a = assign(ShardSpec::Auto { count: Some(count) }, per_task, &env).unwrap();
+                assert_eq!(a.tasks, tasks);
+                assert!(a.shards.len() as u64 <= per_task && !a.shards.is_empty());
+                seen.extend(a.shards);
+            }
+            seen.sort_unstable();
+            assert_eq!(seen, (0..count).collect::<Vec<_>>(), "{count} {per_task}");
+        }
+    }
+
+    #[test]
+    fn assignments_out_of_range_or_without_a_count_are_refused() {
+        let slurm5 = env_of(&[("SLURM_ARRAY_TASK_ID", "5")]);
+        let e = assign(ShardSpec::Auto { count: Some(10) }, 2, &slurm5).unwrap_err();
+        assert!(e.to_string().contains("make 5 tasks (0..=4)"), "{e}");
+        let k8s = env_of(&[("JOB_COMPLETION_INDEX", "1")]);
+        let e = assign(ShardSpec::Auto { count: None }, 1, &k8s).unwrap_err();
+        assert!(e.to_string().contains("expected --shard auto/N"), "{e}");
+        let e = assign(ShardSpec::Auto { count: Some(4) }, 1, &env_of(&[])).unwrap_err();
+        assert!(
+            e.to_string().contains("SLURM_ARRAY_TASK_ID, LSB_JOBINDEX"),
+            "{e}"
+        );
+        let e = assign(ShardSpec::Given { index: 0, count: 4 }, 2, &k8s).unwrap_err();
+        assert!(e.to_string().contains("--shards-per-task"), "{e}");
+        // `auto` takes the count from the scheduler: 4 tasks of 2 shards.
+        let lsf = env_of(&[("LSB_JOBINDEX", "4"), ("LSB_JOBINDEX_END", "4")]);
+        let a = assign(ShardSpec::Auto { count: None }, 2, &lsf).unwrap();
+        assert_eq!((a.count, a.tasks, &a.shards), (8, 4, &vec![3, 7]));
+        assert_eq!(
+            a.describe(),
+            "LSF array task 3 of 4 (LSB_JOBINDEX=4): shards 3, 7 of 8"
+        );
+    }
+}
