@@ -31,8 +31,8 @@ pub struct CalibrateArgs {
         default_value = "ice40,xilinx,generic-fast"
     )]
     targets: Vec<Target>,
-    /// Number of sampled configurations per target (default: the committed sample's, 240
-    /// for ice40 and 120 for the slower xilinx and generic-fast mappings); 1..=100000.
+    /// Number of sampled configurations per target (default: the committed sample's, 320
+    /// for ice40 and 240 for the slower xilinx and generic-fast mappings); 1..=100000.
     #[arg(long, value_parser = parse_count)]
     count: Option<u64>,
     /// Seed of the sample.
@@ -241,8 +241,8 @@ fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
             }
             let have: std::collections::BTreeSet<u64> = records.iter().map(|r| r.index).collect();
             let count = args.count.unwrap_or(match target {
-                Target::Ice40 => 240,
-                _ => 120,
+                Target::Ice40 => 320,
+                _ => 240,
             });
             todo = (0..count).filter(|i| !have.contains(i)).collect();
             // The file takes new lines: checked now, not after the first synthesis.

@@ -11,7 +11,7 @@ use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
 use crate::hdl::cost::{features, Features, Target};
 use crate::nset::NSet;
-use crate::pipeline::{Config, Datapath, StageSpec, Variant};
+use crate::pipeline::{Config, Datapath, Depth, DepthStep, StageSpec, Variant};
 use crate::reference::lobe::Cutoff;
 
 /// One synthesised configuration: what was built and what yosys counted. A configuration
@@ -50,8 +50,51 @@ fn stage(rng: &mut ChaCha8Rng, f: Format) -> StageSpec {
 /// k = 1..7, plain or minimax, every cutoff, rounding and overflow mode, input widths
 /// 8..16 bits, internal stages 6..24 fraction bits, coefficient and output 4..16 fraction
 /// bits, multiplier latencies 1..3, and n sets that are ranges, lists or powers of two.
+/// From index [`DEPTH_FROM_INDEX`] on, half the configurations also get a per-n depth (a step
+/// list giving some exponents fewer than k squarings: the bypass multiplexers), drawn apart so
+/// that the rest of the configuration is the one the index always had.
 /// Draws that the datapath rejects are drawn again (deterministically).
 pub fn sample(seed: u64, index: u64) -> (Config, Arch) {
+    let (cfg, arch) = sample_fixed(seed, index);
+    if index < DEPTH_FROM_INDEX {
+        return (cfg, arch);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(!seed ^ index.wrapping_mul(0xD1B5_4A32_D192_ED03));
+    if cfg.k < 2 || rng.gen_bool(0.5) {
+        return (cfg, arch);
+    }
+    let values = cfg.n.values();
+    // (A configuration no drawn rule suits keeps its fixed depth.)
+    for _ in 0..64 {
+        // One to three steps over the set's exponents, the first from its smallest, with a
+        // depth below k somewhere.
+        let mut froms: Vec<u32> = (1..rng.gen_range(1..=3))
+            .map(|_| values[rng.gen_range(0..values.len())])
+            .chain([values[0]])
+            .collect();
+        froms.sort_unstable();
+        froms.dedup();
+        let steps: Vec<DepthStep> = froms
+            .iter()
+            .map(|&from| DepthStep {
+                from,
+                j: rng.gen_range(1..=cfg.k),
+            })
+            .collect();
+        let mut with = cfg.clone();
+        with.depth = Depth::Steps(steps);
+        if with.has_bypass() && Datapath::new(with.clone()).is_ok() {
+            return (with, arch);
+        }
+    }
+    (cfg, arch)
+}
+
+/// The first index of the calibration sample that may carry a per-n depth (the records before
+/// it were drawn before the depth existed, and keep their configurations).
+pub const DEPTH_FROM_INDEX: u64 = 120;
+
+fn sample_fixed(seed: u64, index: u64) -> (Config, Arch) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15));
     loop {
         let mut cfg = Config::baseline();
@@ -356,6 +399,34 @@ mod tests {
     }
 
     #[test]
+    fn the_per_n_depth_is_drawn_from_its_index_on_in_both_architectures() {
+        // Before DEPTH_FROM_INDEX every depth is fixed; after it, some configurations of each
+        // architecture bypass stages (the bypass features are then fitted, not guessed), and the
+        // rest of a drawn configuration is the one its index had without the depth.
+        let mut bypassing = std::collections::BTreeSet::new();
+        for i in 0..DEPTH_FROM_INDEX + 80 {
+            let (cfg, arch) = sample(1, i);
+            let (fixed, fixed_arch) = sample_fixed(1, i);
+            assert_eq!(arch, fixed_arch);
+            assert_eq!(
+                Config {
+                    depth: Depth::Fixed,
+                    ..cfg.clone()
+                },
+                fixed
+            );
+            if i < DEPTH_FROM_INDEX {
+                assert!(cfg.depth.is_fixed(), "index {i}");
+            } else if !cfg.depth.is_fixed() {
+                assert!(cfg.has_bypass(), "index {i}");
+                assert!(Datapath::new(cfg).is_ok(), "index {i}");
+                bypassing.insert(format!("{arch:?}"));
+            }
+        }
+        assert_eq!(bypassing.len(), 2, "{bypassing:?}");
+    }
+
+    #[test]
     fn stored_failures_and_a_torn_last_line_are_not_records() {
         let (config, arch) = sample(1, 0);
         let record = Record {
@@ -433,64 +504,70 @@ pub fn calibration(target: Target) -> Calibration {
     let (logic, ff_per_register_bit, error) = match target {
         Target::Ice40 => (
             [
-                0.5258735391401844,
-                0.47052069183093126,
-                2.3363884712776066,
-                1.4633650205918907,
-                0.20925837037838485,
-                0.5727676101490458,
-                0.8463718983347418,
-                7.726146518785849,
+                0.4721661103868729,
+                0.6133642889488067,
+                2.3397418005340764,
+                1.599348810342482,
+                0.14608995687204912,
+                0.7141517957132348,
+                0.8034855556836864,
+                0.3334972381127226,
+                0.5005150165858908,
+                4.062061419197905,
             ],
-            0.8861683783293803,
+            0.8967415752626459,
             (
-                239,
-                0.09672131331851574,
-                0.22854625168852938,
-                0.6665903351864917,
-                0.03809073463392054,
-                0.8786610878661087,
+                318,
+                0.09275256227754836,
+                0.2249797897219239,
+                0.6503365199033013,
+                0.03831335243420997,
+                0.8836477987421384,
             ),
         ),
         Target::Xilinx => (
             [
-                0.7511476013622379,
+                0.708043880544244,
                 0.0,
-                1.7292346258341469,
+                1.6465842357218352,
                 0.0,
-                0.14532953400763846,
-                0.27783320553235463,
-                0.26109690098040794,
-                0.0,
+                0.2153257865055097,
+                0.20651925516442132,
+                0.2816480666604655,
+                0.13127623487810114,
+                0.36068261157384396,
+                0.11177037958223981,
             ],
-            0.24537012977285588,
+            0.25656874340187613,
             (
-                120,
-                0.12587346735938787,
-                0.2910857260655747,
-                0.8340891072917502,
-                0.3691653241325359,
-                0.8583333333333333,
+                240,
+                0.13720301201634189,
+                0.30950812565981867,
+                0.8602518715399818,
+                0.3569334700632464,
+                0.8541666666666666,
             ),
         ),
         Target::Generic | Target::GenericFast => (
             [
                 0.0,
                 0.0,
-                2.3850033447528443,
-                10.842408404932266,
+                2.754779580262912,
+                10.745939635787803,
                 0.0,
                 0.0,
-                18.495878363918802,
-                1029.1850300620144,
+                18.345377065574795,
+                0.21941053160262658,
+                2.279836966554759,
+                1225.7091462253593,
             ],
-            0.9535733108811097,
+            0.9557557280334504,
             (
-                120,
-                0.06809421827912443,
-                0.15757036509145417,
-                0.7087534096734314,
-                0.04002686824049351,
+                240,
+                0.07229153207926142,
+                0.16005274846099193,
+                0.7283809159693897,
+                0.03675197617187842,
                 1.0,
             ),
         ),

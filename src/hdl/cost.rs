@@ -204,9 +204,14 @@ pub struct Features {
     pub dsp_glue_bits: u64,
     /// Multiplexer inputs of the power-of-two slope shifter (pipelined, slopes all 2^j).
     pub shifter_bits: u64,
-    /// Operand-select inputs of the folded architecture's shared multiplier, and the bypass
-    /// multiplexers of the squaring stages some exponent bypasses (per-n depth).
+    /// Operand-select inputs of the folded architecture's shared multiplier.
     pub mux_bits: u64,
+    /// Per-n depth, pipelined: inputs of the bypass multiplexers of the squaring stages some
+    /// exponent bypasses (two per bit of the square they select against).
+    pub bypass_bits: u64,
+    /// Per-n depth, folded: the same inputs, on the steps of the shared multiplier (weighed
+    /// apart: there the bypass also splits the step's requantizer from the square's).
+    pub folded_bypass_bits: u64,
     /// Register bits (data, valid bits and the per-n constants carried along).
     pub register_bits: u64,
     /// DSP blocks.
@@ -215,7 +220,7 @@ pub struct Features {
 
 impl Features {
     /// Number of logic features weighed by the model.
-    pub const LOGIC: usize = 8;
+    pub const LOGIC: usize = 10;
     /// Names of the logic features, in the order of [`Features::logic`].
     pub const LOGIC_NAMES: [&'static str; Features::LOGIC] = [
         "adder_bits",
@@ -225,6 +230,8 @@ impl Features {
         "dsp_glue_bits",
         "shifter_bits",
         "mux_bits",
+        "bypass_bits",
+        "folded_bypass_bits",
         "constant",
     ];
 
@@ -238,6 +245,8 @@ impl Features {
             self.dsp_glue_bits as f64,
             self.shifter_bits as f64,
             self.mux_bits as f64,
+            self.bypass_bits as f64,
+            self.folded_bypass_bits as f64,
             1.0,
         ]
     }
@@ -356,7 +365,7 @@ pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
             let stages_carried =
                 u64::from(lat.sub + lat.mul + lat.add) + u64::from(lat.mul) * (k as u64 - 1);
             bits += depth_bits * stages_carried;
-            (products, bits, bypass_mux)
+            (products, bits, 0)
         }
         Arch::Folded => {
             let a = products.iter().map(|m| m.a_bits).max().unwrap_or(1);
@@ -382,7 +391,7 @@ pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
                 b_signed: products.iter().any(|m| m.b_signed),
                 square: false,
             };
-            (vec![shared], bits, mux + bypass_mux)
+            (vec![shared], bits, mux)
         }
     };
     let multiplier_bits: u64 = multipliers
@@ -418,6 +427,12 @@ pub fn features(dp: &Datapath, arch: Arch, target: Target) -> Features {
         dsp_glue_bits: map.glue_bits,
         shifter_bits,
         mux_bits,
+        bypass_bits: if arch == Arch::Pipelined {
+            bypass_mux
+        } else {
+            0
+        },
+        folded_bypass_bits: if arch == Arch::Folded { bypass_mux } else { 0 },
         register_bits,
         dsps: map.dsps,
     }
