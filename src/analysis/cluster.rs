@@ -116,6 +116,11 @@ pub const SCHEDULERS: [Scheduler; 5] = [
     },
 ];
 
+/// specfx's own task variable (0-based): when set, it is the task index whatever scheduler's
+/// variables are set too (a shell loop inside a Slurm allocation, a scheduler specfx does not
+/// know).
+pub const SPECFX_TASK_VAR: &str = "SPECFX_TASK_ID";
+
 /// The array task a scheduler says this process is.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Task {
@@ -139,9 +144,27 @@ fn env_error(problem: String) -> Error {
 }
 
 /// The array task of this process, from the environment `env` gives (a lookup, so tests pass
-/// their own): `None` when no scheduler's index is set; an error when a value is not a
-/// number, or two schedulers' variables name different tasks.
+/// their own): [`SPECFX_TASK_VAR`] when set, else the schedulers' variables; `None` when none
+/// is set; an error when a value is not a number, or two schedulers' variables name different
+/// tasks.
 pub fn task_from_env(env: &dyn Fn(&str) -> Option<String>) -> Result<Option<Task>, Error> {
+    // specfx's own variable is explicit: it wins over whatever scheduler runs the process.
+    if let Some(value) = env(SPECFX_TASK_VAR) {
+        let value = value.trim().to_string();
+        let index = value.parse::<u64>().map_err(|_| {
+            env_error(format!(
+                "{SPECFX_TASK_VAR}={}: expected a whole number (the task index, from 0)",
+                crate::error::OneLine(&value)
+            ))
+        })?;
+        return Ok(Some(Task {
+            scheduler: "specfx",
+            variable: SPECFX_TASK_VAR,
+            value,
+            index,
+            count: None,
+        }));
+    }
     let mut found: Option<Task> = None;
     for s in &SCHEDULERS {
         let Some(value) = env(s.index_var) else {
@@ -276,7 +299,7 @@ pub fn assign(
             })
         }
         ShardSpec::Auto { count } => {
-            let names = SCHEDULERS.map(|s| s.index_var).join(", ");
+            let names = SCHEDULERS.map(|s| s.index_var).join(", ") + " or " + SPECFX_TASK_VAR;
             let task = task_from_env(env)?.ok_or_else(|| {
                 env_error(format!(
                     "no scheduler's array task index is set: expected one of {names} (or --shard I/N)"
@@ -393,6 +416,19 @@ mod tests {
     }
 
     #[test]
+    fn specfx_own_variable_wins_over_a_schedulers() {
+        let vars = [("SLURM_ARRAY_TASK_ID", "5"), ("SPECFX_TASK_ID", "2")];
+        let t = task_from_env(&env_of(&vars)).unwrap().unwrap();
+        assert_eq!((t.scheduler, t.index, t.count), ("specfx", 2, None));
+        let e = task_from_env(&env_of(&[("SPECFX_TASK_ID", "two")])).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("SPECFX_TASK_ID=two: expected a whole number"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn not_an_array_job_is_no_task() {
         assert_eq!(task_from_env(&env_of(&[])).unwrap(), None);
         assert_eq!(
@@ -476,5 +512,186 @@ mod tests {
             a.describe(),
             "LSF array task 3 of 4 (LSB_JOBINDEX=4): shards 3, 7 of 8"
         );
+    }
+}
+
+/// The schedulers `sweep plan` writes job scripts for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Emit {
+    /// A Slurm job array (`sbatch --array`) and a merge job after it (`afterok`).
+    Slurm,
+    /// An LSF job array (`bsub -J "name[1-T]"`) and a merge job after it (`done(...)`).
+    Lsf,
+    /// An SGE array job (`qsub -t 1-T`) and a merge job after it (`-hold_jid`).
+    Sge,
+    /// A Kubernetes Indexed Job and a merge Job applied once it completes.
+    K8s,
+    /// A plain shell loop: the tasks through `xargs -P`, then the merge.
+    Shell,
+}
+
+impl Emit {
+    /// Every scheduler, in the order of the documentation.
+    pub const ALL: [Emit; 5] = [Emit::Slurm, Emit::Lsf, Emit::Sge, Emit::K8s, Emit::Shell];
+
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Emit::Slurm => "slurm",
+            Emit::Lsf => "lsf",
+            Emit::Sge => "sge",
+            Emit::K8s => "k8s",
+            Emit::Shell => "shell",
+        }
+    }
+}
+
+impl std::str::FromStr for Emit {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Emit, Error> {
+        Emit::ALL
+            .into_iter()
+            .find(|e| e.name() == s)
+            .ok_or_else(|| Error::UnknownName {
+                what: "scheduler",
+                expected: "slurm, lsf, sge, k8s or shell",
+                got: s.to_string(),
+            })
+    }
+}
+
+/// What one array task needs: derived from the space's size and the measured cost of a point.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Resources {
+    /// Threads (CPUs) per task.
+    pub threads: u32,
+    /// Memory per task, MiB.
+    pub memory_mib: u64,
+    /// Wall-clock limit per task, seconds.
+    pub time_s: u64,
+}
+
+/// The measured cost of one point: the slowest of the points timed, and the peak memory.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PointCost {
+    /// Seconds per point (on the measuring machine, with its threads).
+    pub seconds: f64,
+    /// Peak resident memory of the process that evaluated it, MiB.
+    pub peak_mib: u64,
+    /// Whether the figures were measured here (else given: `--seconds-per-point`).
+    pub measured: bool,
+}
+
+/// The resources a task of `points_per_task` points needs at `cost` per point: twice the
+/// measured time (another machine, a busier node) plus five minutes for the start and the
+/// results, rounded up to whole minutes; twice the measured peak memory, at least 512 MiB,
+/// rounded up to 256 MiB.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::cluster::{resources, PointCost};
+/// let r = resources(PointCost { seconds: 0.5, peak_mib: 100, measured: true }, 54, 2);
+/// assert_eq!((r.time_s, r.memory_mib, r.threads), (360, 512, 2));
+/// ```
+pub fn resources(cost: PointCost, points_per_task: u64, threads: u32) -> Resources {
+    let seconds = 2.0 * cost.seconds * points_per_task as f64 + 300.0;
+    let time_s = (seconds / 60.0).ceil() as u64 * 60;
+    let memory_mib = (2 * cost.peak_mib).max(512).div_ceil(256) * 256;
+    Resources {
+        threads,
+        memory_mib,
+        time_s,
+    }
+}
+
+/// The number of shards of `tasks` tasks of `shards_per_task` shards over `n_points` points;
+/// refused when either is 0 or there would be more shards than points.
+pub fn split(n_points: u64, tasks: u64, shards_per_task: u64) -> Result<u64, Error> {
+    if tasks == 0 || shards_per_task == 0 {
+        return Err(Error::Cluster {
+            option: if tasks == 0 {
+                "--tasks"
+            } else {
+                "--shards-per-task"
+            }
+            .into(),
+            problem: "expected 1 or more, got 0".into(),
+        });
+    }
+    let shards = tasks
+        .checked_mul(shards_per_task)
+        .ok_or_else(|| Error::Cluster {
+            option: "--tasks".into(),
+            problem: format!("{tasks} tasks of {shards_per_task} shards: too many shards"),
+        })?;
+    if shards > n_points {
+        return Err(Error::Cluster {
+            option: "--tasks".into(),
+            problem: format!(
+                "{tasks} tasks of {shards_per_task} shards make {shards} shards, more than the space's {n_points} points: expected at most {n_points} shards"
+            ),
+        });
+    }
+    Ok(shards)
+}
+
+/// A sweep split for a cluster: what `sweep plan` writes scripts for.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Plan {
+    /// The scheduler.
+    pub emit: Emit,
+    /// The sweep's identity ([`crate::analysis::sweep::sweep_sha256`]).
+    pub sweep_sha256: String,
+    /// Points of the space.
+    pub n_points: u64,
+    /// Shards of the sweep (`N`).
+    pub shards: u64,
+    /// Array tasks (`T`).
+    pub tasks: u64,
+    /// Shards per task (`S`, with `T = ceil(N / S)`).
+    pub shards_per_task: u64,
+    /// The most points one task evaluates.
+    pub points_per_task: u64,
+    /// The measured cost of a point the resources were derived from.
+    pub point_cost: PointCost,
+    /// What each task requests.
+    pub resources: Resources,
+    /// The command that runs specfx in the scripts.
+    pub specfx: String,
+}
+
+impl Plan {
+    /// The plan of a sweep of `n_points` points (identity `sweep_sha256`) over `tasks` array
+    /// tasks of `shards_per_task` shards each, for `emit`; refused when there would be more
+    /// shards than points.
+    pub fn new(
+        emit: Emit,
+        sweep_sha256: &str,
+        n_points: u64,
+        (tasks, shards_per_task): (u64, u64),
+        point_cost: PointCost,
+        threads: u32,
+        specfx: &str,
+    ) -> Result<Plan, Error> {
+        let shards = split(n_points, tasks, shards_per_task)?;
+        let points_per_task = n_points.div_ceil(shards) * shards_per_task;
+        Ok(Plan {
+            emit,
+            sweep_sha256: sweep_sha256.to_string(),
+            n_points,
+            shards,
+            tasks,
+            shards_per_task,
+            points_per_task,
+            point_cost,
+            resources: resources(point_cost, points_per_task, threads),
+            specfx: specfx.to_string(),
+        })
+    }
+
+    /// The job's name: `specfx-sweep-` and the first 12 hex digits of the sweep's identity.
+    pub fn job_name(&self) -> String {
+        format!("specfx-sweep-{}", &self.sweep_sha256[..12])
     }
 }

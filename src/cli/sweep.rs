@@ -11,11 +11,11 @@ use serde::{Deserialize, Serialize};
 
 use super::Outcome;
 use specfx::analysis::cluster::{
-    assign, parse_shard_spec, shard_path, ShardSpec, SHARD_PLACEHOLDER,
+    assign, parse_shard_spec, shard_path, Emit, Plan, PointCost, ShardSpec, SHARD_PLACEHOLDER,
 };
 use specfx::analysis::sweep::{
     check_shard_complete, check_shards, evaluate, mark_pareto, same_space, GivenShard, LogUse,
-    PointResult, Space, SweepInfo,
+    PointResult, Space, SweepInfo, DEFAULT_SPACE,
 };
 use specfx::output::OutDir;
 use specfx::provenance::{Inputs, Provenance};
@@ -53,6 +53,10 @@ pub struct SweepArgs {
 
 #[derive(Debug, Subcommand)]
 enum SweepCommand {
+    /// Writes the job scripts that run a sweep on a cluster: an array job whose tasks take
+    /// their shards from the scheduler (`--shard auto/N`), a merge step after it, and
+    /// `submit.sh` (docs/cluster.md).
+    Plan(PlanArgs),
     /// Joins the shards of one sweep into a complete one.
     Merge {
         /// Output directory of the merged sweep (never one of the shards, nor inside one).
@@ -65,6 +69,154 @@ enum SweepCommand {
         #[arg(required = true)]
         shards: Vec<PathBuf>,
     },
+}
+
+/// Arguments of `specfx sweep plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// The design space (as `specfx sweep --space`; without it, the built-in space).
+    #[arg(long)]
+    space: Option<PathBuf>,
+    /// Number of array tasks.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    tasks: u64,
+    /// Shards per task: the sweep has tasks x shards-per-task shards.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    shards_per_task: u64,
+    /// The scheduler: slurm, lsf, sge, k8s or shell.
+    #[arg(long, default_value = "slurm")]
+    emit: Emit,
+    /// Threads (CPUs) each task requests and uses.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=256))]
+    threads: u32,
+    /// The command the scripts run specfx with (a path on the cluster's nodes).
+    #[arg(long, default_value = "specfx")]
+    specfx: String,
+    /// Seconds a point takes, instead of timing three points of the space here (the scripts
+    /// are then the same bytes on every machine).
+    #[arg(long, value_parser = parse_seconds)]
+    seconds_per_point: Option<f64>,
+    /// Output directory: the space, the scripts, `plan.json`; the tasks write `shards/` and
+    /// the merge `merged/` beside them.
+    #[arg(long, default_value = "specfx-sweep-plan")]
+    out: PathBuf,
+    /// Replace an existing directory that is not an earlier plan.
+    #[arg(long)]
+    force: bool,
+}
+
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 86_400.0 => Ok(v),
+        _ => Err(format!(
+            "expected seconds per point in (0, 86400], got '{s}'"
+        )),
+    }
+}
+
+/// Runs `specfx sweep plan`.
+fn plan(args: &PlanArgs) -> Result<Outcome> {
+    let (space, text) = match &args.space {
+        None => (Space::builtin(), DEFAULT_SPACE.to_string()),
+        Some(path) => {
+            let text = specfx::input::read_text(path, &format!("space {}", path.display()))?;
+            let space =
+                Space::from_toml(&text).with_context(|| format!("space {}", path.display()))?;
+            (space, text)
+        }
+    };
+    let n_points = space.n_points();
+    let shards = specfx::analysis::cluster::split(n_points, args.tasks, args.shards_per_task)?;
+    let sha = specfx::analysis::sweep::sweep_sha256(&space, shards);
+    let out_dir = OutDir::begin(
+        &args.out,
+        "sweep plan",
+        args.force,
+        &args
+            .space
+            .iter()
+            .map(|p| ("--space", p.clone()))
+            .collect::<Vec<_>>(),
+    )?;
+    let point_cost = match args.seconds_per_point {
+        Some(seconds) => PointCost {
+            seconds,
+            peak_mib: 0,
+            measured: false,
+        },
+        None => {
+            log::info!("sweep plan: timing three points of the space ({n_points} points)");
+            measure_points(&space)
+        }
+    };
+    let plan = Plan::new(
+        args.emit,
+        &sha,
+        n_points,
+        (args.tasks, args.shards_per_task),
+        point_cost,
+        args.threads,
+        &args.specfx,
+    )?;
+    let inputs = space
+        .recorded(Inputs::new("sweep plan"))
+        .option("emit", args.emit.name())
+        .option("tasks", plan.tasks.to_string())
+        .option("shards_per_task", plan.shards_per_task.to_string())
+        .option("threads", i64::from(args.threads))
+        .option("specfx", args.specfx.clone())
+        .option("seconds_per_point", point_cost.seconds)
+        .option("peak_mib", point_cost.peak_mib.to_string());
+    let mut files = specfx::report::cluster::plan_files(&plan, &text)?;
+    files.extend(Provenance::new(&inputs).files());
+    specfx::output::write_all_shown(out_dir.path(), &args.out, &files)?;
+    out_dir.commit()?;
+    let r = &plan.resources;
+    super::output::outln!(
+        "sweep plan: {} points in {} shards over {} {} tasks ({} threads, {} MiB, {} min each) in {}; run {}/submit.sh",
+        n_points,
+        plan.shards,
+        plan.tasks,
+        args.emit.name(),
+        r.threads,
+        r.memory_mib,
+        r.time_s / 60,
+        args.out.display(),
+        args.out.display()
+    )?;
+    Ok(Outcome::Ok)
+}
+
+/// The cost of a point of `space`: the slowest of its first, middle and last points, and the
+/// peak memory of this process after them.
+fn measure_points(space: &Space) -> PointCost {
+    let n = space.n_points();
+    let mut picks = vec![0, n / 2, n - 1];
+    picks.dedup();
+    let seconds = picks
+        .iter()
+        .map(|&i| {
+            let start = std::time::Instant::now();
+            let _ = evaluate(space, i);
+            start.elapsed().as_secs_f64()
+        })
+        .fold(0.0, f64::max);
+    PointCost {
+        seconds,
+        peak_mib: peak_rss_mib(),
+        measured: true,
+    }
+}
+
+/// This process's peak resident memory, MiB (0 where the system does not say).
+fn peak_rss_mib() -> u64 {
+    // SAFETY: getrusage writes the struct it is given and nothing else.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
+        return 0;
+    }
+    // Linux reports kilobytes.
+    (usage.ru_maxrss.max(0) as u64).div_ceil(1024)
 }
 
 /// Reads and checks a sweep directory's `space.json` ([`SweepInfo::from_json`]).
@@ -106,8 +258,10 @@ fn read_log(dir: &Path, info: &SweepInfo, how: LogUse) -> Result<BTreeMap<u64, P
 
 /// Runs `specfx sweep ...`.
 pub fn run(args: &SweepArgs) -> Result<Outcome> {
-    if let Some(SweepCommand::Merge { out, force, shards }) = &args.command {
-        return merge(out, shards, *force);
+    match &args.command {
+        Some(SweepCommand::Merge { out, force, shards }) => return merge(out, shards, *force),
+        Some(SweepCommand::Plan(plan_args)) => return plan(plan_args),
+        None => {}
     }
     let space = match &args.space {
         None => Space::builtin(),

@@ -4,6 +4,7 @@ pub mod budget;
 pub mod calibrate;
 pub mod chart;
 pub mod check;
+pub mod cluster;
 pub mod cost;
 pub mod csv;
 pub mod doc;

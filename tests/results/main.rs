@@ -15,4 +15,5 @@ mod report;
 mod stability;
 mod sweep;
 mod sweep_merge;
+mod sweep_plan;
 mod tradeoff;

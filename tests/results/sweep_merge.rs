@@ -468,6 +468,7 @@ fn as_task(var: &str, first: u64, task: u64, args: &[&str]) -> Output {
     for (v, _) in SCHEDULER_VARS {
         cmd.env_remove(v);
     }
+    cmd.env_remove("SPECFX_TASK_ID");
     cmd.env(var, (first + task).to_string());
     cmd.output().expect("specfx runs")
 }
@@ -535,6 +536,7 @@ fn each_schedulers_array_tasks_take_their_shards_and_merge_to_the_one_shot_sweep
     for (v, _) in SCHEDULER_VARS {
         cmd.env_remove(v);
     }
+    cmd.env_remove("SPECFX_TASK_ID");
     refused(
         &cmd.output().unwrap(),
         "no scheduler's array task index is set",
