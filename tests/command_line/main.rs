@@ -1,4 +1,4 @@
-//! The command line's contract, through the binary: outputs, errors, bad input, inputs never destroyed, child processes, provenance.
+//! The command line's contract, through the binary: outputs, errors, bad input, inputs never destroyed, child processes, provenance, a real Slurm cluster.
 //!
 //! One test binary of the suite's groups (model, hardware, command_line, results, fuzz_corpus):
 //! `cargo test --test command_line [NAME]` runs it; every file below is one module.
@@ -13,3 +13,4 @@ mod cli_ux;
 mod inputs;
 mod provenance;
 mod robustness;
+mod slurm;
