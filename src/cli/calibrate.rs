@@ -9,11 +9,12 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use clap::Args;
+use clap::{Args, Subcommand};
 use rayon::prelude::*;
 
 use super::output::{print_json, print_with};
 use super::Outcome;
+use specfx::analysis::cluster::{assign, parse_shard_spec, shard_path, ShardSpec};
 use specfx::hdl::calibrate::{
     calibration, fit, read_records, sample, Calibration, Record, TargetFit,
 };
@@ -23,7 +24,10 @@ use specfx::report::calibrate::write_fits;
 
 /// Arguments of `specfx calibrate`.
 #[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct CalibrateArgs {
+    #[command(subcommand)]
+    command: Option<CalibrateCommand>,
     /// Targets to calibrate (comma-separated): ice40, xilinx, generic-fast.
     #[arg(
         long,
@@ -50,6 +54,31 @@ pub struct CalibrateArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
+    /// Synthesise only the sample's indexes I modulo N (`I/N`; `auto/N` or `auto` from the
+    /// scheduler's array task, as `specfx sweep`), into `--data` (which may hold `{shard}`),
+    /// without fitting: `specfx calibrate merge` joins the shards (docs/cluster.md).
+    #[arg(long, value_parser = parse_shard_spec)]
+    shard: Option<ShardSpec>,
+    /// Shards per array task (with `--shard auto`), as `specfx sweep`.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    shards_per_task: u64,
+}
+
+#[derive(Debug, Subcommand)]
+enum CalibrateCommand {
+    /// Joins the records of calibration shards (and those already in `--data`) into
+    /// `--data`, in index order: the file one machine's run writes.
+    Merge {
+        /// The records directory to write (its records are kept and merged with the shards').
+        #[arg(long, default_value = "data/calibration")]
+        data: PathBuf,
+        /// The seed the shards were drawn with.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// The shards' records directories.
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+    },
 }
 
 fn records_path(dir: &Path, target: Target) -> PathBuf {
@@ -137,7 +166,11 @@ fn collect(args: &CalibrateArgs, plan: &mut Plan, hdl_ref: &Path) -> Result<Vec<
     );
     let log = std::sync::Mutex::new(RecordLog {
         path: plan.path.clone(),
-        dir: args.data.clone(),
+        dir: plan
+            .path
+            .parent()
+            .expect("a records file is in --data")
+            .to_path_buf(),
         file: None,
     });
     let done: Result<Vec<std::result::Result<Record, (u64, String)>>> = plan
@@ -199,7 +232,11 @@ fn parse_count(s: &str) -> Result<u64, String> {
 
 /// Plans every target and checks everything that can be refused (the targets, the reference
 /// Verilog, the data directory and its files, the tools) before the first synthesis.
-fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
+fn plan(
+    args: &CalibrateArgs,
+    data: &Path,
+    shard: Option<(u64, u64)>,
+) -> Result<(Vec<Plan>, Option<PathBuf>)> {
     for (i, t) in args.targets.iter().enumerate() {
         if args.targets[..i].contains(t) {
             bail!(
@@ -212,13 +249,23 @@ fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
         None
     } else {
         let dir = super::hdl_ref::hdl_ref(args.hdl_ref.as_deref())?;
-        specfx::output::check_can_create(&args.data, "--data")?;
+        specfx::output::check_can_create(data, "--data")?;
         Some(dir)
     };
     let mut plans = Vec::new();
     for &target in &args.targets {
-        let path = records_path(&args.data, target);
+        let path = records_path(data, target);
         let records = load_records(&path)?;
+        if let Some((i, n)) = shard {
+            if let Some(r) = records.iter().find(|r| r.index % n != i) {
+                bail!(
+                    "{}: record {} is of shard {}/{n}, not {i}/{n}: expected a directory of this shard (another --data)",
+                    path.display(),
+                    r.index,
+                    r.index % n
+                );
+            }
+        }
         let mut todo = Vec::new();
         if args.fit_only {
             if records.is_empty() {
@@ -244,7 +291,9 @@ fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
                 Target::Ice40 => 320,
                 _ => 240,
             });
-            todo = (0..count).filter(|i| !have.contains(i)).collect();
+            todo = (0..count)
+                .filter(|i| !have.contains(i) && shard.is_none_or(|(s, n)| i % n == s))
+                .collect();
             // The file takes new lines: checked now, not after the first synthesis.
             if !todo.is_empty() && path.exists() {
                 std::fs::OpenOptions::new()
@@ -268,7 +317,47 @@ fn plan(args: &CalibrateArgs) -> Result<(Vec<Plan>, Option<PathBuf>)> {
 
 /// Runs `specfx calibrate`.
 pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
-    let (plans, hdl_ref) = plan(args)?;
+    if let Some(CalibrateCommand::Merge { data, seed, shards }) = &args.command {
+        return merge(args, data, *seed, shards);
+    }
+    let Some(spec) = args.shard else {
+        return calibrate(args, &args.data, None);
+    };
+    if args.fit_only {
+        bail!("--shard: a shard synthesises its part of the sample; --fit-only fits whole records (after `specfx calibrate merge`)");
+    }
+    let env = |var: &str| std::env::var(var).ok();
+    let assignment = assign(spec, args.shards_per_task, &env)?;
+    let required = assignment.task.is_some() || assignment.shards.len() > 1;
+    let template = args
+        .data
+        .to_str()
+        .ok_or_else(|| anyhow::anyhow!("--data {}: expected a UTF-8 path", args.data.display()))?;
+    let dirs: Vec<PathBuf> = assignment
+        .shards
+        .iter()
+        .map(|&i| {
+            Ok(PathBuf::from(shard_path(
+                template,
+                i,
+                assignment.count,
+                required,
+            )?))
+        })
+        .collect::<Result<_>>()?;
+    if matches!(spec, ShardSpec::Auto { .. }) || assignment.shards.len() > 1 {
+        log::info!("calibrate: {}", assignment.describe());
+    }
+    for (&i, dir) in assignment.shards.iter().zip(&dirs) {
+        calibrate(args, dir, Some((i, assignment.count)))?;
+    }
+    Ok(Outcome::Ok)
+}
+
+/// Collects the missing records of `data` (those of shard `shard` only, when given) and fits
+/// them (not a shard's: it is a part of the sample).
+fn calibrate(args: &CalibrateArgs, data: &Path, shard: Option<(u64, u64)>) -> Result<Outcome> {
+    let (plans, hdl_ref) = plan(args, data, shard)?;
     let mut fits = Vec::new();
     for mut plan in plans {
         let target = plan.target;
@@ -301,6 +390,20 @@ pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
                 plan.todo.len()
             );
         }
+        if let Some((i, n)) = shard {
+            super::output::outln!(
+                "calibrate {}: shard {i}/{n}: {} records in {}{}",
+                target.name(),
+                plan.records.len(),
+                plan.path.display(),
+                if failed.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({} failed, tried again by the next run)", failed.len())
+                }
+            )?;
+            continue;
+        }
         let (coefficients, error) = fit(&plan.records, target)?;
         fits.push(TargetFit {
             fitted: Calibration {
@@ -312,10 +415,82 @@ pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
             failed: failed.len(),
         });
     }
+    if shard.is_some() {
+        return Ok(Outcome::Ok);
+    }
     if args.json {
         print_json(&fits)?;
     } else {
         print_with(|w| write_fits(w, &fits, super::terminal::table_width()))?;
+    }
+    Ok(Outcome::Ok)
+}
+
+/// `specfx calibrate merge`: every target's records of `shards` and of `data` joined into
+/// `data`, in index order; refused before writing anything when a record was drawn with
+/// another seed or one index has two different records.
+fn merge(args: &CalibrateArgs, data: &Path, seed: u64, shards: &[PathBuf]) -> Result<Outcome> {
+    let mut merged = Vec::new();
+    for &target in &args.targets {
+        let mut by_index: std::collections::BTreeMap<u64, (Record, PathBuf)> = Default::default();
+        let mut sources = 0;
+        for dir in std::iter::once(&data.to_path_buf()).chain(shards) {
+            let path = records_path(dir, target);
+            let records = load_records(&path)?;
+            sources += usize::from(!records.is_empty() && dir != data);
+            for r in records {
+                if sample(seed, r.index).0 != r.config {
+                    bail!(
+                        "{}: record {} was drawn with another seed than --seed {seed} or another sampler",
+                        path.display(),
+                        r.index
+                    );
+                }
+                match by_index.get(&r.index) {
+                    Some((other, from)) if *other != r => bail!(
+                        "{}: record {} differs from the one in {}: expected one record per configuration",
+                        path.display(),
+                        r.index,
+                        from.display()
+                    ),
+                    Some(_) => {}
+                    None => {
+                        by_index.insert(r.index, (r, path.clone()));
+                    }
+                }
+            }
+        }
+        if sources > 0 {
+            merged.push((
+                target,
+                by_index.into_values().map(|(r, _)| r).collect::<Vec<_>>(),
+            ));
+        }
+    }
+    if merged.is_empty() {
+        bail!(
+            "calibrate merge: no records of {} in the shards given",
+            args.targets
+                .iter()
+                .map(|t| t.name())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    specfx::output::check_can_create(data, "--data")?;
+    std::fs::create_dir_all(data).with_context(|| format!("cannot create {}", data.display()))?;
+    for (target, records) in &merged {
+        let path = records_path(data, *target);
+        specfx::output::write_atomic(&path, records_text(records)?.as_bytes())?;
+        let last = records.last().map_or(0, |r| r.index);
+        super::output::outln!(
+            "calibrate merge {}: {} records into {} (indexes 0..={last}; {} missing: failed or not run, synthesised by `specfx calibrate --data {}`)",
+            target.name(),
+            records.len(),
+            path.display(),
+            last + 1 - records.len() as u64,
+            data.display()
+        )?;
     }
     Ok(Outcome::Ok)
 }

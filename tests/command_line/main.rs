@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod calibrate_shards;
 mod children;
 mod cli;
 mod cli_datapath;

@@ -3,7 +3,9 @@
 //! only, stopped at the end, also when the test fails), submits the array job and the merge
 //! that `specfx sweep plan --emit slurm` writes, and checks that the merged sweep is the
 //! one-shot sweep byte for byte; then cancels a task mid-run (`scancel`), resubmits it, and
-//! checks that its shard resumes and the merge is still the one-shot sweep.
+//! checks that its shard resumes and the merge is still the one-shot sweep; and runs a
+//! calibration (yosys) as an array of shards and a merge, whose records are those of one
+//! machine's run byte for byte.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -280,7 +282,7 @@ fn plan(space: &Path, out: &Path, tasks: &str) {
 }
 
 #[test]
-fn a_slurm_array_sweeps_and_merges_to_the_one_shot_sweep_through_a_cancelled_task() {
+fn a_slurm_array_sweeps_and_calibrates_like_one_machine_through_a_cancelled_task() {
     let cluster = Cluster::start();
     let root = cluster.dir.path().join("work");
     std::fs::create_dir(&root).unwrap();
@@ -373,4 +375,55 @@ fn a_slurm_array_sweeps_and_merges_to_the_one_shot_sweep_through_a_cancelled_tas
                 .any(|l| l.contains(" in this shard, ") && !l.ends_with(", 0 already done"))
         });
     assert!(resumed, "no task log says it resumed a shard");
+
+    // A calibration of two configurations as an array of two shards, then the merge.
+    let cal = root.join("calibration");
+    std::fs::create_dir(&cal).unwrap();
+    let bin = env!("CARGO_BIN_EXE_specfx");
+    std::fs::write(
+        cal.join("calibrate.sbatch"),
+        format!(
+            "#!/bin/bash\n#SBATCH --array=0-1\n#SBATCH --cpus-per-task=1\n#SBATCH --mem=512M\n\
+             #SBATCH --output=%x-%A_%a.out\nset -euo pipefail\n\
+             {bin} calibrate --targets ice40 --count 2 --shard auto/2 --data 'shards/shard-{{shard}}'\n"
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        cal.join("merge.sbatch"),
+        format!(
+            "#!/bin/bash\n#SBATCH --output=%x-%j.out\nset -euo pipefail\n\
+             {bin} calibrate merge --data merged shards/shard-*\n"
+        ),
+    )
+    .unwrap();
+    let array = cluster.ok("sbatch", &["--parsable", "calibrate.sbatch"], &cal);
+    let array = array.trim().split(';').next().unwrap().to_string();
+    cluster.ok(
+        "sbatch",
+        &[
+            "--wait",
+            &format!("--dependency=afterok:{array}"),
+            "merge.sbatch",
+        ],
+        &cal,
+    );
+    specfx(&[
+        "calibrate",
+        "--targets",
+        "ice40",
+        "--count",
+        "2",
+        "--data",
+        cal.join("one").to_str().unwrap(),
+    ]);
+    let read = |p: PathBuf| {
+        std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}{}", p.display(), cluster.logs()))
+    };
+    let merged = read(cal.join("merged/ice40.jsonl"));
+    assert_eq!(String::from_utf8_lossy(&merged).lines().count(), 2);
+    assert!(
+        merged == read(cal.join("one/ice40.jsonl")),
+        "the merged calibration is not one machine's"
+    );
 }
