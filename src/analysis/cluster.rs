@@ -605,6 +605,38 @@ pub fn resources(cost: PointCost, points_per_task: u64, threads: u32) -> Resourc
     }
 }
 
+/// The cost of a point of `space`: the slowest of its first, middle and last points, and the
+/// peak memory of this process after them.
+pub fn measure_point_cost(space: &crate::analysis::sweep::Space) -> PointCost {
+    let n = space.n_points();
+    let mut picks = vec![0, n / 2, n - 1];
+    picks.dedup();
+    let seconds = picks
+        .iter()
+        .map(|&i| {
+            let start = std::time::Instant::now();
+            let _ = crate::analysis::sweep::evaluate(space, i);
+            start.elapsed().as_secs_f64()
+        })
+        .fold(0.0, f64::max);
+    PointCost {
+        seconds,
+        peak_mib: peak_rss_mib(),
+        measured: true,
+    }
+}
+
+/// This process's peak resident memory, MiB (0 where the system does not say).
+fn peak_rss_mib() -> u64 {
+    // SAFETY: getrusage writes the struct it is given and nothing else.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
+        return 0;
+    }
+    // Linux reports kilobytes.
+    (usage.ru_maxrss.max(0) as u64).div_ceil(1024)
+}
+
 /// The number of shards of `tasks` tasks of `shards_per_task` shards over `n_points` points;
 /// refused when either is 0 or there would be more shards than points.
 pub fn split(n_points: u64, tasks: u64, shards_per_task: u64) -> Result<u64, Error> {

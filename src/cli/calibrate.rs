@@ -16,7 +16,7 @@ use super::output::{print_json, print_with};
 use super::Outcome;
 use specfx::analysis::cluster::{assign, parse_shard_spec, shard_path, ShardSpec};
 use specfx::hdl::calibrate::{
-    calibration, fit, read_records, sample, Calibration, Record, TargetFit,
+    calibration, fit, merge_records, read_records, sample, Calibration, Record, TargetFit,
 };
 use specfx::hdl::cost::Target;
 use specfx::pipeline::Datapath;
@@ -432,39 +432,17 @@ fn calibrate(args: &CalibrateArgs, data: &Path, shard: Option<(u64, u64)>) -> Re
 fn merge(args: &CalibrateArgs, data: &Path, seed: u64, shards: &[PathBuf]) -> Result<Outcome> {
     let mut merged = Vec::new();
     for &target in &args.targets {
-        let mut by_index: std::collections::BTreeMap<u64, (Record, PathBuf)> = Default::default();
+        let mut sets = Vec::new();
         let mut sources = 0;
         for dir in std::iter::once(&data.to_path_buf()).chain(shards) {
             let path = records_path(dir, target);
             let records = load_records(&path)?;
             sources += usize::from(!records.is_empty() && dir != data);
-            for r in records {
-                if sample(seed, r.index).0 != r.config {
-                    bail!(
-                        "{}: record {} was drawn with another seed than --seed {seed} or another sampler",
-                        path.display(),
-                        r.index
-                    );
-                }
-                match by_index.get(&r.index) {
-                    Some((other, from)) if *other != r => bail!(
-                        "{}: record {} differs from the one in {}: expected one record per configuration",
-                        path.display(),
-                        r.index,
-                        from.display()
-                    ),
-                    Some(_) => {}
-                    None => {
-                        by_index.insert(r.index, (r, path.clone()));
-                    }
-                }
-            }
+            sets.push((path.display().to_string(), records));
         }
+        let records = merge_records(seed, sets)?;
         if sources > 0 {
-            merged.push((
-                target,
-                by_index.into_values().map(|(r, _)| r).collect::<Vec<_>>(),
-            ));
+            merged.push((target, records));
         }
     }
     if merged.is_empty() {

@@ -146,7 +146,7 @@ fn plan(args: &PlanArgs) -> Result<Outcome> {
         },
         None => {
             log::info!("sweep plan: timing three points of the space ({n_points} points)");
-            measure_points(&space)
+            specfx::analysis::cluster::measure_point_cost(&space)
         }
     };
     let plan = Plan::new(
@@ -185,38 +185,6 @@ fn plan(args: &PlanArgs) -> Result<Outcome> {
         args.out.display()
     )?;
     Ok(Outcome::Ok)
-}
-
-/// The cost of a point of `space`: the slowest of its first, middle and last points, and the
-/// peak memory of this process after them.
-fn measure_points(space: &Space) -> PointCost {
-    let n = space.n_points();
-    let mut picks = vec![0, n / 2, n - 1];
-    picks.dedup();
-    let seconds = picks
-        .iter()
-        .map(|&i| {
-            let start = std::time::Instant::now();
-            let _ = evaluate(space, i);
-            start.elapsed().as_secs_f64()
-        })
-        .fold(0.0, f64::max);
-    PointCost {
-        seconds,
-        peak_mib: peak_rss_mib(),
-        measured: true,
-    }
-}
-
-/// This process's peak resident memory, MiB (0 where the system does not say).
-fn peak_rss_mib() -> u64 {
-    // SAFETY: getrusage writes the struct it is given and nothing else.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
-        return 0;
-    }
-    // Linux reports kilobytes.
-    (usage.ru_maxrss.max(0) as u64).div_ceil(1024)
 }
 
 /// Reads and checks a sweep directory's `space.json` ([`SweepInfo::from_json`]).

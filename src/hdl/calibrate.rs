@@ -160,6 +160,40 @@ fn sample_fixed(seed: u64, index: u64) -> (Config, Arch) {
     }
 }
 
+/// The records of several files of one target joined in index order (`calibrate merge`):
+/// each set named by its file; refused when a record was not drawn with `seed`, or one index
+/// has two different records (the same record twice is one).
+pub fn merge_records(seed: u64, sets: Vec<(String, Vec<Record>)>) -> Result<Vec<Record>, Error> {
+    let mut by_index: std::collections::BTreeMap<u64, (Record, String)> = Default::default();
+    for (name, records) in sets {
+        for r in records {
+            if sample(seed, r.index).0 != r.config {
+                return Err(Error::Merge {
+                    problem: format!(
+                        "{name}: record {} was drawn with another seed than --seed {seed} or another sampler",
+                        r.index
+                    ),
+                });
+            }
+            match by_index.get(&r.index) {
+                Some((other, from)) if *other != r => {
+                    return Err(Error::Merge {
+                        problem: format!(
+                            "{name}: record {} differs from the one in {from}: expected one record per configuration",
+                            r.index
+                        ),
+                    })
+                }
+                Some(_) => {}
+                None => {
+                    by_index.insert(r.index, (r, name.clone()));
+                }
+            }
+        }
+    }
+    Ok(by_index.into_values().map(|(r, _)| r).collect())
+}
+
 /// The coefficients of one target's model: logic cells as a weighted sum of the features,
 /// flip-flops as a multiple of the register bits.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
