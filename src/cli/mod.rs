@@ -155,6 +155,10 @@ const EXAMPLES: &[(&str, &str)] = &[
         "specfx cost --config my.toml --target ice40 --timing",
     ),
     ("calibrate", "specfx calibrate --targets ice40 --fit-only"),
+    (
+        "calibrate merge",
+        "specfx calibrate merge --data cal-all cal/shard-0 cal/shard-1",
+    ),
     ("timing", "specfx timing --config my.toml --device up5k"),
     (
         "sweep",
@@ -163,6 +167,10 @@ const EXAMPLES: &[(&str, &str)] = &[
     (
         "sweep merge",
         "specfx sweep merge --out sweep-all sweep-1 sweep-2 sweep-3 sweep-4",
+    ),
+    (
+        "sweep plan",
+        "specfx sweep plan --space space.toml --tasks 32 --emit slurm --out plan",
     ),
     (
         "budget",
