@@ -9,8 +9,10 @@
 use serde::Serialize;
 
 use crate::analysis::accumulate::MaxAt;
+use crate::analysis::column::{column_figures, Map, Raws};
 use crate::engine::{each_chunk, map_n, Chunk, Codes, Span};
 use crate::error::Error;
+use crate::fixed::{Event, Overflow};
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_SQ0, STAGE_T};
 use crate::pipeline::f64_walk::F64Walk;
 use crate::pipeline::fast::EventCounts;
@@ -593,75 +595,32 @@ impl Acc {
         }
     }
 
-    /// Adds a column of one stage's raw values against their f64 references.
-    ///
-    /// The errors go to a scratch column first; each figure is then one short pass with four
-    /// independent lanes (combined in a fixed order, so results stay deterministic), which the
-    /// compiler turns into SIMD instead of one long dependency chain.
+    /// Adds a column of one stage's raw values against their f64 references `map(refs)` (see
+    /// [`column_figures`] for the order of the sums, which is part of the figures' bits).
     fn add_column(
         &mut self,
-        raws: &[i64],
+        raws: Raws<'_>,
         lsb: f64,
         refs: &[f64],
+        map: Map,
         codes: &[i64],
         n: u32,
-        errs: &mut Vec<f64>,
     ) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2, checked just above. No FMA: the results are the
-            // same bits with or without it.
-            return unsafe { self.add_column_avx2(raws, lsb, refs, codes, n, errs) };
-        }
-        self.add_column_any(raws, lsb, refs, codes, n, errs)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn add_column_avx2(
-        &mut self,
-        raws: &[i64],
-        lsb: f64,
-        refs: &[f64],
-        codes: &[i64],
-        n: u32,
-        errs: &mut Vec<f64>,
-    ) {
-        self.add_column_any(raws, lsb, refs, codes, n, errs)
-    }
-
-    #[inline(always)]
-    fn add_column_any(
-        &mut self,
-        raws: &[i64],
-        lsb: f64,
-        refs: &[f64],
-        codes: &[i64],
-        n: u32,
-        errs: &mut Vec<f64>,
-    ) {
-        errs.clear();
-        errs.extend(raws.iter().zip(refs).map(|(&r, &x)| r as f64 * lsb - x));
-        let errs = &errs[..];
         // A hair of slack for the f64 reference's own rounding.
         let half = 0.5 * lsb * (1.0 + 1e-9);
         let one = lsb * (1.0 - 1e-12);
-        let chunk_max = lanes(errs, f64::NEG_INFINITY, |m, e| m.max(e.abs()), f64::max);
-        if chunk_max > self.max_abs {
-            let i = errs
-                .iter()
-                .position(|e| e.abs() == chunk_max)
-                .expect("the maximum is reached");
-            self.max_abs = chunk_max;
+        let f = column_figures(raws, lsb, refs, map, half, one, self.max_abs);
+        if let Some(i) = f.worst {
+            self.max_abs = f.max_abs;
             self.worst = (n, codes[i]);
         }
-        self.sum += lanes(errs, 0.0, |a, e| a + e, |a, b| a + b);
-        self.sum_abs += lanes(errs, 0.0, |a, e| a + e.abs(), |a, b| a + b);
-        self.sum_sq += lanes(errs, 0.0, |a, e| a + e * e, |a, b| a + b);
-        self.n_correct += errs.iter().map(|e| u64::from(e.abs() <= half)).sum::<u64>();
-        self.n_faithful += errs.iter().map(|e| u64::from(e.abs() < one)).sum::<u64>();
-        self.raw_min = raws.iter().copied().fold(self.raw_min, i64::min);
-        self.raw_max = raws.iter().copied().fold(self.raw_max, i64::max);
+        self.sum += f.sum;
+        self.sum_abs += f.sum_abs;
+        self.sum_sq += f.sum_sq;
+        self.n_correct += f.n_correct;
+        self.n_faithful += f.n_faithful;
+        self.raw_min = self.raw_min.min(f.raw_range.0);
+        self.raw_max = self.raw_max.max(f.raw_range.1);
     }
 
     /// Adds a column whose every error is exactly +0.0, non-decreasing from `raw_first` to
@@ -730,27 +689,6 @@ impl Acc {
         self.saturated += o.saturated;
         self.zeroed += o.zeroed;
     }
-}
-
-/// Folds a column in four interleaved lanes, then combines the lanes pairwise.
-#[inline(always)]
-fn lanes(
-    xs: &[f64],
-    init: f64,
-    step: impl Fn(f64, f64) -> f64,
-    join: impl Fn(f64, f64) -> f64,
-) -> f64 {
-    let mut acc = [init; 4];
-    let mut quads = xs.chunks_exact(4);
-    for q in &mut quads {
-        for lane in 0..4 {
-            acc[lane] = step(acc[lane], q[lane]);
-        }
-    }
-    for &x in quads.remainder() {
-        acc[0] = step(acc[0], x);
-    }
-    join(join(acc[0], acc[1]), join(acc[2], acc[3]))
 }
 
 /// Everything gathered for one n.
@@ -875,6 +813,8 @@ struct NFold<'a> {
     dp: &'a Datapath,
     nc: &'a NConstants,
     lsb: Vec<f64>,
+    /// Each stage's format width in bits.
+    width: Vec<u32>,
     c_lsb: f64,
     one: i64,
     last_sq: usize,
@@ -900,13 +840,15 @@ struct NFold<'a> {
     /// The largest code whose fixed and f64 lobes are both 0: cos^n is increasing in c, so
     /// its error there is the largest of all such codes and needs one evaluation at the end.
     zero_lobe_code: Option<(i64, f64)>,
-    refs: Vec<Vec<f64>>,
-    errs: Vec<f64>,
+    /// b's f64 reference over the chunk (t's is `slope * d`, d's is shared by every n).
+    ref_b: Vec<f64>,
     /// Compacted columns of the inputs whose base is not 0 in both models ("live").
     live: Vec<usize>,
     live_codes: Vec<i64>,
     live_raws: Vec<i64>,
     live_refs: Vec<f64>,
+    /// cos^n of the live inputs.
+    live_cos: Vec<f64>,
 }
 
 impl<'a> NFold<'a> {
@@ -917,6 +859,7 @@ impl<'a> NFold<'a> {
             dp,
             nc,
             lsb: dp.stages().iter().map(|s| s.format.lsb()).collect(),
+            width: dp.stages().iter().map(|s| s.format.width()).collect(),
             c_lsb: cfg.c.format.lsb(),
             one: dp.one_code(),
             last_sq: dp.stage_last_square(),
@@ -937,12 +880,12 @@ impl<'a> NFold<'a> {
             n_cut: 0,
             prev_out: None,
             zero_lobe_code: None,
-            refs: vec![Vec::new(); n_stages],
-            errs: Vec::with_capacity(CHUNK),
+            ref_b: Vec::with_capacity(CHUNK),
             live: Vec::with_capacity(CHUNK),
             live_codes: Vec::with_capacity(CHUNK),
             live_raws: Vec::with_capacity(CHUNK),
             live_refs: Vec::with_capacity(CHUNK),
+            live_cos: Vec::with_capacity(CHUNK),
         }
     }
 
@@ -952,38 +895,29 @@ impl<'a> NFold<'a> {
         for (a, counts) in self.acc.iter_mut().zip(&c.probes.event_counts) {
             a.add_events(counts);
         }
-        self.reference_columns(c, ref_d);
-        self.fold_d_t_coef(c);
+        self.reference_b(c, ref_d);
+        self.fold_d_t_coef(c, ref_d);
         self.find_live(c);
         self.fold_live_stages(c);
         self.fold_cuts_and_monotonicity(c);
     }
 
-    /// The f64 value of d, t and b by the same algorithm (see `reference_probes`); b's only
-    /// above the dead prefix (below it every base is cut, and 0 in the f64 model too).
-    fn reference_columns(&mut self, c: &Chunk<'_>, ref_d: &[f64]) {
+    /// The f64 value of b by the same algorithm (see `reference_probes`), only above the dead
+    /// prefix (below it every base is cut, and 0 in the f64 model too); d's is shared by every
+    /// n and t's is `slope * d`, computed where it is used.
+    fn reference_b(&mut self, c: &Chunk<'_>, ref_d: &[f64]) {
         let (nc, cutoff, one, threshold) =
             (self.nc, self.dp.config().cutoff, self.one, self.threshold);
-        for r in self.refs.iter_mut() {
-            r.clear();
-        }
-        // d's f64 reference, needed by t's (and by d's own figures when it is not exact).
-        self.refs[STAGE_D].extend_from_slice(ref_d);
-        let (head, tail) = self.refs.split_at_mut(STAGE_T);
-        tail[0].extend(head[STAGE_D].iter().map(|&d| nc.slope * d));
+        self.ref_b.clear();
         if !c.dead {
-            let (head, tail) = self.refs.split_at_mut(STAGE_B);
-            tail[0].extend(
-                head[STAGE_T]
-                    .iter()
-                    .zip(c.codes)
-                    .map(|(&t, &k)| reference_base(cutoff, t, nc.offset, k.min(one) < threshold)),
-            );
+            self.ref_b.extend(ref_d.iter().zip(c.codes).map(|(&d, &k)| {
+                reference_base(cutoff, nc.slope * d, nc.offset, k.min(one) < threshold)
+            }));
         }
     }
 
     /// d's, t's and the coefficient's figures, over every input of the chunk.
-    fn fold_d_t_coef(&mut self, c: &Chunk<'_>) {
+    fn fold_d_t_coef(&mut self, c: &Chunk<'_>, ref_d: &[f64]) {
         let (chunk, cols, n) = (c.codes, c.probes, self.nc.n);
         if self.d_is_exact {
             let d = &cols.values[STAGE_D];
@@ -995,21 +929,22 @@ impl<'a> NFold<'a> {
             );
         } else {
             self.acc[STAGE_D].add_column(
-                &cols.values[STAGE_D],
+                Raws::of(&cols.values[STAGE_D], self.width[STAGE_D]),
                 self.lsb[STAGE_D],
-                &self.refs[STAGE_D],
+                ref_d,
+                Map::Identity,
                 chunk,
                 n,
-                &mut self.errs,
             );
         }
+        let slope = self.nc.slope;
         self.acc[STAGE_T].add_column(
-            &cols.values[STAGE_T],
+            Raws::of(&cols.values[STAGE_T], self.width[STAGE_T]),
             self.lsb[STAGE_T],
-            &self.refs[STAGE_T],
+            ref_d,
+            Map::Scale(slope),
             chunk,
             n,
-            &mut self.errs,
         );
         self.acc[self.coef_idx].add_constant(
             self.nc.coef_raw,
@@ -1025,7 +960,7 @@ impl<'a> NFold<'a> {
     /// and remembers the largest dead code.
     fn find_live(&mut self, c: &Chunk<'_>) {
         let (chunk, b) = (c.codes, &c.probes.values[STAGE_B]);
-        let ref_b = &self.refs[STAGE_B];
+        let ref_b = &self.ref_b;
         self.live.clear();
         if !c.dead {
             self.live
@@ -1055,10 +990,16 @@ impl<'a> NFold<'a> {
 
     /// b, the squarings and the output on the live inputs (the dead ones are exact zeros);
     /// the lobe against cos^n after the last squaring, the normalised output against the
-    /// exact normalised cos^n at the output.
+    /// exact normalised cos^n at the output. Where the live inputs are one run of the chunk
+    /// (above a cut prefix), the stages' columns are read in place instead of gathered.
     fn fold_live_stages(&mut self, c: &Chunk<'_>) {
         let (chunk, cols, n) = (c.codes, c.probes, self.nc.n);
         let n_dead = (chunk.len() - self.live.len()) as u64;
+        let run = match (self.live.first(), self.live.last()) {
+            (Some(&a), Some(&b)) if b - a + 1 == self.live.len() => Some(a..b + 1),
+            _ => None,
+        };
+        let mut gathered = std::mem::take(&mut self.live_raws);
         for stage_idx in (STAGE_B..=self.last_sq).chain([self.out]) {
             if stage_idx == self.out {
                 // live_refs holds the last squaring's references here.
@@ -1071,45 +1012,41 @@ impl<'a> NFold<'a> {
                     *r *= *r;
                 }
             }
-            self.live_raws.clear();
-            self.live_raws
-                .extend(self.live.iter().map(|&i| cols.values[stage_idx][i]));
+            let raws: &[i64] = match &run {
+                Some(r) => &cols.values[stage_idx][r.clone()],
+                None => {
+                    gathered.clear();
+                    gathered.extend(self.live.iter().map(|&i| cols.values[stage_idx][i]));
+                    &gathered
+                }
+            };
             self.acc[stage_idx].add_column(
-                &self.live_raws,
+                Raws::of(raws, self.width[stage_idx]),
                 self.lsb[stage_idx],
                 &self.live_refs,
+                Map::Identity,
                 &self.live_codes,
                 n,
-                &mut self.errs,
             );
             self.acc[stage_idx].add_exact_zeros(n_dead);
-            if stage_idx == self.out {
-                self.fold_normalised(c);
-            }
             if stage_idx == self.last_sq {
-                self.fold_lobe(c);
+                self.fold_lobe(c, raws);
+            }
+            if stage_idx == self.out {
+                self.fold_normalised(c, raws);
             }
         }
+        self.live_raws = gathered;
     }
 
-    /// cos^n of a code of the chunk: 0 at and below c = 0.
-    #[inline]
-    fn cos_n(&self, c: &Chunk<'_>, i: usize) -> f64 {
-        if c.codes[i] as f64 * self.c_lsb <= 0.0 {
-            0.0
-        } else {
-            (self.nf * c.ln_c[i]).exp()
-        }
-    }
-
-    /// The normalised output against the exact normalised cos^n, on the live inputs
-    /// (`live_raws` and `live_refs` hold the output's values and the f64 lobe times the f64
-    /// coefficient).
-    fn fold_normalised(&mut self, c: &Chunk<'_>) {
+    /// The normalised output against the exact normalised cos^n, on the live inputs (`raws`
+    /// the output's values, `live_refs` the f64 lobe times the f64 coefficient, `live_cos`
+    /// their cos^n).
+    fn fold_normalised(&mut self, c: &Chunk<'_>, raws: &[i64]) {
         let lsb_out = self.lsb[self.out];
         for (j, &i) in self.live.iter().enumerate() {
-            let cos_n = self.cos_n(c, i);
-            let o = self.live_raws[j] as f64 * lsb_out;
+            let cos_n = self.live_cos[j];
+            let o = raws[j] as f64 * lsb_out;
             self.norm
                 .add((o - self.norm_peak * cos_n).abs(), (self.nc.n, c.codes[i]));
             self.norm_approx = self
@@ -1118,15 +1055,24 @@ impl<'a> NFold<'a> {
         }
     }
 
-    /// The lobe against cos^n on the live inputs (`live_raws` and `live_refs` hold the last
-    /// squaring's values): its quantization, approximation and total error.
-    fn fold_lobe(&mut self, c: &Chunk<'_>) {
+    /// The lobe against cos^n on the live inputs (`raws` the last squaring's values,
+    /// `live_refs` their f64 references): its quantization, approximation and total error.
+    /// Leaves the live inputs' cos^n (0 at and below c = 0) in `live_cos`.
+    fn fold_lobe(&mut self, c: &Chunk<'_>, raws: &[i64]) {
         let lsb_sq = self.lsb[self.last_sq];
+        self.live_cos.clear();
+        self.live_cos.extend(self.live.iter().map(|&i| {
+            if c.codes[i] as f64 * self.c_lsb <= 0.0 {
+                0.0
+            } else {
+                (self.nf * c.ln_c[i]).exp()
+            }
+        }));
         for (j, &i) in self.live.iter().enumerate() {
             let at = (self.nc.n, c.codes[i]);
-            let s_fixed = self.live_raws[j] as f64 * lsb_sq;
+            let s_fixed = raws[j] as f64 * lsb_sq;
             let s_ref = self.live_refs[j];
-            let cos_n = self.cos_n(c, i);
+            let cos_n = self.live_cos[j];
             self.quant.add((s_fixed - s_ref).abs(), at);
             self.approx.add((s_ref - cos_n).abs(), at);
             self.total.add((s_fixed - cos_n).abs(), at);
@@ -1163,6 +1109,84 @@ impl<'a> NFold<'a> {
         }
     }
 
+    /// Folds the whole chunks, from the first, that are dead (below `dead_end`) and whose t
+    /// overflows below its range at every code, without evaluating them; returns the index of
+    /// the first code left to the stream.
+    ///
+    /// Such a chunk's figures follow from its codes: d is exact (`d_is_exact`), t is one raw
+    /// value with one event at every code, the coefficient is a constant, and from b on every
+    /// value is 0 in both models. The proof that t is one value: d = c - 1 is non-decreasing
+    /// in the code and at most 0, so with a slope of at least 0 the exact product d * slope is
+    /// non-decreasing and at most 0, and so is its rounding (every rounding mode is monotone);
+    /// an overflow at the chunk's last code can then only be below the range, and every
+    /// earlier code's rounded product is lower still, so it overflows too and, unless t wraps,
+    /// is given the same value with the same event.
+    fn overflowed_prefix(&mut self, shared: &CodeColumns, dead_end: i64) -> usize {
+        let (dp, nc) = (self.dp, self.nc);
+        if !self.d_is_exact || nc.slope_raw < 0 || dp.config().t.overflow == Overflow::Wrap {
+            return 0;
+        }
+        let codes = &shared.codes.codes;
+        let mut start = 0;
+        while start < codes.len() {
+            let end = (start + CHUNK).min(codes.len());
+            let last = codes[end - 1];
+            if last >= dead_end {
+                break;
+            }
+            let t = dp.op_mul_t(dp.op_sub(last).1, nc);
+            let kind = match t.event {
+                Event::None => break,
+                Event::Wrapped => 0,
+                Event::Saturated => 1,
+                Event::Zeroed => 2,
+            };
+            let chunk = &codes[start..end];
+            let (n, len) = (nc.n, chunk.len() as u64);
+            let mut counts = [0u64; 3];
+            counts[kind] = len;
+            self.acc[STAGE_T].add_events(&counts);
+            self.acc[STAGE_D].add_exact_column(
+                dp.op_sub(chunk[0]).1,
+                dp.op_sub(last).1,
+                len,
+                (n, chunk[0]),
+            );
+            self.acc[STAGE_T].add_column(
+                Raws::Constant(t.raw),
+                self.lsb[STAGE_T],
+                &shared.ref_d[start..end],
+                Map::Scale(nc.slope),
+                chunk,
+                n,
+            );
+            self.acc[self.coef_idx].add_constant(
+                nc.coef_raw,
+                self.lsb[self.coef_idx],
+                nc.coef,
+                len,
+                (n, chunk[0]),
+            );
+            // From b on every value is 0 in both models; the largest such code is the
+            // chunk's last.
+            for stage_idx in (STAGE_B..=self.last_sq).chain([self.out]) {
+                self.acc[stage_idx].add_exact_zeros(len);
+            }
+            if self.zero_lobe_code.is_none_or(|(k, _)| last > k) {
+                self.zero_lobe_code = Some((last, shared.codes.ln_c[end - 1]));
+            }
+            // Every base is cut and every output is 0: none below the one before it.
+            self.n_cut += len;
+            debug_assert!(
+                self.prev_out.is_none_or(|p| p == 0),
+                "a prefix of the codes"
+            );
+            self.prev_out = Some(0);
+            start = end;
+        }
+        start
+    }
+
     /// The exponent's figures, with the largest code of zero lobes counted once.
     fn finish(mut self) -> PerN {
         if let Some((code, lnc)) = self.zero_lobe_code {
@@ -1196,12 +1220,13 @@ impl<'a> NFold<'a> {
 /// One exponent's exhaustive check: every chunk of the stream above the dead prefix's start,
 /// folded by [`NFold`].
 fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
+    let dead_end = dead_prefix_end(dp, nc, &shared.codes.codes);
+    let mut fold = NFold::new(dp, nc);
     let span = Span {
-        from: 0,
-        dead_end: dead_prefix_end(dp, nc, &shared.codes.codes),
+        from: fold.overflowed_prefix(shared, dead_end),
+        dead_end,
         chunk_codes: CHUNK,
     };
-    let mut fold = NFold::new(dp, nc);
     each_chunk(dp, nc, &shared.codes, span, |c| {
         fold.chunk(c, &shared.ref_d[c.start..c.start + c.codes.len()]);
     });

@@ -5,6 +5,7 @@ pub mod budget;
 pub mod budget_expr;
 pub mod check;
 pub mod cluster;
+mod column;
 pub mod frontier;
 pub mod furnace;
 pub mod gappa;

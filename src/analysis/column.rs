@@ -1,0 +1,517 @@
+//! The error figures of one column of a stage (its raw values against their f64 references) in
+//! one pass: four lanes per figure, in an order that is part of the figures' bits, with an AVX2
+//! kernel where the CPU has it and the portable loop, its oracle, everywhere.
+//!
+//! Element `i` of a column goes to lane `i % 4` while whole quads remain and the rest to lane
+//! 0; each sum joins its lanes as `(l0 + l1) + (l2 + l3)`. Every output of the exhaustive check
+//! is the same bytes from one version to the next and with any number of threads, so neither
+//! kernel may change that order, use FMA, or reassociate.
+
+/// The raw values of a column.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Raws<'a> {
+    /// One value for every element.
+    Constant(i64),
+    /// Values whose magnitudes are below 2^51 (formats of at most [`NARROW_BITS`] bits).
+    Narrow(&'a [i64]),
+    /// Any values.
+    Wide(&'a [i64]),
+}
+
+impl<'a> Raws<'a> {
+    /// A stage's column: narrow when its format has at most [`NARROW_BITS`] bits.
+    pub(crate) fn of(column: &'a [i64], width: u32) -> Raws<'a> {
+        if width <= NARROW_BITS {
+            Raws::Narrow(column)
+        } else {
+            Raws::Wide(column)
+        }
+    }
+}
+
+/// The widest format whose raw values [`narrow_to_f64`] converts.
+pub(crate) const NARROW_BITS: u32 = 51;
+
+/// `x as f64` for `|x| < 2^51`, exact both ways: the bits of `1.5 * 2^52 + x` minus
+/// `1.5 * 2^52` (an integer addition and one f64 subtraction, which vectorise where `as f64`
+/// of an `i64` does not before AVX-512).
+#[inline(always)]
+pub(crate) fn narrow_to_f64(x: i64) -> f64 {
+    f64::from_bits((x as u64).wrapping_add(MAGIC.to_bits())) - MAGIC
+}
+
+/// 1.5 * 2^52.
+const MAGIC: f64 = 6_755_399_441_055_744.0;
+
+/// The reference of an element from the column of references: `refs[i]` itself, or
+/// `scale * refs[i]` (t's reference from d's, `slope * d`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Map {
+    /// The reference as it is.
+    Identity,
+    /// The reference times this factor (the factor on the left, as `slope * d`).
+    Scale(f64),
+}
+
+impl Map {
+    #[inline(always)]
+    fn apply(self, x: f64) -> f64 {
+        match self {
+            Map::Identity => x,
+            Map::Scale(s) => s * x,
+        }
+    }
+}
+
+/// The figures of one column: the lanes joined, ready to add to a running total.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ColumnFigures {
+    /// max |error|, `-inf` for an empty column (a NaN error is skipped).
+    pub(crate) max_abs: f64,
+    /// The first element where `max_abs` is reached, if the column is not empty.
+    pub(crate) worst: Option<usize>,
+    /// Sum of the errors.
+    pub(crate) sum: f64,
+    /// Sum of |error|.
+    pub(crate) sum_abs: f64,
+    /// Sum of squared errors.
+    pub(crate) sum_sq: f64,
+    /// Errors within `half` (correctly rounded).
+    pub(crate) n_correct: u64,
+    /// Errors below `one` (faithfully rounded).
+    pub(crate) n_faithful: u64,
+    /// The smallest and the largest raw value (`(i64::MAX, i64::MIN)` for an empty column).
+    pub(crate) raw_range: (i64, i64),
+}
+
+/// The figures of the column `raws` (value `raw * lsb`) against the references `map(refs)`:
+/// errors `raw * lsb - map(ref)`, counted as correct when `|error| <= half` and faithful when
+/// `|error| < one`. `worst` is looked for only when `max_abs > above` (the caller's running
+/// maximum), since only then is it used.
+pub(crate) fn column_figures(
+    raws: Raws<'_>,
+    lsb: f64,
+    refs: &[f64],
+    map: Map,
+    half: f64,
+    one: f64,
+    above: f64,
+) -> ColumnFigures {
+    if let Raws::Narrow(r) | Raws::Wide(r) = raws {
+        assert_eq!(r.len(), refs.len(), "a raw value for every reference");
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2, checked just above, and the lengths agree (asserted).
+        let mut f = unsafe { avx2::figures(raws, lsb, refs, map, half, one) };
+        f.worst = worst(&f, raws, lsb, refs, map, above);
+        return f;
+    }
+    portable(raws, lsb, refs, map, half, one, above)
+}
+
+/// The error of element `i`.
+#[inline(always)]
+fn error(raws: Raws<'_>, lsb: f64, refs: &[f64], map: Map, i: usize) -> f64 {
+    let value = match raws {
+        Raws::Constant(r) => r as f64 * lsb,
+        Raws::Narrow(r) => narrow_to_f64(r[i]) * lsb,
+        Raws::Wide(r) => r[i] as f64 * lsb,
+    };
+    value - map.apply(refs[i])
+}
+
+/// The first element where the maximum is reached, when it is above `above`.
+fn worst(
+    f: &ColumnFigures,
+    raws: Raws<'_>,
+    lsb: f64,
+    refs: &[f64],
+    map: Map,
+    above: f64,
+) -> Option<usize> {
+    (f.max_abs > above).then(|| {
+        (0..refs.len())
+            .position(|i| error(raws, lsb, refs, map, i).abs() == f.max_abs)
+            .expect("the maximum is reached")
+    })
+}
+
+/// The portable kernel, element by element: the oracle of the AVX2 one (same bits).
+pub(crate) fn portable(
+    raws: Raws<'_>,
+    lsb: f64,
+    refs: &[f64],
+    map: Map,
+    half: f64,
+    one: f64,
+    above: f64,
+) -> ColumnFigures {
+    let len = refs.len();
+    let mut max = [f64::NEG_INFINITY; 4];
+    let mut sum = [0.0f64; 4];
+    let mut sum_abs = [0.0f64; 4];
+    let mut sum_sq = [0.0f64; 4];
+    let mut n_correct = 0u64;
+    let mut n_faithful = 0u64;
+    let whole = len / 4 * 4;
+    for i in 0..len {
+        let lane = if i < whole { i % 4 } else { 0 };
+        let e = error(raws, lsb, refs, map, i);
+        let a = e.abs();
+        max[lane] = max[lane].max(a);
+        sum[lane] += e;
+        sum_abs[lane] += a;
+        sum_sq[lane] += e * e;
+        n_correct += u64::from(a <= half);
+        n_faithful += u64::from(a < one);
+    }
+    let mut f = ColumnFigures {
+        max_abs: max[0].max(max[1]).max(max[2].max(max[3])),
+        worst: None,
+        sum: join(sum),
+        sum_abs: join(sum_abs),
+        sum_sq: join(sum_sq),
+        n_correct,
+        n_faithful,
+        raw_range: raw_range(raws, len),
+    };
+    f.worst = worst(&f, raws, lsb, refs, map, above);
+    f
+}
+
+/// The lanes of a sum joined.
+#[inline(always)]
+fn join(a: [f64; 4]) -> f64 {
+    (a[0] + a[1]) + (a[2] + a[3])
+}
+
+/// The smallest and largest raw value.
+fn raw_range(raws: Raws<'_>, len: usize) -> (i64, i64) {
+    match raws {
+        Raws::Constant(r) if len > 0 => (r, r),
+        Raws::Constant(_) => (i64::MAX, i64::MIN),
+        Raws::Narrow(r) | Raws::Wide(r) => {
+            let (mut lo, mut hi) = ([i64::MAX; 4], [i64::MIN; 4]);
+            let quads = r.chunks_exact(4);
+            let rest = quads.remainder();
+            for q in quads {
+                for l in 0..4 {
+                    lo[l] = lo[l].min(q[l]);
+                    hi[l] = hi[l].max(q[l]);
+                }
+            }
+            for &x in rest {
+                lo[0] = lo[0].min(x);
+                hi[0] = hi[0].max(x);
+            }
+            (
+                lo.into_iter().fold(i64::MAX, i64::min),
+                hi.into_iter().fold(i64::MIN, i64::max),
+            )
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    //! The AVX2 kernel: one 256-bit register per figure, its four lanes the four lanes of the
+    //! portable loop.
+    use super::{join, raw_range, ColumnFigures, Map, Raws, MAGIC};
+    use std::arch::x86_64::*;
+
+    /// The figures (without `worst`) of a column, as [`super::portable`] computes them.
+    ///
+    /// # Safety
+    /// The CPU has AVX2, and a column of raw values is as long as `refs`.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn figures(
+        raws: Raws<'_>,
+        lsb: f64,
+        refs: &[f64],
+        map: Map,
+        half: f64,
+        one: f64,
+    ) -> ColumnFigures {
+        let l = _mm256_set1_pd(lsb);
+        match (raws, map) {
+            (Raws::Constant(r), Map::Identity) => {
+                let v = _mm256_set1_pd(r as f64 * lsb);
+                kernel(raws, lsb, refs, map, half, one, |_| v, |x| x)
+            }
+            (Raws::Constant(r), Map::Scale(s)) => {
+                let (v, s) = (_mm256_set1_pd(r as f64 * lsb), _mm256_set1_pd(s));
+                kernel(
+                    raws,
+                    lsb,
+                    refs,
+                    map,
+                    half,
+                    one,
+                    |_| v,
+                    |x| _mm256_mul_pd(s, x),
+                )
+            }
+            (Raws::Narrow(r), Map::Identity) => {
+                kernel(raws, lsb, refs, map, half, one, |q| narrow(r, q, l), |x| x)
+            }
+            (Raws::Narrow(r), Map::Scale(s)) => {
+                let s = _mm256_set1_pd(s);
+                kernel(
+                    raws,
+                    lsb,
+                    refs,
+                    map,
+                    half,
+                    one,
+                    |q| narrow(r, q, l),
+                    |x| _mm256_mul_pd(s, x),
+                )
+            }
+            (Raws::Wide(r), Map::Identity) => {
+                kernel(raws, lsb, refs, map, half, one, |q| wide(r, q, l), |x| x)
+            }
+            (Raws::Wide(r), Map::Scale(s)) => {
+                let s = _mm256_set1_pd(s);
+                kernel(
+                    raws,
+                    lsb,
+                    refs,
+                    map,
+                    half,
+                    one,
+                    |q| wide(r, q, l),
+                    |x| _mm256_mul_pd(s, x),
+                )
+            }
+        }
+    }
+
+    /// The values `raw * lsb` of quad `q` of a narrow column.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn narrow(r: &[i64], q: usize, lsb: __m256d) -> __m256d {
+        let quad: &[i64; 4] = r[4 * q..4 * q + 4].try_into().expect("a whole quad");
+        // SAFETY: the load reads the four values of `quad` (unaligned).
+        let x = unsafe { _mm256_loadu_si256(quad.as_ptr().cast()) };
+        let bits = _mm256_add_epi64(x, _mm256_set1_epi64x(MAGIC.to_bits() as i64));
+        let v = _mm256_sub_pd(_mm256_castsi256_pd(bits), _mm256_set1_pd(MAGIC));
+        _mm256_mul_pd(v, lsb)
+    }
+
+    /// The values `raw * lsb` of quad `q` of a wide column (converted one by one).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn wide(r: &[i64], q: usize, lsb: __m256d) -> __m256d {
+        let quad = &r[4 * q..4 * q + 4];
+        let v = _mm256_set_pd(
+            quad[3] as f64,
+            quad[2] as f64,
+            quad[1] as f64,
+            quad[0] as f64,
+        );
+        _mm256_mul_pd(v, lsb)
+    }
+
+    /// The loop: `value(q)` the four values of quad `q`, `scale` the map of four references.
+    #[allow(clippy::too_many_arguments)]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn kernel(
+        raws: Raws<'_>,
+        lsb: f64,
+        refs: &[f64],
+        map: Map,
+        half: f64,
+        one: f64,
+        value: impl Fn(usize) -> __m256d,
+        scale: impl Fn(__m256d) -> __m256d,
+    ) -> ColumnFigures {
+        let len = refs.len();
+        let quads = len / 4;
+        let sign = _mm256_set1_pd(-0.0);
+        let (half4, one4) = (_mm256_set1_pd(half), _mm256_set1_pd(one));
+        let mut max = _mm256_set1_pd(f64::NEG_INFINITY);
+        let (mut sum, mut sum_abs, mut sum_sq) = (
+            _mm256_setzero_pd(),
+            _mm256_setzero_pd(),
+            _mm256_setzero_pd(),
+        );
+        let (mut n_correct, mut n_faithful) = (_mm256_setzero_si256(), _mm256_setzero_si256());
+        for q in 0..quads {
+            let x: &[f64; 4] = refs[4 * q..4 * q + 4].try_into().expect("a whole quad");
+            // SAFETY: the load reads the four values of `x` (unaligned).
+            let e = _mm256_sub_pd(value(q), scale(unsafe { _mm256_loadu_pd(x.as_ptr()) }));
+            let a = _mm256_andnot_pd(sign, e);
+            // max(a, m): a where a > m, else m; m is never NaN, so a NaN error is skipped.
+            max = _mm256_max_pd(a, max);
+            sum = _mm256_add_pd(sum, e);
+            sum_abs = _mm256_add_pd(sum_abs, a);
+            sum_sq = _mm256_add_pd(sum_sq, _mm256_mul_pd(e, e));
+            // A true comparison is all ones, -1 as an integer.
+            let le = _mm256_castpd_si256(_mm256_cmp_pd::<_CMP_LE_OQ>(a, half4));
+            let lt = _mm256_castpd_si256(_mm256_cmp_pd::<_CMP_LT_OQ>(a, one4));
+            n_correct = _mm256_sub_epi64(n_correct, le);
+            n_faithful = _mm256_sub_epi64(n_faithful, lt);
+        }
+        // SAFETY (both): the stores write the four values of `out`.
+        let lanes = |v: __m256d| {
+            let mut out = [0.0f64; 4];
+            unsafe { _mm256_storeu_pd(out.as_mut_ptr(), v) };
+            out
+        };
+        let counts = |v: __m256i| {
+            let mut out = [0i64; 4];
+            unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), v) };
+            out.iter().map(|&c| c as u64).sum::<u64>()
+        };
+        let (mut max, mut sum, mut sum_abs, mut sum_sq) =
+            (lanes(max), lanes(sum), lanes(sum_abs), lanes(sum_sq));
+        let (mut n_correct, mut n_faithful) = (counts(n_correct), counts(n_faithful));
+        for i in 4 * quads..len {
+            let e = super::error(raws, lsb, refs, map, i);
+            let a = e.abs();
+            max[0] = max[0].max(a);
+            sum[0] += e;
+            sum_abs[0] += a;
+            sum_sq[0] += e * e;
+            n_correct += u64::from(a <= half);
+            n_faithful += u64::from(a < one);
+        }
+        ColumnFigures {
+            max_abs: max[0].max(max[1]).max(max[2].max(max[3])),
+            worst: None,
+            sum: join(sum),
+            sum_abs: join(sum_abs),
+            sum_sq: join(sum_sq),
+            n_correct,
+            n_faithful,
+            raw_range: raw_range(raws, len),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Sums in the order the module promises, written out plainly: the independent oracle of
+    /// both kernels' sums.
+    fn lane_sums(errs: &[f64]) -> (f64, f64, f64) {
+        let mut s = [[0.0f64; 4]; 3];
+        let whole = errs.len() / 4 * 4;
+        for (i, &e) in errs.iter().enumerate() {
+            let l = if i < whole { i % 4 } else { 0 };
+            s[0][l] += e;
+            s[1][l] += e.abs();
+            s[2][l] += e * e;
+        }
+        let j = |a: [f64; 4]| (a[0] + a[1]) + (a[2] + a[3]);
+        (j(s[0]), j(s[1]), j(s[2]))
+    }
+
+    fn check_column(raws: &[i64], refs: &[f64], lsb: f64, map: Map, width: u32) {
+        let half = 0.5 * lsb;
+        let one = lsb;
+        let column = Raws::of(raws, width);
+        let f = column_figures(column, lsb, refs, map, half, one, -1.0);
+        let p = portable(column, lsb, refs, map, half, one, -1.0);
+        assert_eq!(f, p, "the AVX2 kernel and the portable one differ");
+        let errs: Vec<f64> = raws
+            .iter()
+            .zip(refs)
+            .map(|(&r, &x)| {
+                r as f64 * lsb
+                    - match map {
+                        Map::Identity => x,
+                        Map::Scale(s) => s * x,
+                    }
+            })
+            .collect();
+        let (sum, sum_abs, sum_sq) = lane_sums(&errs);
+        assert_eq!(f.sum.to_bits(), sum.to_bits());
+        assert_eq!(f.sum_abs.to_bits(), sum_abs.to_bits());
+        assert_eq!(f.sum_sq.to_bits(), sum_sq.to_bits());
+        let max = errs
+            .iter()
+            .map(|e| e.abs())
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(f.max_abs.to_bits(), max.to_bits());
+        assert_eq!(
+            f.worst,
+            errs.iter().position(|e| e.abs() == max),
+            "the first maximum"
+        );
+        let correct = errs.iter().filter(|e| e.abs() <= half).count() as u64;
+        let faithful = errs.iter().filter(|e| e.abs() < one).count() as u64;
+        assert_eq!((f.n_correct, f.n_faithful), (correct, faithful));
+        if !raws.is_empty() {
+            let lo = *raws.iter().min().unwrap();
+            let hi = *raws.iter().max().unwrap();
+            assert_eq!(f.raw_range, (lo, hi));
+        }
+    }
+
+    #[test]
+    fn narrow_conversion_is_exact_to_the_edges() {
+        let edge = (1i64 << 51) - 1;
+        for x in [0, 1, -1, 12345, -98765, edge, -edge, edge - 7, -(edge - 7)] {
+            assert_eq!(narrow_to_f64(x).to_bits(), (x as f64).to_bits(), "{x}");
+        }
+    }
+
+    #[test]
+    fn constant_column_matches_the_plain_sums() {
+        let refs: Vec<f64> = (0..2049).map(|i| -1.0 + f64::from(i) / 2048.0).collect();
+        let raws = vec![-131072i64; refs.len()];
+        let f = column_figures(
+            Raws::Constant(-131072),
+            2f64.powi(-16),
+            &refs,
+            Map::Scale(3.5),
+            2f64.powi(-17),
+            2f64.powi(-16),
+            -1.0,
+        );
+        let g = column_figures(
+            Raws::Narrow(&raws),
+            2f64.powi(-16),
+            &refs,
+            Map::Scale(3.5),
+            2f64.powi(-17),
+            2f64.powi(-16),
+            -1.0,
+        );
+        assert_eq!(f, g);
+        check_column(&raws, &refs, 2f64.powi(-16), Map::Scale(3.5), 18);
+    }
+
+    proptest! {
+        #[test]
+        fn kernels_agree_with_the_plain_order(
+            raws in proptest::collection::vec(-(1i64 << 50)..(1i64 << 50), 0..40),
+            frac in 0i32..60,
+            scale in proptest::option::of(-100.0f64..100.0),
+            seed in any::<u64>(),
+        ) {
+            let lsb = 2f64.powi(-frac);
+            let refs: Vec<f64> = raws
+                .iter()
+                .enumerate()
+                .map(|(i, &r)| r as f64 * lsb + ((seed >> (i % 60)) & 7) as f64 * lsb * 0.3)
+                .collect();
+            let map = scale.map_or(Map::Identity, Map::Scale);
+            check_column(&raws, &refs, lsb, map, 51);
+            check_column(&raws, &refs, lsb, map, 64);
+        }
+
+        #[test]
+        fn wide_values_convert_one_by_one(
+            raws in proptest::collection::vec(any::<i64>(), 0..20),
+        ) {
+            let refs: Vec<f64> = raws.iter().map(|&r| r as f64 * 0.5 + 1.0).collect();
+            check_column(&raws, &refs, 1.0, Map::Identity, 64);
+        }
+    }
+}
