@@ -9,7 +9,7 @@
 use serde::Serialize;
 
 use crate::analysis::accumulate::MaxAt;
-use crate::analysis::column::{column_figures, Map, Raws};
+use crate::analysis::column::{column_figures, Map, Raws, Refs};
 use crate::engine::{each_chunk, map_n, Chunk, Codes, Span};
 use crate::error::Error;
 use crate::fixed::{Event, Overflow};
@@ -601,7 +601,7 @@ impl Acc {
         &mut self,
         raws: Raws<'_>,
         lsb: f64,
-        refs: &[f64],
+        refs: Refs<'_>,
         map: Map,
         codes: &[i64],
         n: u32,
@@ -931,7 +931,7 @@ impl<'a> NFold<'a> {
             self.acc[STAGE_D].add_column(
                 Raws::of(&cols.values[STAGE_D], self.width[STAGE_D]),
                 self.lsb[STAGE_D],
-                ref_d,
+                Refs::Column(ref_d),
                 Map::Identity,
                 chunk,
                 n,
@@ -941,7 +941,7 @@ impl<'a> NFold<'a> {
         self.acc[STAGE_T].add_column(
             Raws::of(&cols.values[STAGE_T], self.width[STAGE_T]),
             self.lsb[STAGE_T],
-            ref_d,
+            Refs::Column(ref_d),
             Map::Scale(slope),
             chunk,
             n,
@@ -1023,7 +1023,7 @@ impl<'a> NFold<'a> {
             self.acc[stage_idx].add_column(
                 Raws::of(raws, self.width[stage_idx]),
                 self.lsb[stage_idx],
-                &self.live_refs,
+                Refs::Column(&self.live_refs),
                 Map::Identity,
                 &self.live_codes,
                 n,
@@ -1155,7 +1155,11 @@ impl<'a> NFold<'a> {
             self.acc[STAGE_T].add_column(
                 Raws::Constant(t.raw),
                 self.lsb[STAGE_T],
-                &shared.ref_d[start..end],
+                Refs::D {
+                    first: chunk[0],
+                    len: chunk.len(),
+                    c_lsb: self.c_lsb,
+                },
                 Map::Scale(nc.slope),
                 chunk,
                 n,

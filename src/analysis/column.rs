@@ -63,6 +63,43 @@ impl Map {
     }
 }
 
+/// The f64 references of a column, before their [`Map`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Refs<'a> {
+    /// One per element.
+    Column(&'a [f64]),
+    /// d's reference `code * c_lsb - 1` of `len` consecutive codes from `first` (none above
+    /// the code of 1.0), computed instead of read: the overflowed prefix of every n reads no
+    /// memory.
+    D {
+        /// The first code.
+        first: i64,
+        /// How many codes.
+        len: usize,
+        /// The input's LSB.
+        c_lsb: f64,
+    },
+}
+
+impl Refs<'_> {
+    /// How many references.
+    pub(crate) fn len(self) -> usize {
+        match self {
+            Refs::Column(r) => r.len(),
+            Refs::D { len, .. } => len,
+        }
+    }
+
+    /// Reference `i`.
+    #[inline(always)]
+    fn at(self, i: usize) -> f64 {
+        match self {
+            Refs::Column(r) => r[i],
+            Refs::D { first, c_lsb, .. } => (first + i as i64) as f64 * c_lsb - 1.0,
+        }
+    }
+}
+
 /// The figures of one column: the lanes joined, ready to add to a running total.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct ColumnFigures {
@@ -91,7 +128,7 @@ pub(crate) struct ColumnFigures {
 pub(crate) fn column_figures(
     raws: Raws<'_>,
     lsb: f64,
-    refs: &[f64],
+    refs: Refs<'_>,
     map: Map,
     half: f64,
     one: f64,
@@ -100,48 +137,149 @@ pub(crate) fn column_figures(
     if let Raws::Narrow(r) | Raws::Wide(r) = raws {
         assert_eq!(r.len(), refs.len(), "a raw value for every reference");
     }
+    if let Some(f) = monotone(raws, lsb, refs, map, half, one, above) {
+        return f;
+    }
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2, checked just above, and the lengths agree (asserted).
         let mut f = unsafe { avx2::figures(raws, lsb, refs, map, half, one) };
-        f.worst = worst(&f, raws, lsb, refs, map, above);
+        f.worst = f.worst.filter(|_| f.max_abs > above);
         return f;
     }
     portable(raws, lsb, refs, map, half, one, above)
 }
 
+/// The figures of a column whose errors are proven non-increasing in the element's index:
+/// one raw value against d's references of consecutive codes (increasing), mapped by the
+/// identity or a factor of at least 0. Each operation from the code to the error (the code in
+/// f64, exact; times the LSB, exact; minus 1, times the factor, the value minus that, each
+/// rounded by a monotone rounding) keeps the order, so the largest |error| is at an end, and
+/// the elements within `half` or below `one` are one run, found by bisection. Only the three
+/// sums look at every element. None where the proof does not hold.
+fn monotone(
+    raws: Raws<'_>,
+    lsb: f64,
+    refs: Refs<'_>,
+    map: Map,
+    half: f64,
+    one: f64,
+    above: f64,
+) -> Option<ColumnFigures> {
+    let (Raws::Constant(raw), Refs::D { first, len, c_lsb }) = (raws, refs) else {
+        return None;
+    };
+    if let Map::Scale(s) = map {
+        if !(s >= 0.0 && s.is_finite()) {
+            return None;
+        }
+    }
+    if len == 0 {
+        return None;
+    }
+    let value = raw as f64 * lsb;
+    let err = |i: usize| error(raws, lsb, refs, map, i);
+    let (e_first, e_last) = (err(0), err(len - 1));
+    if !(e_first.is_finite() && e_last.is_finite()) {
+        return None;
+    }
+    // The first index of a suffix where `holds` (a predicate true from some index on).
+    let suffix_start = |holds: &dyn Fn(f64) -> bool| {
+        let (mut lo, mut hi) = (0usize, len);
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if holds(err(mid)) {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        lo
+    };
+    // The errors e with lo_ok(e) and hi_ok(e): below hi from some index on, above lo up to
+    // some index.
+    let run = |below: &dyn Fn(f64) -> bool, above_lo: &dyn Fn(f64) -> bool| {
+        let from = suffix_start(below);
+        let to = suffix_start(&|e| !above_lo(e));
+        to.saturating_sub(from) as u64
+    };
+    let n_correct = run(&|e| e <= half, &|e| e >= -half);
+    let n_faithful = run(&|e| e < one, &|e| e > -one);
+    // The largest |error| is at the first element, or else on the run of the last value
+    // (then negative, and larger in magnitude than every error above it).
+    let (max_abs, at) = if e_first.abs() >= e_last.abs() {
+        (e_first.abs(), 0)
+    } else {
+        (e_last.abs(), suffix_start(&|e| e <= e_last))
+    };
+    let (sum, sum_abs, sum_sq) = monotone_sums(value, map, first, len, c_lsb);
+    Some(ColumnFigures {
+        max_abs,
+        worst: (max_abs > above).then_some(at),
+        sum,
+        sum_abs,
+        sum_sq,
+        n_correct,
+        n_faithful,
+        raw_range: (raw, raw),
+    })
+}
+
+/// The three sums of [`monotone`]'s column, in the module's lane order.
+fn monotone_sums(value: f64, map: Map, first: i64, len: usize, c_lsb: f64) -> (f64, f64, f64) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2, checked just above.
+        return unsafe { avx2::monotone_sums(value, map, first, len, c_lsb) };
+    }
+    monotone_sums_portable(value, map, first, len, c_lsb)
+}
+
+/// [`monotone_sums`] element by element.
+fn monotone_sums_portable(
+    value: f64,
+    map: Map,
+    first: i64,
+    len: usize,
+    c_lsb: f64,
+) -> (f64, f64, f64) {
+    let refs = Refs::D { first, len, c_lsb };
+    let (mut sum, mut sum_abs, mut sum_sq) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
+    let whole = len / 4 * 4;
+    for i in 0..len {
+        let lane = if i < whole { i % 4 } else { 0 };
+        let e = value - map.apply(refs.at(i));
+        sum[lane] += e;
+        sum_abs[lane] += e.abs();
+        sum_sq[lane] += e * e;
+    }
+    (join(sum), join(sum_abs), join(sum_sq))
+}
+
 /// The error of element `i`.
 #[inline(always)]
-fn error(raws: Raws<'_>, lsb: f64, refs: &[f64], map: Map, i: usize) -> f64 {
+fn error(raws: Raws<'_>, lsb: f64, refs: Refs<'_>, map: Map, i: usize) -> f64 {
     let value = match raws {
         Raws::Constant(r) => r as f64 * lsb,
         Raws::Narrow(r) => narrow_to_f64(r[i]) * lsb,
         Raws::Wide(r) => r[i] as f64 * lsb,
     };
-    value - map.apply(refs[i])
+    value - map.apply(refs.at(i))
 }
 
-/// The first element where the maximum is reached, when it is above `above`.
-fn worst(
-    f: &ColumnFigures,
-    raws: Raws<'_>,
-    lsb: f64,
-    refs: &[f64],
-    map: Map,
-    above: f64,
-) -> Option<usize> {
-    (f.max_abs > above).then(|| {
-        (0..refs.len())
-            .position(|i| error(raws, lsb, refs, map, i).abs() == f.max_abs)
-            .expect("the maximum is reached")
-    })
+/// The largest of the lanes' maxima and the first element where it is reached, from each
+/// lane's maximum and the first element where that lane reached it.
+fn first_max(max: [f64; 4], first: [usize; 4]) -> (f64, Option<usize>) {
+    let m = max[0].max(max[1]).max(max[2].max(max[3]));
+    let at = (0..4).filter(|&l| max[l] == m).map(|l| first[l]).min();
+    (m, at)
 }
 
 /// The portable kernel, element by element: the oracle of the AVX2 one (same bits).
 pub(crate) fn portable(
     raws: Raws<'_>,
     lsb: f64,
-    refs: &[f64],
+    refs: Refs<'_>,
     map: Map,
     half: f64,
     one: f64,
@@ -154,30 +292,34 @@ pub(crate) fn portable(
     let mut sum_sq = [0.0f64; 4];
     let mut n_correct = 0u64;
     let mut n_faithful = 0u64;
+    let mut first = [0usize; 4];
     let whole = len / 4 * 4;
     for i in 0..len {
         let lane = if i < whole { i % 4 } else { 0 };
         let e = error(raws, lsb, refs, map, i);
         let a = e.abs();
-        max[lane] = max[lane].max(a);
+        // `f64::max`, since the running maximum is never NaN; the first element kept.
+        if a > max[lane] {
+            max[lane] = a;
+            first[lane] = i;
+        }
         sum[lane] += e;
         sum_abs[lane] += a;
         sum_sq[lane] += e * e;
         n_correct += u64::from(a <= half);
         n_faithful += u64::from(a < one);
     }
-    let mut f = ColumnFigures {
-        max_abs: max[0].max(max[1]).max(max[2].max(max[3])),
-        worst: None,
+    let (max_abs, worst) = first_max(max, first);
+    ColumnFigures {
+        max_abs,
+        worst: worst.filter(|_| max_abs > above),
         sum: join(sum),
         sum_abs: join(sum_abs),
         sum_sq: join(sum_sq),
         n_correct,
         n_faithful,
         raw_range: raw_range(raws, len),
-    };
-    f.worst = worst(&f, raws, lsb, refs, map, above);
-    f
+    }
 }
 
 /// The lanes of a sum joined.
@@ -217,10 +359,11 @@ fn raw_range(raws: Raws<'_>, len: usize) -> (i64, i64) {
 mod avx2 {
     //! The AVX2 kernel: one 256-bit register per figure, its four lanes the four lanes of the
     //! portable loop.
-    use super::{join, raw_range, ColumnFigures, Map, Raws, MAGIC};
+    use super::{join, raw_range, ColumnFigures, Map, Raws, Refs, MAGIC};
     use std::arch::x86_64::*;
 
-    /// The figures (without `worst`) of a column, as [`super::portable`] computes them.
+    /// The figures of a column, as [`super::portable`] computes them (`worst` whatever the
+    /// caller's running maximum).
     ///
     /// # Safety
     /// The CPU has AVX2, and a column of raw values is as long as `refs`.
@@ -228,7 +371,7 @@ mod avx2 {
     pub(super) fn figures(
         raws: Raws<'_>,
         lsb: f64,
-        refs: &[f64],
+        refs: Refs<'_>,
         map: Map,
         half: f64,
         one: f64,
@@ -287,6 +430,65 @@ mod avx2 {
         }
     }
 
+    /// [`super::monotone_sums`]: the codes counted in f64 (integers below 2^53, exact), no
+    /// maximum, no counts.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn monotone_sums(
+        value: f64,
+        map: Map,
+        first: i64,
+        len: usize,
+        c_lsb: f64,
+    ) -> (f64, f64, f64) {
+        let scale = match map {
+            Map::Identity => None,
+            Map::Scale(s) => Some(_mm256_set1_pd(s)),
+        };
+        let (v, lsb4, one) = (
+            _mm256_set1_pd(value),
+            _mm256_set1_pd(c_lsb),
+            _mm256_set1_pd(1.0),
+        );
+        let (sign, four) = (_mm256_set1_pd(-0.0), _mm256_set1_pd(4.0));
+        let mut k = _mm256_add_pd(
+            _mm256_set1_pd(first as f64),
+            _mm256_set_pd(3.0, 2.0, 1.0, 0.0),
+        );
+        let (mut sum, mut sum_abs, mut sum_sq) = (
+            _mm256_setzero_pd(),
+            _mm256_setzero_pd(),
+            _mm256_setzero_pd(),
+        );
+        let quads = len / 4;
+        for _ in 0..quads {
+            let d = _mm256_sub_pd(_mm256_mul_pd(k, lsb4), one);
+            let r = match scale {
+                Some(s) => _mm256_mul_pd(s, d),
+                None => d,
+            };
+            let e = _mm256_sub_pd(v, r);
+            sum = _mm256_add_pd(sum, e);
+            sum_abs = _mm256_add_pd(sum_abs, _mm256_andnot_pd(sign, e));
+            sum_sq = _mm256_add_pd(sum_sq, _mm256_mul_pd(e, e));
+            k = _mm256_add_pd(k, four);
+        }
+        // SAFETY: the store writes the four values of `out`.
+        let lanes = |x: __m256d| {
+            let mut out = [0.0f64; 4];
+            unsafe { _mm256_storeu_pd(out.as_mut_ptr(), x) };
+            out
+        };
+        let (mut sum, mut sum_abs, mut sum_sq) = (lanes(sum), lanes(sum_abs), lanes(sum_sq));
+        let refs = Refs::D { first, len, c_lsb };
+        for i in 4 * quads..len {
+            let e = value - map.apply(refs.at(i));
+            sum[0] += e;
+            sum_abs[0] += e.abs();
+            sum_sq[0] += e * e;
+        }
+        (join(sum), join(sum_abs), join(sum_sq))
+    }
+
     /// The values `raw * lsb` of quad `q` of a narrow column.
     #[target_feature(enable = "avx2")]
     #[inline]
@@ -320,18 +522,52 @@ mod avx2 {
     fn kernel(
         raws: Raws<'_>,
         lsb: f64,
-        refs: &[f64],
+        refs: Refs<'_>,
         map: Map,
         half: f64,
         one: f64,
         value: impl Fn(usize) -> __m256d,
         scale: impl Fn(__m256d) -> __m256d,
     ) -> ColumnFigures {
+        match refs {
+            Refs::Column(r) => kernel_with(raws, lsb, refs, map, half, one, value, |q| {
+                let x: &[f64; 4] = r[4 * q..4 * q + 4].try_into().expect("a whole quad");
+                // SAFETY: the load reads the four values of `x` (unaligned).
+                scale(unsafe { _mm256_loadu_pd(x.as_ptr()) })
+            }),
+            Refs::D { first, c_lsb, .. } => {
+                let (steps, lsb4) = (_mm256_set_pd(3.0, 2.0, 1.0, 0.0), _mm256_set1_pd(c_lsb));
+                let one_v = _mm256_set1_pd(1.0);
+                kernel_with(raws, lsb, refs, map, half, one, value, |q| {
+                    // The four codes are integers below 2^53: exact in f64, as is each sum.
+                    let k = _mm256_add_pd(_mm256_set1_pd((first + 4 * q as i64) as f64), steps);
+                    scale(_mm256_sub_pd(_mm256_mul_pd(k, lsb4), one_v))
+                })
+            }
+        }
+    }
+
+    /// The loop of [`kernel`], `reference(q)` the mapped references of quad `q`.
+    #[allow(clippy::too_many_arguments)]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn kernel_with(
+        raws: Raws<'_>,
+        lsb: f64,
+        refs: Refs<'_>,
+        map: Map,
+        half: f64,
+        one: f64,
+        value: impl Fn(usize) -> __m256d,
+        reference: impl Fn(usize) -> __m256d,
+    ) -> ColumnFigures {
         let len = refs.len();
         let quads = len / 4;
         let sign = _mm256_set1_pd(-0.0);
         let (half4, one4) = (_mm256_set1_pd(half), _mm256_set1_pd(one));
         let mut max = _mm256_set1_pd(f64::NEG_INFINITY);
+        // The quad where each lane's maximum was first reached (an integer, exact in f64).
+        let mut first = _mm256_setzero_pd();
         let (mut sum, mut sum_abs, mut sum_sq) = (
             _mm256_setzero_pd(),
             _mm256_setzero_pd(),
@@ -339,11 +575,11 @@ mod avx2 {
         );
         let (mut n_correct, mut n_faithful) = (_mm256_setzero_si256(), _mm256_setzero_si256());
         for q in 0..quads {
-            let x: &[f64; 4] = refs[4 * q..4 * q + 4].try_into().expect("a whole quad");
-            // SAFETY: the load reads the four values of `x` (unaligned).
-            let e = _mm256_sub_pd(value(q), scale(unsafe { _mm256_loadu_pd(x.as_ptr()) }));
+            let e = _mm256_sub_pd(value(q), reference(q));
             let a = _mm256_andnot_pd(sign, e);
             // max(a, m): a where a > m, else m; m is never NaN, so a NaN error is skipped.
+            let gt = _mm256_cmp_pd::<_CMP_GT_OQ>(a, max);
+            first = _mm256_blendv_pd(first, _mm256_set1_pd(q as f64), gt);
             max = _mm256_max_pd(a, max);
             sum = _mm256_add_pd(sum, e);
             sum_abs = _mm256_add_pd(sum_abs, a);
@@ -367,20 +603,28 @@ mod avx2 {
         };
         let (mut max, mut sum, mut sum_abs, mut sum_sq) =
             (lanes(max), lanes(sum), lanes(sum_abs), lanes(sum_sq));
+        let mut first: [usize; 4] = {
+            let q = lanes(first);
+            std::array::from_fn(|l| 4 * q[l] as usize + l)
+        };
         let (mut n_correct, mut n_faithful) = (counts(n_correct), counts(n_faithful));
         for i in 4 * quads..len {
             let e = super::error(raws, lsb, refs, map, i);
             let a = e.abs();
-            max[0] = max[0].max(a);
+            if a > max[0] {
+                max[0] = a;
+                first[0] = i;
+            }
             sum[0] += e;
             sum_abs[0] += a;
             sum_sq[0] += e * e;
             n_correct += u64::from(a <= half);
             n_faithful += u64::from(a < one);
         }
+        let (max_abs, worst) = super::first_max(max, first);
         ColumnFigures {
-            max_abs: max[0].max(max[1]).max(max[2].max(max[3])),
-            worst: None,
+            max_abs,
+            worst,
             sum: join(sum),
             sum_abs: join(sum_abs),
             sum_sq: join(sum_sq),
@@ -415,8 +659,8 @@ mod tests {
         let half = 0.5 * lsb;
         let one = lsb;
         let column = Raws::of(raws, width);
-        let f = column_figures(column, lsb, refs, map, half, one, -1.0);
-        let p = portable(column, lsb, refs, map, half, one, -1.0);
+        let f = column_figures(column, lsb, Refs::Column(refs), map, half, one, -1.0);
+        let p = portable(column, lsb, Refs::Column(refs), map, half, one, -1.0);
         assert_eq!(f, p, "the AVX2 kernel and the portable one differ");
         let errs: Vec<f64> = raws
             .iter()
@@ -468,7 +712,7 @@ mod tests {
         let f = column_figures(
             Raws::Constant(-131072),
             2f64.powi(-16),
-            &refs,
+            Refs::Column(&refs),
             Map::Scale(3.5),
             2f64.powi(-17),
             2f64.powi(-16),
@@ -477,7 +721,7 @@ mod tests {
         let g = column_figures(
             Raws::Narrow(&raws),
             2f64.powi(-16),
-            &refs,
+            Refs::Column(&refs),
             Map::Scale(3.5),
             2f64.powi(-17),
             2f64.powi(-16),
@@ -485,6 +729,61 @@ mod tests {
         );
         assert_eq!(f, g);
         check_column(&raws, &refs, 2f64.powi(-16), Map::Scale(3.5), 18);
+    }
+
+    #[test]
+    fn d_computed_from_codes_is_the_column_of_d() {
+        // The overflowed prefix's shape (t saturated at -2 against 64 d), then errors that
+        // cross zero (so that some are within half an LSB, at code 16384) by the identity and
+        // by a factor, each in chunks that start and end anywhere; the computed column of d
+        // and its monotone shortcut give the figures of the column read from memory by the
+        // full kernels, which the plain order above checks.
+        let c_lsb = 2f64.powi(-15);
+        let cases = [
+            (-131072, Map::Scale(64.0)),
+            (-32768, Map::Identity),
+            (-32768, Map::Scale(1.0)),
+            (-16384, Map::Scale(0.5)),
+            (-16384, Map::Scale(0.0)),
+        ];
+        for (raw, map) in cases {
+            for (first, len) in [
+                (0i64, 2048usize),
+                (4093, 2047),
+                (-5, 9),
+                (32765, 3),
+                (16000, 2048),
+                (16383, 2),
+                (16384, 1),
+                (15360, 1024),
+            ] {
+                let refs: Vec<f64> = (first..first + len as i64)
+                    .map(|k| k as f64 * c_lsb - 1.0)
+                    .collect();
+                let varying: Vec<i64> = (0..len as i64).map(|i| raw + i % 7).collect();
+                for raws in [Raws::Constant(raw), Raws::Narrow(&varying)] {
+                    let lsb = 2f64.powi(-16);
+                    let run = |refs, above| {
+                        column_figures(raws, lsb, refs, map, 2f64.powi(-17), lsb, above)
+                    };
+                    let computed = Refs::D { first, len, c_lsb };
+                    let read = Refs::Column(&refs);
+                    for above in [-1.0, 0.25, 10.0] {
+                        let want = run(read, above);
+                        assert_eq!(run(computed, above), want, "{raw} {map:?} {first} {len}");
+                        assert_eq!(
+                            portable(raws, lsb, computed, map, 2f64.powi(-17), lsb, above),
+                            want
+                        );
+                    }
+                    let value = raw as f64 * lsb;
+                    assert_eq!(
+                        monotone_sums(value, map, first, len, c_lsb),
+                        monotone_sums_portable(value, map, first, len, c_lsb)
+                    );
+                }
+            }
+        }
     }
 
     proptest! {
