@@ -301,22 +301,24 @@ pub fn output_sum(dp: &Datapath, codes: Range<i64>) -> OutputSum {
     let parts = map_items(dp, &all, |nc, range| {
         let mut scratch = crate::pipeline::OutputScratch::default();
         let mut out = vec![0i64; BATCH_CODES];
+        // The sum of out * (c + 1), times n once at the end (mod 2^64 either way).
         let mut sum = 0u64;
+        let live = dp.first_live_code(nc, range.clone());
         let mut start = range.start;
-        let n = u64::from(nc.n);
         while start < range.end {
             let end = (start + BATCH_CODES as i64).min(range.end);
             let out = &mut out[..(end - start) as usize];
-            dp.eval_outputs_range(nc, start..end, out, &mut scratch);
-            for (c, &o) in (start..end).zip(out.iter()) {
-                let weight = (c as u64).wrapping_add(1).wrapping_mul(n);
-                sum = sum.wrapping_add((o as u64).wrapping_mul(weight));
+            let n_dead = dp.eval_outputs_from(nc, start..end, live, out, &mut scratch);
+            // The cut prefix's outputs are 0 and add nothing.
+            let first_live = start + n_dead as i64;
+            for (c, &o) in (first_live..end).zip(&out[n_dead..]) {
+                sum = sum.wrapping_add((o as u64).wrapping_mul((c as u64).wrapping_add(1)));
             }
             start = end;
         }
         OutputSum {
             evaluations: (range.end - range.start) as u64,
-            checksum: sum,
+            checksum: sum.wrapping_mul(u64::from(nc.n)),
         }
     });
     parts.iter().fold(

@@ -1134,26 +1134,55 @@ impl Datapath {
     }
 
     /// [`Datapath::eval_outputs`] over a range of codes, `out[i]` for code `codes.start + i`:
-    /// the cut prefix (see [`Datapath::first_live_code`]) is filled with its one output, the
-    /// rest is evaluated.
+    /// the cut prefix (see [`Datapath::first_live_code`]) is filled with its output, 0, the
+    /// rest is evaluated. Returns the length of the cut prefix.
     pub fn eval_outputs_range(
         &self,
         nc: &NConstants,
         codes: std::ops::Range<i64>,
         out: &mut [i64],
         scratch: &mut OutputScratch,
-    ) {
+    ) -> usize {
         let live = self.first_live_code(nc, codes.clone());
+        self.eval_outputs_from(nc, codes, live, out, scratch)
+    }
+
+    /// [`Datapath::eval_outputs_range`] given `live`, [`Datapath::first_live_code`] of a range
+    /// that holds `codes` (found once for many batches of it): the codes of `codes` below it
+    /// are cut (their output is 0), the others are evaluated. Returns the length of the cut
+    /// prefix.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::{Config, Datapath, OutputScratch};
+    /// let dp = Datapath::new(Config::baseline()).unwrap();
+    /// let nc = dp.constants_for(1024).unwrap();
+    /// let live = dp.first_live_code(nc, 0..32769);
+    /// let mut out = vec![0; 2048];
+    /// let cut = dp.eval_outputs_from(nc, 30720..32768, live, &mut out, &mut OutputScratch::default());
+    /// assert_eq!(cut, (live - 30720) as usize);
+    /// assert_eq!(out[2047], dp.eval(32767, nc).values[dp.stage_out()]);
+    /// ```
+    pub fn eval_outputs_from(
+        &self,
+        nc: &NConstants,
+        codes: std::ops::Range<i64>,
+        live: i64,
+        out: &mut [i64],
+        scratch: &mut OutputScratch,
+    ) -> usize {
+        let live = live.clamp(codes.start, codes.end);
         let n_dead = (live - codes.start) as usize;
-        if n_dead > 0 {
-            let dead = self.eval(codes.start, nc).values[self.stage_out()];
-            out[..n_dead].fill(dead);
-        }
+        // A cut base is 0, and 0 is every stage's exact value from b on (every rounding mode
+        // keeps 0, and every format holds it): the cut output is 0, written at the memory's
+        // pace (the check's dead prefix rests on the same fact).
+        out[..n_dead].fill(0);
         let mut live_codes = std::mem::take(&mut scratch.codes);
         live_codes.clear();
         live_codes.extend(live..codes.end);
         self.eval_outputs(nc, &live_codes, &mut out[n_dead..], scratch);
         scratch.codes = live_codes;
+        n_dead
     }
 }
 

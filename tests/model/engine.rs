@@ -35,11 +35,13 @@ fn output_sum_equals_the_scalar_model_with_any_thread_count() {
         // t wraps: the cut codes are no prefix and every code is evaluated.
         Config::from_toml("[t]\nformat = \"s2.12\"\noverflow = \"WRAP\"\n").unwrap(),
         Config::from_toml("variant = \"minimax\"\n[b]\nformat = \"u1.24\"\n").unwrap(),
+        // A signed input: the cut prefix starts at negative codes.
+        Config::from_toml("[c]\nformat = \"s2.10\"\n[d]\nformat = \"s3.11\"\n").unwrap(),
     ];
     for mut cfg in configs {
         cfg.n = "16,17,100,555,1024".parse().unwrap();
         let dp = Datapath::new(cfg).unwrap();
-        let codes = 0..dp.one_code() + 100;
+        let codes = (*dp.input_codes().start()).max(-3000)..dp.one_code() + 100;
         let want = slow_sum(&dp, codes.clone());
         for threads in [1, 2] {
             let got = in_pool(threads, || output_sum(&dp, codes.clone()));
