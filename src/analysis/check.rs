@@ -1285,8 +1285,10 @@ pub fn stage_events(dp: &Datapath) -> Result<Vec<EventCounts>, Error> {
     Ok(total)
 }
 
-/// The largest number of input codes an exhaustive check evaluates per exponent.
-pub const MAX_CHECK_CODES: u64 = 1 << 24;
+/// The largest number of input codes an exhaustive check evaluates per exponent: every code of
+/// a 24-bit fraction up to 1.0 (`u1.24`, 0..=2^24). Its columns (the codes, their `ln c` and
+/// d's reference, 24 bytes a code) then take 384 MiB, whatever the number of exponents.
+pub const MAX_CHECK_CODES: u64 = (1 << 24) + 1;
 
 /// Every input code up to 1.0 with its ln c and d's f64 reference, or [`Error::TooManyCodes`].
 fn code_columns(dp: &Datapath) -> Result<CodeColumns, Error> {
@@ -1328,12 +1330,51 @@ fn code_columns(dp: &Datapath) -> Result<CodeColumns, Error> {
 /// assert!(r.monotonic);
 /// ```
 pub fn check(dp: &Datapath) -> Result<CheckReport, Error> {
+    check_with_progress(dp, &|_, _| {})
+}
+
+/// [`check`], calling `progress(done, total)` as each of the `total` exponents finishes (from
+/// the worker threads, in any order; the report is the same).
+///
+/// # Errors
+/// As [`check`].
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::check::{check, check_with_progress};
+/// use specfx::pipeline::{Config, Datapath};
+/// use std::sync::atomic::{AtomicUsize, Ordering};
+/// let mut cfg = Config::baseline();
+/// cfg.n = "16..=19".parse().unwrap();
+/// let dp = Datapath::new(cfg).unwrap();
+/// let calls = AtomicUsize::new(0);
+/// let r = check_with_progress(&dp, &|done, total| {
+///     assert!(done <= total && total == 4);
+///     calls.fetch_add(1, Ordering::Relaxed);
+/// })
+/// .unwrap();
+/// assert_eq!(calls.into_inner(), 4);
+/// assert_eq!(r, check(&dp).unwrap());
+/// ```
+pub fn check_with_progress(
+    dp: &Datapath,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<CheckReport, Error> {
     let shared = code_columns(dp)?;
     let codes_all = dp.input_codes();
     let last = (*codes_all.end()).min(dp.one_code());
     let n_codes = shared.codes.codes.len() as u64;
     let c_lsb = dp.config().c.format.lsb();
-    let per_n: Vec<PerN> = map_n(dp, |nc| check_one_n(dp, nc, &shared));
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let total = dp.constants().len();
+    let per_n: Vec<PerN> = map_n(dp, |nc| {
+        let p = check_one_n(dp, nc, &shared);
+        progress(
+            done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+            total,
+        );
+        p
+    });
 
     let stages = dp.stages();
     let mut acc = vec![Acc::new(); stages.len()];

@@ -5,7 +5,7 @@ use clap::Args;
 
 use super::output::{print_json, print_with};
 use super::Outcome;
-use specfx::analysis::check::check;
+use specfx::analysis::check::check_with_progress;
 use specfx::nset::NSet;
 use specfx::report::check::write_check_table;
 
@@ -23,10 +23,22 @@ pub struct CheckArgs {
     json: bool,
 }
 
+/// Evaluations from which `check` shows its progress.
+const PROGRESS_FROM: u64 = 1 << 29;
+
 /// Runs `specfx check`.
 pub fn run(args: &CheckArgs) -> Result<Outcome> {
     let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
-    let report = check(&dp).map_err(|e| anyhow!("config {}: {e}", args.config))?;
+    // A bar only for a check long enough to watch (a 20-bit input: about a second).
+    let evaluations = dp.constants().len() as u64 * (dp.one_code() + 1) as u64;
+    let bar = if evaluations >= PROGRESS_FROM {
+        super::progress::Progress::new("check", "exponents", dp.constants().len() as u64)
+    } else {
+        super::progress::Progress::off("check", "exponents", 0)
+    };
+    let report = check_with_progress(&dp, &|done, _| bar.set_position(done as u64))
+        .map_err(|e| anyhow!("config {}: {e}", args.config))?;
+    bar.finish();
     if args.json {
         print_json(&report)?;
     } else {
