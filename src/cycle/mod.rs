@@ -358,6 +358,7 @@ fn op_units(owner: &[Op]) -> Vec<Op> {
 }
 
 impl Machine for Pipelined {
+    #[inline]
     fn in_ready(&self, out_ready: bool) -> bool {
         self.output().is_none() || out_ready
     }
@@ -370,6 +371,7 @@ impl Machine for Pipelined {
         self.reg(self.ring.len() - 1).map(|it| (it.tag, it.out))
     }
 
+    #[inline]
     fn step(&mut self, _dp: &Datapath, input: Option<Item>, out_ready: bool) {
         if !self.in_ready(out_ready) {
             // Rule 5: a stalled pipeline holds everything (and accepts nothing).
@@ -387,9 +389,17 @@ impl Machine for Pipelined {
         self.ring[self.head] = input;
     }
 
+    #[inline]
     fn count_occupancy(&self, counts: &mut [u64]) {
-        for (count, &mask) in counts.iter_mut().zip(&self.unit_masks) {
-            *count += u64::from(self.valid & mask != 0);
+        // A full pipeline (every register valid: the usual case of a stream without
+        // bubbles) occupies every unit, an empty one none.
+        let full = u128::MAX >> (128 - self.ring.len());
+        if self.valid == full {
+            counts.iter_mut().for_each(|c| *c += 1);
+        } else if self.valid != 0 {
+            for (count, &mask) in counts.iter_mut().zip(&self.unit_masks) {
+                *count += u64::from(self.valid & mask != 0);
+            }
         }
     }
 

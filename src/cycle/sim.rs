@@ -228,8 +228,12 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
     fn refill(&mut self) {
         self.ahead.clear();
         self.next = 0;
-        self.ahead
-            .extend(self.items.by_ref().take(self.block).map(|(n, c)| (n, c, 0)));
+        for _ in 0..self.block {
+            match self.items.next() {
+                Some((n, c)) => self.ahead.push((n, c, 0)),
+                None => break,
+            }
+        }
         self.exhausted = self.ahead.len() < self.block;
         self.block = (self.block * 2).min(Self::MAX_BLOCK);
         // Group by n (a counting sort, so each group keeps stream order), evaluate, scatter
@@ -262,8 +266,22 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
             self.codes.extend(group.iter().map(|&i| self.ahead[i].1));
             self.values.clear();
             self.values.resize(group.len(), 0);
-            self.dp
-                .eval_outputs(nc, &self.codes, &mut self.values, &mut self.scratch);
+            let (first, last) = (self.codes[0], self.codes[self.codes.len() - 1]);
+            if last - first + 1 == self.codes.len() as i64
+                && self.codes.windows(2).all(|w| w[1] == w[0] + 1)
+            {
+                // A run of consecutive codes (the sweep stream): its cut prefix is found by
+                // bisection and filled, not evaluated.
+                self.dp.eval_outputs_range(
+                    nc,
+                    first..last + 1,
+                    &mut self.values,
+                    &mut self.scratch,
+                );
+            } else {
+                self.dp
+                    .eval_outputs(nc, &self.codes, &mut self.values, &mut self.scratch);
+            }
             for (&i, &v) in group.iter().zip(&self.values) {
                 self.ahead[i].2 = v;
             }
@@ -496,10 +514,19 @@ crate::names::named_enum!(Stream, "input stream", "random or sweep");
 /// assert_eq!(first, [(0, 32768), (1, 0)]);
 /// ```
 pub fn sweep_inputs(dp: &Datapath) -> impl Iterator<Item = (usize, i64)> + '_ {
-    let codes = *dp.input_codes().start()..=dp.one_code();
-    (0..dp.constants().len())
-        .flat_map(move |n_idx| codes.clone().map(move |c| (n_idx, c)))
-        .cycle()
+    let (first, last) = (*dp.input_codes().start(), dp.one_code());
+    let n_count = dp.constants().len();
+    let (mut n_idx, mut c) = (0, first);
+    std::iter::from_fn(move || {
+        let item = (n_idx, c);
+        if c == last {
+            c = first;
+            n_idx = (n_idx + 1) % n_count;
+        } else {
+            c += 1;
+        }
+        Some(item)
+    })
 }
 
 /// An endless seeded stream of random inputs: n uniform over the set, c uniform over the
