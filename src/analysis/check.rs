@@ -1110,37 +1110,22 @@ impl<'a> NFold<'a> {
     }
 
     /// Folds the whole chunks, from the first, that are dead (below `dead_end`) and whose t
-    /// overflows below its range at every code, without evaluating them; returns the index of
-    /// the first code left to the stream.
+    /// overflows below its range at every code ([`overflowed_chunks`]), without evaluating
+    /// them; returns the index of the first code left to the stream.
     ///
     /// Such a chunk's figures follow from its codes: d is exact (`d_is_exact`), t is one raw
     /// value with one event at every code, the coefficient is a constant, and from b on every
-    /// value is 0 in both models. The proof that t is one value: d = c - 1 is non-decreasing
-    /// in the code and at most 0, so with a slope of at least 0 the exact product d * slope is
-    /// non-decreasing and at most 0, and so is its rounding (every rounding mode is monotone);
-    /// an overflow at the chunk's last code can then only be below the range, and every
-    /// earlier code's rounded product is lower still, so it overflows too and, unless t wraps,
-    /// is given the same value with the same event.
+    /// value is 0 in both models.
     fn overflowed_prefix(&mut self, shared: &CodeColumns, dead_end: i64) -> usize {
         let (dp, nc) = (self.dp, self.nc);
-        if !self.d_is_exact || nc.slope_raw < 0 || dp.config().t.overflow == Overflow::Wrap {
+        if !self.d_is_exact {
             return 0;
         }
         let codes = &shared.codes.codes;
-        let mut start = 0;
-        while start < codes.len() {
-            let end = (start + CHUNK).min(codes.len());
+        let mut next = 0;
+        for (start, end, t, kind) in overflowed_chunks(dp, nc, codes, dead_end) {
+            next = end;
             let last = codes[end - 1];
-            if last >= dead_end {
-                break;
-            }
-            let t = dp.op_mul_t(dp.op_sub(last).1, nc);
-            let kind = match t.event {
-                Event::None => break,
-                Event::Wrapped => 0,
-                Event::Saturated => 1,
-                Event::Zeroed => 2,
-            };
             let chunk = &codes[start..end];
             let (n, len) = (nc.n, chunk.len() as u64);
             let mut counts = [0u64; 3];
@@ -1186,9 +1171,8 @@ impl<'a> NFold<'a> {
                 "a prefix of the codes"
             );
             self.prev_out = Some(0);
-            start = end;
         }
-        start
+        next
     }
 
     /// The exponent's figures, with the largest code of zero lobes counted once.
@@ -1219,6 +1203,46 @@ impl<'a> NFold<'a> {
             n_cut: self.n_cut,
         }
     }
+}
+
+/// The whole chunks of `codes` (consecutive codes up to 1.0, [`CHUNK`] each), from the first,
+/// that are dead (below `dead_end`) and whose t overflows below its range at every code:
+/// `(start, end, t, event index)` of each, with the one value and event t has there (the
+/// event index of [`EventCounts`]).
+///
+/// The proof that t is one value: d = c - 1 is non-decreasing in the code and at most 0, so
+/// with a slope of at least 0 the exact product d * slope is non-decreasing and at most 0, and
+/// so is its rounding (every rounding mode is monotone); an overflow at the chunk's last code
+/// can then only be below the range, and every earlier code's rounded product is lower still,
+/// so it overflows too and, unless t wraps, is given the same value with the same event.
+fn overflowed_chunks<'a>(
+    dp: &'a Datapath,
+    nc: &'a NConstants,
+    codes: &'a [i64],
+    dead_end: i64,
+) -> impl Iterator<Item = (usize, usize, crate::fixed::Quantized, usize)> + 'a {
+    let proven = nc.slope_raw >= 0 && dp.config().t.overflow != Overflow::Wrap;
+    let mut start = 0;
+    std::iter::from_fn(move || {
+        if !proven || start >= codes.len() {
+            return None;
+        }
+        let end = (start + CHUNK).min(codes.len());
+        let last = codes[end - 1];
+        if last >= dead_end {
+            return None;
+        }
+        let t = dp.op_mul_t(dp.op_sub(last).1, nc);
+        let kind = match t.event {
+            Event::None => return None,
+            Event::Wrapped => 0,
+            Event::Saturated => 1,
+            Event::Zeroed => 2,
+        };
+        let chunk = (start, end, t, kind);
+        start = end;
+        Some(chunk)
+    })
 }
 
 /// One exponent's exhaustive check: every chunk of the stream above the dead prefix's start,
@@ -1259,12 +1283,20 @@ pub fn stage_events(dp: &Datapath) -> Result<Vec<EventCounts>, Error> {
     let shared = code_columns(dp)?;
     let n_stages = dp.stages().len();
     let per_n = map_n(dp, |nc| {
+        let codes = &shared.codes.codes;
+        let dead_end = dead_prefix_end(dp, nc, codes);
+        let mut counts = vec![[0u64; 3]; n_stages];
+        // The overflowed chunks: t's one event at every code, none elsewhere.
+        let mut from = 0;
+        for (start, end, _, kind) in overflowed_chunks(dp, nc, codes, dead_end) {
+            counts[STAGE_T][kind] += (end - start) as u64;
+            from = end;
+        }
         let span = Span {
-            from: 0,
-            dead_end: dead_prefix_end(dp, nc, &shared.codes.codes),
+            from,
+            dead_end,
             chunk_codes: CHUNK,
         };
-        let mut counts = vec![[0u64; 3]; n_stages];
         each_chunk(dp, nc, &shared.codes, span, |c| {
             for (sum, e) in counts.iter_mut().zip(&c.probes.event_counts) {
                 for (a, b) in sum.iter_mut().zip(e) {
