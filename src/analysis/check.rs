@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use crate::analysis::accumulate::MaxAt;
 use crate::analysis::column::{column_figures, Map, Raws, Refs};
-use crate::engine::{each_chunk, map_n, Chunk, Codes, Span};
+use crate::engine::{each_chunk, each_chunk_in, map_n, map_n_with, Chunk, Codes, Span};
 use crate::error::Error;
 use crate::fixed::{Event, Overflow};
 use crate::pipeline::datapath::{CutStructure, STAGE_B, STAGE_D, STAGE_SQ0, STAGE_T};
@@ -852,7 +852,8 @@ struct NFold<'a> {
 }
 
 impl<'a> NFold<'a> {
-    fn new(dp: &'a Datapath, nc: &'a NConstants) -> NFold<'a> {
+    /// A fold whose columns come from `scratch` ([`NFold::finish`] gives them back).
+    fn new(dp: &'a Datapath, nc: &'a NConstants, scratch: &mut Scratch) -> NFold<'a> {
         let cfg = dp.config();
         let n_stages = dp.stages().len();
         NFold {
@@ -880,12 +881,12 @@ impl<'a> NFold<'a> {
             n_cut: 0,
             prev_out: None,
             zero_lobe_code: None,
-            ref_b: Vec::with_capacity(CHUNK),
-            live: Vec::with_capacity(CHUNK),
-            live_codes: Vec::with_capacity(CHUNK),
-            live_raws: Vec::with_capacity(CHUNK),
-            live_refs: Vec::with_capacity(CHUNK),
-            live_cos: Vec::with_capacity(CHUNK),
+            ref_b: std::mem::take(&mut scratch.ref_b),
+            live: std::mem::take(&mut scratch.live),
+            live_codes: std::mem::take(&mut scratch.live_codes),
+            live_raws: std::mem::take(&mut scratch.live_raws),
+            live_refs: std::mem::take(&mut scratch.live_refs),
+            live_cos: std::mem::take(&mut scratch.live_cos),
         }
     }
 
@@ -1176,7 +1177,13 @@ impl<'a> NFold<'a> {
     }
 
     /// The exponent's figures, with the largest code of zero lobes counted once.
-    fn finish(mut self) -> PerN {
+    fn finish(mut self, scratch: &mut Scratch) -> PerN {
+        scratch.ref_b = std::mem::take(&mut self.ref_b);
+        scratch.live = std::mem::take(&mut self.live);
+        scratch.live_codes = std::mem::take(&mut self.live_codes);
+        scratch.live_raws = std::mem::take(&mut self.live_raws);
+        scratch.live_refs = std::mem::take(&mut self.live_refs);
+        scratch.live_cos = std::mem::take(&mut self.live_cos);
         if let Some((code, lnc)) = self.zero_lobe_code {
             let at = (self.nc.n, code);
             let cos_n = if code <= 0 {
@@ -1247,18 +1254,38 @@ fn overflowed_chunks<'a>(
 
 /// One exponent's exhaustive check: every chunk of the stream above the dead prefix's start,
 /// folded by [`NFold`].
-fn check_one_n(dp: &Datapath, nc: &NConstants, shared: &CodeColumns) -> PerN {
+/// A worker's columns, reused from one exponent to the next.
+#[derive(Default)]
+struct Scratch {
+    probes: crate::pipeline::ProbeColumns,
+    ref_b: Vec<f64>,
+    live: Vec<usize>,
+    live_codes: Vec<i64>,
+    live_raws: Vec<i64>,
+    live_refs: Vec<f64>,
+    live_cos: Vec<f64>,
+}
+
+fn check_one_n(
+    dp: &Datapath,
+    nc: &NConstants,
+    shared: &CodeColumns,
+    scratch: &mut Scratch,
+) -> PerN {
     let dead_end = dead_prefix_end(dp, nc, &shared.codes.codes);
-    let mut fold = NFold::new(dp, nc);
+    let mut fold = NFold::new(dp, nc, scratch);
+    let mut probes = std::mem::take(&mut scratch.probes);
     let span = Span {
         from: fold.overflowed_prefix(shared, dead_end),
         dead_end,
         chunk_codes: CHUNK,
     };
-    each_chunk(dp, nc, &shared.codes, span, |c| {
+    each_chunk_in(dp, nc, &shared.codes, span, &mut probes, |c| {
         fold.chunk(c, &shared.ref_d[c.start..c.start + c.codes.len()]);
     });
-    fold.finish()
+    let per_n = fold.finish(scratch);
+    scratch.probes = probes;
+    per_n
 }
 
 /// The overflow events of every stage (wrapped, saturated, zeroed; indexed like
@@ -1399,8 +1426,8 @@ pub fn check_with_progress(
     let c_lsb = dp.config().c.format.lsb();
     let done = std::sync::atomic::AtomicUsize::new(0);
     let total = dp.constants().len();
-    let per_n: Vec<PerN> = map_n(dp, |nc| {
-        let p = check_one_n(dp, nc, &shared);
+    let per_n: Vec<PerN> = map_n_with(dp, Scratch::default, |scratch, nc| {
+        let p = check_one_n(dp, nc, &shared, scratch);
         progress(
             done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
             total,

@@ -24,12 +24,12 @@ pub struct CheckArgs {
 }
 
 /// Evaluations from which `check` shows its progress.
-const PROGRESS_FROM: u64 = 1 << 29;
+const PROGRESS_FROM: u64 = 1 << 32;
 
 /// Runs `specfx check`.
 pub fn run(args: &CheckArgs) -> Result<Outcome> {
     let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
-    // A bar only for a check long enough to watch (a 20-bit input: about a second).
+    // A bar only for a check long enough to watch (a 22-bit input and wider: seconds).
     let evaluations = dp.constants().len() as u64 * (dp.one_code() + 1) as u64;
     let bar = if evaluations >= PROGRESS_FROM {
         super::progress::Progress::new("check", "exponents", dp.constants().len() as u64)

@@ -94,6 +94,19 @@ pub fn map_n<T: Send>(dp: &Datapath, work: impl Fn(&NConstants) -> T + Sync) -> 
     dp.constants().par_iter().map(&work).collect()
 }
 
+/// [`map_n`] with a scratch `init` makes for each worker's run of exponents (columns reused
+/// from one n to the next instead of allocated for each); results in n order.
+pub fn map_n_with<S, T: Send>(
+    dp: &Datapath,
+    init: impl Fn() -> S + Sync + Send,
+    work: impl Fn(&mut S, &NConstants) -> T + Sync + Send,
+) -> Vec<T> {
+    dp.constants()
+        .par_iter()
+        .map_init(init, |s, nc| work(s, nc))
+        .collect()
+}
+
 /// The input codes a stream evaluates for every n, with `ln c` of each (c clamped to 1.0),
 /// computed once and shared by every n: `cos^n = exp(n ln c)`.
 #[derive(Debug, Clone, PartialEq)]
@@ -248,25 +261,36 @@ pub fn each_chunk(
     nc: &NConstants,
     codes: &Codes,
     span: Span,
+    f: impl FnMut(&Chunk<'_>),
+) {
+    each_chunk_in(dp, nc, codes, span, &mut ProbeColumns::default(), f);
+}
+
+/// [`each_chunk`] with the columns of `probes` reused (a thread's, across its exponents).
+pub fn each_chunk_in(
+    dp: &Datapath,
+    nc: &NConstants,
+    codes: &Codes,
+    span: Span,
+    probes: &mut ProbeColumns,
     mut f: impl FnMut(&Chunk<'_>),
 ) {
-    let mut probes = ProbeColumns::default();
     let mut start = span.from;
     while start < codes.codes.len() {
         let end = (start + span.chunk_codes).min(codes.codes.len());
         let chunk = &codes.codes[start..end];
         let dead = chunk[chunk.len() - 1] < span.dead_end;
         if dead {
-            dp.eval_batch_cut(nc, chunk, &mut probes);
+            dp.eval_batch_cut(nc, chunk, probes);
         } else {
-            dp.eval_batch(nc, chunk, &mut probes);
+            dp.eval_batch(nc, chunk, probes);
         }
         f(&Chunk {
             dp,
             nc,
             codes: chunk,
             ln_c: &codes.ln_c[start..end],
-            probes: &probes,
+            probes,
             start,
             dead,
         });
