@@ -910,10 +910,26 @@ impl<'a> NFold<'a> {
         let (nc, cutoff, one, threshold) =
             (self.nc, self.dp.config().cutoff, self.one, self.threshold);
         self.ref_b.clear();
-        if !c.dead {
-            self.ref_b.extend(ref_d.iter().zip(c.codes).map(|(&d, &k)| {
-                reference_base(cutoff, nc.slope * d, nc.offset, k.min(one) < threshold)
-            }));
+        if c.dead {
+            return;
+        }
+        // `reference_base` with the cutoff decided once for the chunk (the same values).
+        let (slope, offset) = (nc.slope, nc.offset);
+        match cutoff {
+            Cutoff::Clamp => self.ref_b.extend(ref_d.iter().map(|&d| {
+                let sum = slope * d + offset;
+                if sum < 0.0 {
+                    0.0
+                } else {
+                    sum
+                }
+            })),
+            Cutoff::None => self.ref_b.extend(ref_d.iter().map(|&d| slope * d + offset)),
+            Cutoff::Paper => {
+                self.ref_b.extend(ref_d.iter().zip(c.codes).map(|(&d, &k)| {
+                    reference_base(cutoff, slope * d, offset, k.min(one) < threshold)
+                }))
+            }
         }
     }
 
@@ -962,14 +978,27 @@ impl<'a> NFold<'a> {
     fn find_live(&mut self, c: &Chunk<'_>) {
         let (chunk, b) = (c.codes, &c.probes.values[STAGE_B]);
         let ref_b = &self.ref_b;
+        let is_live = |i: usize| b[i] != 0 || ref_b[i] != 0.0;
         self.live.clear();
-        if !c.dead {
-            self.live
-                .extend((0..chunk.len()).filter(|&i| b[i] != 0 || ref_b[i] != 0.0));
+        // The usual live chunk: a run of dead inputs, then only live ones.
+        let first_live = if c.dead {
+            chunk.len()
+        } else {
+            (0..chunk.len())
+                .find(|&i| is_live(i))
+                .unwrap_or(chunk.len())
+        };
+        let suffix = !c.dead && (first_live..chunk.len()).all(is_live);
+        if suffix {
+            self.live.extend(first_live..chunk.len());
+        } else if !c.dead {
+            self.live.extend((0..chunk.len()).filter(|&i| is_live(i)));
         }
         if self.live.len() < chunk.len() {
             let largest_dead = if c.dead {
                 chunk.len() - 1
+            } else if suffix {
+                first_live - 1
             } else {
                 (0..chunk.len())
                     .rev()
@@ -984,9 +1013,14 @@ impl<'a> NFold<'a> {
             }
         }
         self.live_codes.clear();
-        self.live_codes.extend(self.live.iter().map(|&i| chunk[i]));
         self.live_refs.clear();
-        self.live_refs.extend(self.live.iter().map(|&i| ref_b[i]));
+        if suffix {
+            self.live_codes.extend_from_slice(&chunk[first_live..]);
+            self.live_refs.extend_from_slice(&ref_b[first_live..]);
+        } else {
+            self.live_codes.extend(self.live.iter().map(|&i| chunk[i]));
+            self.live_refs.extend(self.live.iter().map(|&i| ref_b[i]));
+        }
     }
 
     /// b, the squarings and the output on the live inputs (the dead ones are exact zeros);
@@ -1092,7 +1126,16 @@ impl<'a> NFold<'a> {
             )
         };
         self.n_cut += n_chunk_cut;
-        for (&o, &code) in c.probes.values[self.out].iter().zip(c.codes).take(checked) {
+        let outs = &c.probes.values[self.out][..checked];
+        // Most chunks have no violation: one pass that counts them, in the chunk and against
+        // the output before it, and the per-output walk only where there is one.
+        let inside = outs.windows(2).filter(|w| w[1] < w[0]).count();
+        let at_start = self.prev_out.is_some_and(|p| outs[0] < p);
+        if inside == 0 && !at_start {
+            self.prev_out = Some(outs[checked - 1]);
+            return;
+        }
+        for (&o, &code) in outs.iter().zip(c.codes) {
             if let Some(prev) = self.prev_out {
                 if o < prev {
                     self.n_violations += 1;
