@@ -8,7 +8,7 @@ use clap::Args;
 
 use super::output::{print_json, print_with};
 use super::Outcome;
-use specfx::cycle::sim::{simulate_with, Record, SimStats, Stimulus, Stop, Stream};
+use specfx::cycle::sim::{simulate_stream, Record, SimStats, Stimulus, Stop, Stream};
 use specfx::cycle::vcd::write_vcd;
 use specfx::cycle::Arch;
 use specfx::nset::NSet;
@@ -93,10 +93,11 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
         transfers: false,
         trace_cycles,
     };
-    let result = simulate_with(
+    let result = simulate_stream(
         &dp,
         args.arch,
-        args.stream.inputs(&dp, args.seed),
+        args.stream,
+        args.seed,
         &mut stim,
         Stop::Cycles(args.cycles),
         record,

@@ -169,6 +169,23 @@ pub fn simulate_with(
     }
 }
 
+/// [`simulate_with`] on a named stream of inputs (`seed` seeds the random one), the stream's
+/// own iterator type given to the simulation (no call through a trait object per input).
+pub fn simulate_stream(
+    dp: &Datapath,
+    arch: Arch,
+    stream: Stream,
+    seed: u64,
+    stimulus: &mut Stimulus,
+    stop: Stop,
+    record: Record,
+) -> SimResult {
+    match stream {
+        Stream::Random => simulate_with(dp, arch, random_inputs(dp, seed), stimulus, stop, record),
+        Stream::Sweep => simulate_with(dp, arch, sweep_inputs(dp), stimulus, stop, record),
+    }
+}
+
 /// The input stream with each input's functional output, computed ahead in blocks: a block's
 /// inputs are grouped by n and evaluated with [`Datapath::eval_outputs`]. Blocks grow from
 /// [`Source::FIRST_BLOCK`] to [`Source::MAX_BLOCK`] inputs, so a short simulation reads little
@@ -236,10 +253,31 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
         }
         self.exhausted = self.ahead.len() < self.block;
         self.block = (self.block * 2).min(Self::MAX_BLOCK);
+        if self.ahead.windows(2).all(|w| w[0].0 <= w[1].0) {
+            // Already grouped by n (the sweep stream): each run of one n is evaluated in
+            // place.
+            let mut start = 0;
+            while start < self.ahead.len() {
+                let n_idx = self.ahead[start].0;
+                let end = start + self.ahead[start..].partition_point(|&(n, _, _)| n == n_idx);
+                self.codes.clear();
+                self.codes
+                    .extend(self.ahead[start..end].iter().map(|&(_, c, _)| c));
+                self.evaluate(n_idx);
+                for (item, &v) in self.ahead[start..end].iter_mut().zip(&self.values) {
+                    item.2 = v;
+                }
+                start = end;
+            }
+            return;
+        }
         // Group by n (a counting sort, so each group keeps stream order), evaluate, scatter
         // back.
         let constants = self.dp.constants();
-        let starts = &mut self.starts;
+        let (mut starts, mut order) = (
+            std::mem::take(&mut self.starts),
+            std::mem::take(&mut self.order),
+        );
         starts.clear();
         starts.resize(constants.len() + 1, 0);
         for &(n_idx, _, _) in &self.ahead {
@@ -248,43 +286,48 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
         for i in 1..starts.len() {
             starts[i] += starts[i - 1];
         }
-        self.order.clear();
-        self.order.resize(self.ahead.len(), 0);
+        order.clear();
+        order.resize(self.ahead.len(), 0);
         for (i, &(n_idx, _, _)) in self.ahead.iter().enumerate() {
             // starts[n_idx] is the next free place of group n_idx; it ends at the group's end.
-            self.order[starts[n_idx]] = i;
+            order[starts[n_idx]] = i;
             starts[n_idx] += 1;
         }
         let mut group_start = 0;
-        for (n_idx, nc) in constants.iter().enumerate() {
-            let group = &self.order[group_start..starts[n_idx]];
+        for n_idx in 0..constants.len() {
+            let group = &order[group_start..starts[n_idx]];
             group_start = starts[n_idx];
             if group.is_empty() {
                 continue;
             }
             self.codes.clear();
             self.codes.extend(group.iter().map(|&i| self.ahead[i].1));
-            self.values.clear();
-            self.values.resize(group.len(), 0);
-            let (first, last) = (self.codes[0], self.codes[self.codes.len() - 1]);
-            if last - first + 1 == self.codes.len() as i64
-                && self.codes.windows(2).all(|w| w[1] == w[0] + 1)
-            {
-                // A run of consecutive codes (the sweep stream): its cut prefix is found by
-                // bisection and filled, not evaluated.
-                self.dp.eval_outputs_range(
-                    nc,
-                    first..last + 1,
-                    &mut self.values,
-                    &mut self.scratch,
-                );
-            } else {
-                self.dp
-                    .eval_outputs(nc, &self.codes, &mut self.values, &mut self.scratch);
-            }
+            self.evaluate(n_idx);
             for (&i, &v) in group.iter().zip(&self.values) {
                 self.ahead[i].2 = v;
             }
+        }
+        (self.starts, self.order) = (starts, order);
+    }
+}
+
+impl<I> Source<'_, I> {
+    /// The outputs of `codes` (non-empty) for exponent `n_idx`, into `values`: a run of
+    /// consecutive codes by range (its cut prefix found by bisection and filled, not
+    /// evaluated), any other codes one by one in a batch.
+    fn evaluate(&mut self, n_idx: usize) {
+        let nc = &self.dp.constants()[n_idx];
+        self.values.clear();
+        self.values.resize(self.codes.len(), 0);
+        let (first, last) = (self.codes[0], self.codes[self.codes.len() - 1]);
+        if last - first + 1 == self.codes.len() as i64
+            && self.codes.windows(2).all(|w| w[1] == w[0] + 1)
+        {
+            self.dp
+                .eval_outputs_range(nc, first..last + 1, &mut self.values, &mut self.scratch);
+        } else {
+            self.dp
+                .eval_outputs(nc, &self.codes, &mut self.values, &mut self.scratch);
         }
     }
 }
