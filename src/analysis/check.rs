@@ -9,7 +9,7 @@
 use serde::Serialize;
 
 use crate::analysis::accumulate::MaxAt;
-use crate::analysis::column::{column_figures, Map, Raws, Refs};
+use crate::analysis::column::{column_figures, Map, Raws, References};
 use crate::engine::{each_chunk, each_chunk_in, map_n, map_n_with, Chunk, Codes, Span};
 use crate::error::Error;
 use crate::fixed::{Event, Overflow};
@@ -601,7 +601,7 @@ impl Acc {
         &mut self,
         raws: Raws<'_>,
         lsb: f64,
-        refs: Refs<'_>,
+        refs: References<'_>,
         map: Map,
         codes: &[i64],
         n: u32,
@@ -948,7 +948,7 @@ impl<'a> NFold<'a> {
             self.acc[STAGE_D].add_column(
                 Raws::of(&cols.values[STAGE_D], self.width[STAGE_D]),
                 self.lsb[STAGE_D],
-                Refs::Column(ref_d),
+                References::Column(ref_d),
                 Map::Identity,
                 chunk,
                 n,
@@ -958,7 +958,7 @@ impl<'a> NFold<'a> {
         self.acc[STAGE_T].add_column(
             Raws::of(&cols.values[STAGE_T], self.width[STAGE_T]),
             self.lsb[STAGE_T],
-            Refs::Column(ref_d),
+            References::Column(ref_d),
             Map::Scale(slope),
             chunk,
             n,
@@ -1058,7 +1058,7 @@ impl<'a> NFold<'a> {
             self.acc[stage_idx].add_column(
                 Raws::of(raws, self.width[stage_idx]),
                 self.lsb[stage_idx],
-                Refs::Column(&self.live_refs),
+                References::Column(&self.live_refs),
                 Map::Identity,
                 &self.live_codes,
                 n,
@@ -1184,7 +1184,7 @@ impl<'a> NFold<'a> {
             self.acc[STAGE_T].add_column(
                 Raws::Constant(t.raw),
                 self.lsb[STAGE_T],
-                Refs::D {
+                References::D {
                     first: chunk[0],
                     len: chunk.len(),
                     c_lsb: self.c_lsb,

@@ -65,7 +65,7 @@ impl Map {
 
 /// The f64 references of a column, before their [`Map`].
 #[derive(Debug, Clone, Copy)]
-pub(crate) enum Refs<'a> {
+pub(crate) enum References<'a> {
     /// One per element.
     Column(&'a [f64]),
     /// d's reference `code * c_lsb - 1` of `len` consecutive codes from `first` (none above
@@ -81,12 +81,12 @@ pub(crate) enum Refs<'a> {
     },
 }
 
-impl Refs<'_> {
+impl References<'_> {
     /// How many references.
     pub(crate) fn len(self) -> usize {
         match self {
-            Refs::Column(r) => r.len(),
-            Refs::D { len, .. } => len,
+            References::Column(r) => r.len(),
+            References::D { len, .. } => len,
         }
     }
 
@@ -94,8 +94,8 @@ impl Refs<'_> {
     #[inline(always)]
     fn at(self, i: usize) -> f64 {
         match self {
-            Refs::Column(r) => r[i],
-            Refs::D { first, c_lsb, .. } => (first + i as i64) as f64 * c_lsb - 1.0,
+            References::Column(r) => r[i],
+            References::D { first, c_lsb, .. } => (first + i as i64) as f64 * c_lsb - 1.0,
         }
     }
 }
@@ -128,7 +128,7 @@ pub(crate) struct ColumnFigures {
 pub(crate) fn column_figures(
     raws: Raws<'_>,
     lsb: f64,
-    refs: Refs<'_>,
+    refs: References<'_>,
     map: Map,
     half: f64,
     one: f64,
@@ -160,13 +160,13 @@ pub(crate) fn column_figures(
 fn monotone(
     raws: Raws<'_>,
     lsb: f64,
-    refs: Refs<'_>,
+    refs: References<'_>,
     map: Map,
     half: f64,
     one: f64,
     above: f64,
 ) -> Option<ColumnFigures> {
-    let (Raws::Constant(raw), Refs::D { first, len, c_lsb }) = (raws, refs) else {
+    let (Raws::Constant(raw), References::D { first, len, c_lsb }) = (raws, refs) else {
         return None;
     };
     if let Map::Scale(s) = map {
@@ -243,7 +243,7 @@ fn monotone_sums_portable(
     len: usize,
     c_lsb: f64,
 ) -> (f64, f64, f64) {
-    let refs = Refs::D { first, len, c_lsb };
+    let refs = References::D { first, len, c_lsb };
     let (mut sum, mut sum_abs, mut sum_sq) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
     let whole = len / 4 * 4;
     for i in 0..len {
@@ -258,7 +258,7 @@ fn monotone_sums_portable(
 
 /// The error of element `i`.
 #[inline(always)]
-fn error(raws: Raws<'_>, lsb: f64, refs: Refs<'_>, map: Map, i: usize) -> f64 {
+fn error(raws: Raws<'_>, lsb: f64, refs: References<'_>, map: Map, i: usize) -> f64 {
     let value = match raws {
         Raws::Constant(r) => r as f64 * lsb,
         Raws::Narrow(r) => narrow_to_f64(r[i]) * lsb,
@@ -279,7 +279,7 @@ fn first_max(max: [f64; 4], first: [usize; 4]) -> (f64, Option<usize>) {
 pub(crate) fn portable(
     raws: Raws<'_>,
     lsb: f64,
-    refs: Refs<'_>,
+    refs: References<'_>,
     map: Map,
     half: f64,
     one: f64,
@@ -359,7 +359,7 @@ fn raw_range(raws: Raws<'_>, len: usize) -> (i64, i64) {
 mod avx2 {
     //! The AVX2 kernel: one 256-bit register per figure, its four lanes the four lanes of the
     //! portable loop.
-    use super::{join, raw_range, ColumnFigures, Map, Raws, Refs, MAGIC};
+    use super::{join, raw_range, ColumnFigures, Map, Raws, References, MAGIC};
     use std::arch::x86_64::*;
 
     /// The figures of a column, as [`super::portable`] computes them (`worst` whatever the
@@ -371,7 +371,7 @@ mod avx2 {
     pub(super) fn figures(
         raws: Raws<'_>,
         lsb: f64,
-        refs: Refs<'_>,
+        refs: References<'_>,
         map: Map,
         half: f64,
         one: f64,
@@ -479,7 +479,7 @@ mod avx2 {
             out
         };
         let (mut sum, mut sum_abs, mut sum_sq) = (lanes(sum), lanes(sum_abs), lanes(sum_sq));
-        let refs = Refs::D { first, len, c_lsb };
+        let refs = References::D { first, len, c_lsb };
         for i in 4 * quads..len {
             let e = value - map.apply(refs.at(i));
             sum[0] += e;
@@ -522,7 +522,7 @@ mod avx2 {
     fn kernel(
         raws: Raws<'_>,
         lsb: f64,
-        refs: Refs<'_>,
+        refs: References<'_>,
         map: Map,
         half: f64,
         one: f64,
@@ -530,12 +530,12 @@ mod avx2 {
         scale: impl Fn(__m256d) -> __m256d,
     ) -> ColumnFigures {
         match refs {
-            Refs::Column(r) => kernel_with(raws, lsb, refs, map, half, one, value, |q| {
+            References::Column(r) => kernel_with(raws, lsb, refs, map, half, one, value, |q| {
                 let x: &[f64; 4] = r[4 * q..4 * q + 4].try_into().expect("a whole quad");
                 // SAFETY: the load reads the four values of `x` (unaligned).
                 scale(unsafe { _mm256_loadu_pd(x.as_ptr()) })
             }),
-            Refs::D { first, c_lsb, .. } => {
+            References::D { first, c_lsb, .. } => {
                 let (steps, lsb4) = (_mm256_set_pd(3.0, 2.0, 1.0, 0.0), _mm256_set1_pd(c_lsb));
                 let one_v = _mm256_set1_pd(1.0);
                 kernel_with(raws, lsb, refs, map, half, one, value, |q| {
@@ -554,7 +554,7 @@ mod avx2 {
     fn kernel_with(
         raws: Raws<'_>,
         lsb: f64,
-        refs: Refs<'_>,
+        refs: References<'_>,
         map: Map,
         half: f64,
         one: f64,
@@ -659,8 +659,8 @@ mod tests {
         let half = 0.5 * lsb;
         let one = lsb;
         let column = Raws::of(raws, width);
-        let f = column_figures(column, lsb, Refs::Column(refs), map, half, one, -1.0);
-        let p = portable(column, lsb, Refs::Column(refs), map, half, one, -1.0);
+        let f = column_figures(column, lsb, References::Column(refs), map, half, one, -1.0);
+        let p = portable(column, lsb, References::Column(refs), map, half, one, -1.0);
         assert_eq!(f, p, "the AVX2 kernel and the portable one differ");
         let errs: Vec<f64> = raws
             .iter()
@@ -712,7 +712,7 @@ mod tests {
         let f = column_figures(
             Raws::Constant(-131072),
             2f64.powi(-16),
-            Refs::Column(&refs),
+            References::Column(&refs),
             Map::Scale(3.5),
             2f64.powi(-17),
             2f64.powi(-16),
@@ -721,7 +721,7 @@ mod tests {
         let g = column_figures(
             Raws::Narrow(&raws),
             2f64.powi(-16),
-            Refs::Column(&refs),
+            References::Column(&refs),
             Map::Scale(3.5),
             2f64.powi(-17),
             2f64.powi(-16),
@@ -766,8 +766,8 @@ mod tests {
                     let run = |refs, above| {
                         column_figures(raws, lsb, refs, map, 2f64.powi(-17), lsb, above)
                     };
-                    let computed = Refs::D { first, len, c_lsb };
-                    let read = Refs::Column(&refs);
+                    let computed = References::D { first, len, c_lsb };
+                    let read = References::Column(&refs);
                     for above in [-1.0, 0.25, 10.0] {
                         let want = run(read, above);
                         assert_eq!(run(computed, above), want, "{raw} {map:?} {first} {len}");

@@ -12,7 +12,7 @@ fn slow_sum(dp: &Datapath, codes: std::ops::Range<i64>) -> u64 {
     for nc in dp.constants() {
         for c in codes.clone() {
             let out = dp.eval(c, nc).values[dp.stage_out()];
-            let w = (c as u64 + 1).wrapping_mul(u64::from(nc.n));
+            let w = (c as u64).wrapping_add(1).wrapping_mul(u64::from(nc.n));
             sum = sum.wrapping_add((out as u64).wrapping_mul(w));
         }
     }
