@@ -377,55 +377,36 @@ mod avx2 {
         one: f64,
     ) -> ColumnFigures {
         let l = _mm256_set1_pd(lsb);
-        match (raws, map) {
-            (Raws::Constant(r), Map::Identity) => {
+        match raws {
+            Raws::Constant(r) => {
                 let v = _mm256_set1_pd(r as f64 * lsb);
-                kernel(raws, lsb, refs, map, half, one, |_| v, |x| x)
+                mapped(raws, lsb, refs, map, half, one, |_| v)
             }
-            (Raws::Constant(r), Map::Scale(s)) => {
-                let (v, s) = (_mm256_set1_pd(r as f64 * lsb), _mm256_set1_pd(s));
-                kernel(
-                    raws,
-                    lsb,
-                    refs,
-                    map,
-                    half,
-                    one,
-                    |_| v,
-                    |x| _mm256_mul_pd(s, x),
-                )
-            }
-            (Raws::Narrow(r), Map::Identity) => {
-                kernel(raws, lsb, refs, map, half, one, |q| narrow(r, q, l), |x| x)
-            }
-            (Raws::Narrow(r), Map::Scale(s)) => {
+            Raws::Narrow(r) => mapped(raws, lsb, refs, map, half, one, |q| narrow(r, q, l)),
+            Raws::Wide(r) => mapped(raws, lsb, refs, map, half, one, |q| wide(r, q, l)),
+        }
+    }
+
+    /// [`kernel`] with the map of the references as a closure, `value(q)` the four values of
+    /// quad `q`.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn mapped(
+        raws: Raws<'_>,
+        lsb: f64,
+        refs: References<'_>,
+        map: Map,
+        half: f64,
+        one: f64,
+        value: impl Fn(usize) -> __m256d,
+    ) -> ColumnFigures {
+        match map {
+            Map::Identity => kernel(raws, lsb, refs, map, half, one, value, |x| x),
+            Map::Scale(s) => {
                 let s = _mm256_set1_pd(s);
-                kernel(
-                    raws,
-                    lsb,
-                    refs,
-                    map,
-                    half,
-                    one,
-                    |q| narrow(r, q, l),
-                    |x| _mm256_mul_pd(s, x),
-                )
-            }
-            (Raws::Wide(r), Map::Identity) => {
-                kernel(raws, lsb, refs, map, half, one, |q| wide(r, q, l), |x| x)
-            }
-            (Raws::Wide(r), Map::Scale(s)) => {
-                let s = _mm256_set1_pd(s);
-                kernel(
-                    raws,
-                    lsb,
-                    refs,
-                    map,
-                    half,
-                    one,
-                    |q| wide(r, q, l),
-                    |x| _mm256_mul_pd(s, x),
-                )
+                kernel(raws, lsb, refs, map, half, one, value, |x| {
+                    _mm256_mul_pd(s, x)
+                })
             }
         }
     }
