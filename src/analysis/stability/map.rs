@@ -527,7 +527,6 @@ pub(super) fn fixed_columns(
         .collect()
 }
 
-/// Folds the per-n accumulators of one path, in n order, into its map.
 /// What [`assemble`] needs to know of a path besides its accumulators.
 pub(super) struct PathMeta {
     name: String,
@@ -538,6 +537,7 @@ pub(super) struct PathMeta {
     reason: Option<String>,
 }
 
+/// Folds the per-n accumulators of one path, in n order, into its map.
 pub(super) fn assemble(meta: PathMeta, ns: &[u32], accs: Vec<NAcc>, tol: f64) -> PathMap {
     let PathMeta {
         name,
