@@ -227,7 +227,7 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
     }
 
     /// The next input, if the stream has one.
-    #[inline]
+    #[inline(always)]
     fn peek(&mut self) -> Option<(usize, i64, i64)> {
         if self.next == self.ahead.len() && !self.exhausted {
             self.refill();
@@ -235,13 +235,16 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
         self.ahead.get(self.next).copied()
     }
 
-    #[inline]
+    #[inline(always)]
     fn next(&mut self) -> Option<(usize, i64, i64)> {
         let item = self.peek();
         self.next += usize::from(item.is_some());
         item
     }
 
+    /// Reads and evaluates the next block (once per block: kept out of the per-cycle loop).
+    #[cold]
+    #[inline(never)]
     fn refill(&mut self) {
         self.ahead.clear();
         self.next = 0;
