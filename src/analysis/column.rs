@@ -376,14 +376,22 @@ mod avx2 {
         half: f64,
         one: f64,
     ) -> ColumnFigures {
+        let args = Args {
+            raws,
+            lsb,
+            refs,
+            map,
+            half,
+            one,
+        };
         let l = _mm256_set1_pd(lsb);
         match raws {
             Raws::Constant(r) => {
                 let v = _mm256_set1_pd(r as f64 * lsb);
-                mapped(raws, lsb, refs, map, half, one, |_| v)
+                mapped(args, |_| v)
             }
-            Raws::Narrow(r) => mapped(raws, lsb, refs, map, half, one, |q| narrow(r, q, l)),
-            Raws::Wide(r) => mapped(raws, lsb, refs, map, half, one, |q| wide(r, q, l)),
+            Raws::Narrow(r) => mapped(args, |q| narrow(r, q, l)),
+            Raws::Wide(r) => mapped(args, |q| wide(r, q, l)),
         }
     }
 
@@ -391,22 +399,12 @@ mod avx2 {
     /// quad `q`.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn mapped(
-        raws: Raws<'_>,
-        lsb: f64,
-        refs: References<'_>,
-        map: Map,
-        half: f64,
-        one: f64,
-        value: impl Fn(usize) -> __m256d,
-    ) -> ColumnFigures {
-        match map {
-            Map::Identity => kernel(raws, lsb, refs, map, half, one, value, |x| x),
+    fn mapped(args: Args<'_>, value: impl Fn(usize) -> __m256d) -> ColumnFigures {
+        match args.map {
+            Map::Identity => kernel(args, value, |x| x),
             Map::Scale(s) => {
                 let s = _mm256_set1_pd(s);
-                kernel(raws, lsb, refs, map, half, one, value, |x| {
-                    _mm256_mul_pd(s, x)
-                })
+                kernel(args, value, |x| _mm256_mul_pd(s, x))
             }
         }
     }
@@ -497,21 +495,15 @@ mod avx2 {
     }
 
     /// The loop: `value(q)` the four values of quad `q`, `scale` the map of four references.
-    #[allow(clippy::too_many_arguments)]
     #[target_feature(enable = "avx2")]
     #[inline]
     fn kernel(
-        raws: Raws<'_>,
-        lsb: f64,
-        refs: References<'_>,
-        map: Map,
-        half: f64,
-        one: f64,
+        args: Args<'_>,
         value: impl Fn(usize) -> __m256d,
         scale: impl Fn(__m256d) -> __m256d,
     ) -> ColumnFigures {
-        match refs {
-            References::Column(r) => kernel_with(raws, lsb, refs, map, half, one, value, |q| {
+        match args.refs {
+            References::Column(r) => kernel_with(args, value, |q| {
                 let x: &[f64; 4] = r[4 * q..4 * q + 4].try_into().expect("a whole quad");
                 // SAFETY: the load reads the four values of `x` (unaligned).
                 scale(unsafe { _mm256_loadu_pd(x.as_ptr()) })
@@ -519,7 +511,7 @@ mod avx2 {
             References::D { first, c_lsb, .. } => {
                 let (steps, lsb4) = (_mm256_set_pd(3.0, 2.0, 1.0, 0.0), _mm256_set1_pd(c_lsb));
                 let one_v = _mm256_set1_pd(1.0);
-                kernel_with(raws, lsb, refs, map, half, one, value, |q| {
+                kernel_with(args, value, |q| {
                     // The four codes are integers below 2^53: exact in f64, as is each sum.
                     let k = _mm256_add_pd(_mm256_set1_pd((first + 4 * q as i64) as f64), steps);
                     scale(_mm256_sub_pd(_mm256_mul_pd(k, lsb4), one_v))
@@ -529,19 +521,21 @@ mod avx2 {
     }
 
     /// The loop of [`kernel`], `reference(q)` the mapped references of quad `q`.
-    #[allow(clippy::too_many_arguments)]
     #[target_feature(enable = "avx2")]
     #[inline]
     fn kernel_with(
-        raws: Raws<'_>,
-        lsb: f64,
-        refs: References<'_>,
-        map: Map,
-        half: f64,
-        one: f64,
+        args: Args<'_>,
         value: impl Fn(usize) -> __m256d,
         reference: impl Fn(usize) -> __m256d,
     ) -> ColumnFigures {
+        let Args {
+            raws,
+            lsb,
+            refs,
+            map,
+            half,
+            one,
+        } = args;
         let len = refs.len();
         let quads = len / 4;
         let sign = _mm256_set1_pd(-0.0);
@@ -613,6 +607,18 @@ mod avx2 {
             n_faithful,
             raw_range: raw_range(raws, len),
         }
+    }
+
+    /// What every step of the kernel is given: the column, its references and their map, and
+    /// the bounds of the counts.
+    #[derive(Clone, Copy)]
+    struct Args<'a> {
+        raws: Raws<'a>,
+        lsb: f64,
+        refs: References<'a>,
+        map: Map,
+        half: f64,
+        one: f64,
     }
 }
 
