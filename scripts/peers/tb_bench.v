@@ -1,5 +1,6 @@
 // tb_bench: the Icarus Verilog driver of scripts/bench-peers. Streams every input code
-// c_raw = 0..=32768 for each n of a constants file through specfx_dut (hdl_ref/, pipelined),
+// c_raw = 0..=2^C_F (up to 1.0, C_F = `SPECFX_C_F of specfx_params.vh; 0..=32768 for the
+// baseline's u1.15) for each n of a constants file through specfx_dut (hdl_ref/, pipelined),
 // with in_valid and out_ready high on every cycle, and sums out_raw * (c_raw + 1) * n
 // (mod 2^64) per n, pairing each output with its input by order (docs/cycle.md, rule 4).
 //
@@ -15,7 +16,7 @@ module tb_bench;
     localparam integer OFFSET_W = `SPECFX_OFFSET_W;
     localparam integer COEF_W = `SPECFX_COEF_W;
     localparam integer OUT_W = `SPECFX_OUT_W;
-    localparam integer CODES = 32769;
+    localparam integer CODES = (1 << `SPECFX_C_F) + 1;  // c_raw = 0..=2^C_F
     localparam integer MAXN = 1024;
 
     reg clk = 1'b0;

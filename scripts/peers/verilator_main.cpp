@@ -1,7 +1,9 @@
-// Verilator harness of scripts/bench-peers: streams every input code c_raw = 0..=32768 for
-// each n of a constants file through specfx_dut (hdl_ref/, the pipelined baseline), with
-// in_valid and out_ready high on every cycle, and sums out_raw * (c_raw + 1) * n (mod 2^64)
-// per n, pairing each accepted output with its input by order (docs/cycle.md, rule 4).
+// Verilator harness of scripts/bench-peers: streams every input code c_raw = 0..=2^C_F (up to
+// 1.0; 0..=32768 for the baseline's u1.15) for each n of a constants file through specfx_dut
+// (hdl_ref/, pipelined), with in_valid and out_ready high on every cycle, and sums
+// out_raw * (c_raw + 1) * n (mod 2^64) per n, pairing each accepted output with its input by
+// order (docs/cycle.md, rule 4). C_F, the input's fraction bits, is the macro SPECFX_C_F
+// (`-CFLAGS -DSPECFX_C_F=F`, as `specfx hdl params` gives it; default 15, the baseline's).
 //
 // Usage: Vspecfx_dut CONSTS RESULTS [DUMP]
 //   CONSTS   one line per n, decimal: n slope offset threshold coef (the per-n inputs)
@@ -23,7 +25,11 @@ namespace {
 struct Consts {
     uint64_t n, slope, offset, threshold, coef;
 };
-constexpr uint32_t kCodes = 32769;  // c_raw = 0..=32768 (u1.15 up to 1.0)
+#ifndef SPECFX_C_F
+#define SPECFX_C_F 15
+#endif
+static_assert(SPECFX_C_F >= 0 && SPECFX_C_F <= 30, "SPECFX_C_F: the input's fraction bits");
+constexpr uint32_t kCodes = (uint32_t(1) << SPECFX_C_F) + 1;  // c_raw = 0..=2^C_F (up to 1.0)
 
 [[noreturn]] void die(const char* what) {
     std::fprintf(stderr, "verilator harness: %s\n", what);
