@@ -277,6 +277,12 @@ pub trait Machine: Clone {
             *count += u64::from(busy);
         }
     }
+    /// Whether every unit holds valid data now: [`Machine::count_occupancy`] would add 1 to
+    /// every count (a simulation counts such cycles once). `false` when unsure.
+    #[inline]
+    fn full(&self) -> bool {
+        false
+    }
     /// Names of the units whose occupancy is measured.
     fn unit_names(&self) -> Vec<String>;
     /// Whether each unit holds valid data now.
@@ -401,6 +407,11 @@ impl Machine for Pipelined {
                 *count += u64::from(self.valid & mask != 0);
             }
         }
+    }
+
+    #[inline]
+    fn full(&self) -> bool {
+        self.valid == u128::MAX >> (128 - self.ring.len())
     }
 
     fn unit_names(&self) -> Vec<String> {

@@ -27,6 +27,12 @@ impl Stimulus {
         }
     }
 
+    /// Whether every cycle offers an input and is ready for an output (no bubbles, no
+    /// stalls): [`Stimulus::next_cycle`] then draws nothing.
+    pub fn always_ready(&self) -> bool {
+        self.bubble == 0.0 && self.stall == 0.0
+    }
+
     /// The next cycle's (valid offer, out_ready).
     #[inline]
     pub fn next_cycle(&mut self) -> (bool, bool) {
@@ -193,16 +199,19 @@ pub fn simulate_stream(
 struct Source<'a, I> {
     dp: &'a Datapath,
     items: I,
-    /// Inputs read and evaluated, `(n_idx, c_raw, out)`; those before `next` are accepted.
-    ahead: Vec<(usize, i64, i64)>,
+    /// Inputs read and evaluated (column by column: each one's n index, raw code and
+    /// output); those before `next` are accepted.
+    n_idx: Vec<usize>,
+    codes: Vec<i64>,
+    outs: Vec<i64>,
     next: usize,
     block: usize,
     exhausted: bool,
     scratch: crate::pipeline::OutputScratch,
-    /// Reused buffers of [`Source::refill`].
+    /// Reused buffers of [`Source::refill`] for a block not grouped by n.
     order: Vec<usize>,
     starts: Vec<usize>,
-    codes: Vec<i64>,
+    group: Vec<i64>,
     values: Vec<i64>,
 }
 
@@ -214,14 +223,16 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
         Source {
             dp,
             items,
-            ahead: Vec::new(),
+            n_idx: Vec::new(),
+            codes: Vec::new(),
+            outs: Vec::new(),
             next: 0,
             block: Self::FIRST_BLOCK,
             exhausted: false,
             scratch: crate::pipeline::OutputScratch::default(),
             order: Vec::new(),
             starts: Vec::new(),
-            codes: Vec::new(),
+            group: Vec::new(),
             values: Vec::new(),
         }
     }
@@ -229,47 +240,60 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
     /// The next input, if the stream has one.
     #[inline(always)]
     fn peek(&mut self) -> Option<(usize, i64, i64)> {
-        if self.next == self.ahead.len() && !self.exhausted {
+        if self.next == self.n_idx.len() {
+            if self.exhausted {
+                return None;
+            }
             self.refill();
+            if self.next == self.n_idx.len() {
+                return None;
+            }
         }
-        self.ahead.get(self.next).copied()
+        let i = self.next;
+        Some((self.n_idx[i], self.codes[i], self.outs[i]))
     }
 
+    /// Accepts the input [`Source::peek`] returned.
     #[inline(always)]
-    fn next(&mut self) -> Option<(usize, i64, i64)> {
-        let item = self.peek();
-        self.next += usize::from(item.is_some());
-        item
+    fn advance(&mut self) {
+        self.next += 1;
     }
 
     /// Reads and evaluates the next block (once per block: kept out of the per-cycle loop).
     #[cold]
     #[inline(never)]
     fn refill(&mut self) {
-        self.ahead.clear();
+        self.n_idx.clear();
+        self.codes.clear();
         self.next = 0;
-        for _ in 0..self.block {
-            match self.items.next() {
-                Some((n, c)) => self.ahead.push((n, c, 0)),
-                None => break,
-            }
-        }
-        self.exhausted = self.ahead.len() < self.block;
+        // Through separate borrows, so that the stream's state and the columns' lengths stay
+        // in registers.
+        let (n_idx, codes) = (&mut self.n_idx, &mut self.codes);
+        n_idx.reserve(self.block);
+        codes.reserve(self.block);
+        self.items.by_ref().take(self.block).for_each(|(n, c)| {
+            n_idx.push(n);
+            codes.push(c);
+        });
+        let len = self.n_idx.len();
+        self.exhausted = len < self.block;
         self.block = (self.block * 2).min(Self::MAX_BLOCK);
-        if self.ahead.windows(2).all(|w| w[0].0 <= w[1].0) {
+        self.outs.clear();
+        self.outs.resize(len, 0);
+        if self.n_idx.windows(2).all(|w| w[0] <= w[1]) {
             // Already grouped by n (the sweep stream): each run of one n is evaluated in
             // place.
             let mut start = 0;
-            while start < self.ahead.len() {
-                let n_idx = self.ahead[start].0;
-                let end = start + self.ahead[start..].partition_point(|&(n, _, _)| n == n_idx);
-                self.codes.clear();
-                self.codes
-                    .extend(self.ahead[start..end].iter().map(|&(_, c, _)| c));
-                self.evaluate(n_idx);
-                for (item, &v) in self.ahead[start..end].iter_mut().zip(&self.values) {
-                    item.2 = v;
-                }
+            while start < len {
+                let n_idx = self.n_idx[start];
+                let end = start + self.n_idx[start..].partition_point(|&n| n == n_idx);
+                evaluate(
+                    self.dp,
+                    n_idx,
+                    &self.codes[start..end],
+                    &mut self.outs[start..end],
+                    &mut self.scratch,
+                );
                 start = end;
             }
             return;
@@ -277,21 +301,18 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
         // Group by n (a counting sort, so each group keeps stream order), evaluate, scatter
         // back.
         let constants = self.dp.constants();
-        let (mut starts, mut order) = (
-            std::mem::take(&mut self.starts),
-            std::mem::take(&mut self.order),
-        );
+        let (starts, order) = (&mut self.starts, &mut self.order);
         starts.clear();
         starts.resize(constants.len() + 1, 0);
-        for &(n_idx, _, _) in &self.ahead {
+        for &n_idx in &self.n_idx {
             starts[n_idx + 1] += 1;
         }
         for i in 1..starts.len() {
             starts[i] += starts[i - 1];
         }
         order.clear();
-        order.resize(self.ahead.len(), 0);
-        for (i, &(n_idx, _, _)) in self.ahead.iter().enumerate() {
+        order.resize(len, 0);
+        for (i, &n_idx) in self.n_idx.iter().enumerate() {
             // starts[n_idx] is the next free place of group n_idx; it ends at the group's end.
             order[starts[n_idx]] = i;
             starts[n_idx] += 1;
@@ -303,35 +324,40 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
             if group.is_empty() {
                 continue;
             }
-            self.codes.clear();
-            self.codes.extend(group.iter().map(|&i| self.ahead[i].1));
-            self.evaluate(n_idx);
+            self.group.clear();
+            self.group.extend(group.iter().map(|&i| self.codes[i]));
+            self.values.clear();
+            self.values.resize(group.len(), 0);
+            evaluate(
+                self.dp,
+                n_idx,
+                &self.group,
+                &mut self.values,
+                &mut self.scratch,
+            );
             for (&i, &v) in group.iter().zip(&self.values) {
-                self.ahead[i].2 = v;
+                self.outs[i] = v;
             }
         }
-        (self.starts, self.order) = (starts, order);
     }
 }
 
-impl<I> Source<'_, I> {
-    /// The outputs of `codes` (non-empty) for exponent `n_idx`, into `values`: a run of
-    /// consecutive codes by range (its cut prefix found by bisection and filled, not
-    /// evaluated), any other codes one by one in a batch.
-    fn evaluate(&mut self, n_idx: usize) {
-        let nc = &self.dp.constants()[n_idx];
-        self.values.clear();
-        self.values.resize(self.codes.len(), 0);
-        let (first, last) = (self.codes[0], self.codes[self.codes.len() - 1]);
-        if last - first + 1 == self.codes.len() as i64
-            && self.codes.windows(2).all(|w| w[1] == w[0] + 1)
-        {
-            self.dp
-                .eval_outputs_range(nc, first..last + 1, &mut self.values, &mut self.scratch);
-        } else {
-            self.dp
-                .eval_outputs(nc, &self.codes, &mut self.values, &mut self.scratch);
-        }
+/// The outputs of `codes` (non-empty) for exponent `n_idx`, into `values`: a run of
+/// consecutive codes by range (its cut prefix found by bisection and filled, not evaluated),
+/// any other codes one by one in a batch.
+fn evaluate(
+    dp: &Datapath,
+    n_idx: usize,
+    codes: &[i64],
+    values: &mut [i64],
+    scratch: &mut crate::pipeline::OutputScratch,
+) {
+    let nc = &dp.constants()[n_idx];
+    let (first, last) = (codes[0], codes[codes.len() - 1]);
+    if last - first + 1 == codes.len() as i64 && codes.windows(2).all(|w| w[1] == w[0] + 1) {
+        dp.eval_outputs_range(nc, first..last + 1, values, scratch);
+    } else {
+        dp.eval_outputs(nc, codes, values, scratch);
     }
 }
 
@@ -349,57 +375,87 @@ pub struct Record {
 /// and stalls, keeping what `record` asks for; `arch` names the architecture in the
 /// statistics. [`simulate`] is this with the machine of an architecture; tests run other
 /// machines (a literal register-by-register pipeline) through it.
+///
+/// A run with neither bubbles nor stalls that records nothing (the statistics of a stream at
+/// full rate) takes the same loop compiled without what it does not need: no draw per cycle
+/// (a probability of 0 never draws, [`Stimulus::next_cycle`]), no record and no trace.
 pub fn run<M: Machine>(
     dp: &Datapath,
     arch: Arch,
-    mut machine: M,
+    machine: M,
     items: impl Iterator<Item = (usize, i64)>,
     stimulus: &mut Stimulus,
     stop: Stop,
     record: Record,
 ) -> SimResult {
+    if stimulus.always_ready() && !record.transfers && record.trace_cycles == 0 {
+        run_loop::<M, _, true>(dp, arch, machine, items, stimulus, stop, record)
+    } else {
+        run_loop::<M, _, false>(dp, arch, machine, items, stimulus, stop, record)
+    }
+}
+
+/// [`run`]'s loop; `STEADY`: the stimulus is always ready and nothing is recorded.
+fn run_loop<M: Machine, I: Iterator<Item = (usize, i64)>, const STEADY: bool>(
+    dp: &Datapath,
+    arch: Arch,
+    mut machine: M,
+    items: I,
+    stimulus: &mut Stimulus,
+    stop: Stop,
+    record: Record,
+) -> SimResult {
     let mut items = Source::new(dp, items);
+    let transfers = !STEADY && record.transfers;
+    let trace_cycles = if STEADY { 0 } else { record.trace_cycles };
     // Room for a run that stops after a number of cycles (up to 2^22 of them; longer runs
     // grow), so that the per-cycle records do not move as they grow.
     let room = match stop {
-        Stop::Cycles(c) if record.transfers => c.min(1 << 22) as usize,
+        Stop::Cycles(c) if transfers => c.min(1 << 22) as usize,
         _ => 0,
     };
     let mut outputs: Vec<OutputEvent> = Vec::with_capacity(room);
     let mut valid_bits = Vec::with_capacity(room);
     let mut ready_bits = Vec::with_capacity(room);
     let mut trace = Vec::new();
-    // The inputs in flight from tag `first_in_flight` on: the cycle each transferred and the
-    // functional model's output for it. Outputs leave in order, so the front leaves first.
-    let mut in_flight: std::collections::VecDeque<(u64, i64)> = Default::default();
+    // The inputs in flight, tags `first_in_flight..n_inputs`: the cycle each transferred and
+    // the functional model's output for it, tag `t` at `in_flight[t & mask]` (a ring that
+    // doubles when full). Outputs leave in order, so the oldest leaves first.
+    let mut in_flight: Vec<(u64, i64)> = vec![(0, 0); 64];
+    let mut mask = in_flight.len() as u64 - 1;
     let mut first_in_flight = 0u64;
     let (mut n_inputs, mut n_outputs) = (0u64, 0u64);
     let (mut latency_min, mut latency_max) = (u64::MAX, 0);
     let mut mismatches = 0;
     let units = machine.unit_names();
     let mut occupied = vec![0u64; units.len()];
+    // Cycles in which every unit was busy (added to each unit's count at the end).
+    let mut full_cycles = 0u64;
     let (mut bubbles, mut stalls, mut backpressure) = (0, 0, 0);
     let mut order_errors = 0;
-    let max_cycles = match stop {
-        Stop::Cycles(c) | Stop::Drained(c) => c,
+    let (max_cycles, drained) = match stop {
+        Stop::Cycles(c) => (c, false),
+        Stop::Drained(c) => (c, true),
     };
     let mut cycle = 0u64;
     while cycle < max_cycles {
-        if let Stop::Drained(_) = stop {
-            if items.peek().is_none() && n_outputs == n_inputs {
-                break;
-            }
+        let next_item = items.peek();
+        if drained && next_item.is_none() && n_outputs == n_inputs {
+            break;
         }
-        let (offer, out_ready) = stimulus.next_cycle();
-        if record.transfers {
+        let (offer, out_ready) = if STEADY {
+            (true, true)
+        } else {
+            stimulus.next_cycle()
+        };
+        if transfers {
             valid_bits.push(offer);
             ready_bits.push(out_ready);
         }
-        let next_item = items.peek();
         let in_valid = offer && next_item.is_some();
         let in_ready = machine.in_ready(out_ready);
         let output = machine.output();
-        if cycle < record.trace_cycles {
+        if cycle < trace_cycles {
             trace.push(CycleTrace {
                 cycle,
                 in_valid,
@@ -411,27 +467,35 @@ pub fn run<M: Machine>(
                 registers: machine.registers(dp),
             });
         }
-        machine.count_occupancy(&mut occupied);
-        if next_item.is_some() && !offer {
+        if machine.full() {
+            full_cycles += 1;
+        } else {
+            machine.count_occupancy(&mut occupied);
+        }
+        if !STEADY && next_item.is_some() && !offer {
             bubbles += 1;
         }
         if in_valid && !in_ready {
             backpressure += 1;
         }
-        let transfer_in = in_valid && in_ready;
-        let item = if transfer_in {
-            let (n_idx, c_raw, out) = items.next().expect("peeked");
-            let tag = n_inputs;
-            n_inputs += 1;
-            in_flight.push_back((cycle, out));
-            Some(Item {
-                tag,
-                n_idx,
-                c_raw,
-                out,
-            })
-        } else {
-            None
+        let item = match next_item {
+            Some((n_idx, c_raw, out)) if in_valid && in_ready => {
+                items.advance();
+                let tag = n_inputs;
+                n_inputs += 1;
+                if tag - first_in_flight > mask {
+                    in_flight = grow_ring(&in_flight, first_in_flight, tag);
+                    mask = in_flight.len() as u64 - 1;
+                }
+                in_flight[(tag & mask) as usize] = (cycle, out);
+                Some(Item {
+                    tag,
+                    n_idx,
+                    c_raw,
+                    out,
+                })
+            }
+            _ => None,
         };
         if let Some((tag, value)) = output {
             if out_ready {
@@ -440,20 +504,18 @@ pub fn run<M: Machine>(
                 }
                 n_outputs += 1;
                 // An output whose tag names no input in flight is an order error only.
-                let at = tag
-                    .checked_sub(first_in_flight)
-                    .and_then(|i| in_flight.get(i as usize).copied());
+                let at = (tag >= first_in_flight && tag < n_inputs)
+                    .then(|| in_flight[(tag & mask) as usize]);
                 let latency = at.map_or(0, |(accepted, _)| cycle - accepted);
                 if at.is_some_and(|(_, want)| want != value) {
                     mismatches += 1;
                 }
                 if at.is_some() && tag == first_in_flight {
-                    in_flight.pop_front();
                     first_in_flight += 1;
                 }
                 latency_min = latency_min.min(latency);
                 latency_max = latency_max.max(latency);
-                if record.transfers {
+                if transfers {
                     outputs.push(OutputEvent {
                         tag,
                         value,
@@ -471,6 +533,7 @@ pub fn run<M: Machine>(
     if n_outputs == 0 {
         latency_min = 0;
     }
+    occupied.iter_mut().for_each(|o| *o += full_cycles);
     let cfg = dp.config();
     let stats = SimStats {
         arch,
@@ -513,6 +576,19 @@ pub fn run<M: Machine>(
         ready_bits,
         trace,
     }
+}
+
+/// The in-flight ring holding tags `first..tag` (full: `tag - first` is its length), moved
+/// into one twice its size, each tag at its index modulo the new length.
+#[cold]
+#[inline(never)]
+fn grow_ring(ring: &[(u64, i64)], first: u64, tag: u64) -> Vec<(u64, i64)> {
+    let (old, new) = (ring.len() as u64, ring.len() * 2);
+    let mut grown = vec![(0, 0); new];
+    for t in first..tag {
+        grown[(t % (new as u64)) as usize] = ring[(t % old) as usize];
+    }
+    grown
 }
 
 /// An input stream a simulation can be driven with.

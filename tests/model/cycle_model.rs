@@ -171,7 +171,8 @@ proptest! {
     /// The ring of tokens is the register-by-register pipeline: the same outputs on the same
     /// cycles, the same statistics and occupancy, and the same value in every register of the
     /// trace on every cycle, for any latencies, k, cutoff, stream and stall pattern (the
-    /// stream's inputs reach past 1.0 and into the cut region).
+    /// stream's inputs reach past 1.0 and into the cut region). Half the cases run at full
+    /// rate (no bubbles, no stalls), where statistics alone take `run`'s steady loop.
     #[test]
     fn the_pipeline_ring_equals_the_literal_pipeline(
         k in 1u32..=7,
@@ -180,9 +181,11 @@ proptest! {
         seed in any::<u64>(),
         bubble in 0.0f64..0.9,
         stall in 0.0f64..0.9,
+        steady in any::<bool>(),
         inputs in prop::collection::vec((0usize..3, 0i64..=65535), 1..200),
         per_n in any::<bool>(),
     ) {
+        let (bubble, stall) = if steady { (0.0, 0.0) } else { (bubble, stall) };
         let mut cfg = with_depth(datapath(k, lat, "16,300,1024"), per_n).config().clone();
         cfg.cutoff = specfx::reference::lobe::Cutoff::ALL[cutoff];
         let dp = Datapath::new(cfg).unwrap();
@@ -200,6 +203,60 @@ proptest! {
         prop_assert!(stats.outputs.is_empty() && stats.trace.is_empty());
         prop_assert_eq!(&stats.stats, &ring.stats);
         prop_assert_eq!(ring, literal);
+    }
+}
+
+/// A pipeline of 88 registers holds more inputs in flight than the simulator's first ring of
+/// them (64): it grows, and the pipeline still equals the literal one, at full rate (the
+/// steady loop) and with bubbles and stalls, stopped after a number of cycles or drained.
+#[test]
+fn a_pipeline_longer_than_the_in_flight_ring_equals_the_literal_pipeline() {
+    let dp = datapath(7, (8, 8, 8), "16,300,1024");
+    assert_eq!(Arch::Pipelined.latency(dp.config()), 88);
+    let inputs: Vec<(usize, i64)> = (0..300).map(|i| (i % 3, 30_000 + 7 * i as i64)).collect();
+    for (bubble, stall) in [(0.0, 0.0), (0.2, 0.3)] {
+        for stop in [Stop::Cycles(250), Stop::Drained(100_000)] {
+            let go = |machine_is_ring: bool, record: Record| {
+                let mut stim = Stimulus::new(7, bubble, stall);
+                let items = inputs.iter().copied();
+                if machine_is_ring {
+                    run(
+                        &dp,
+                        Arch::Pipelined,
+                        Pipelined::new(&dp),
+                        items,
+                        &mut stim,
+                        stop,
+                        record,
+                    )
+                } else {
+                    run(
+                        &dp,
+                        Arch::Pipelined,
+                        Literal::new(&dp),
+                        items,
+                        &mut stim,
+                        stop,
+                        record,
+                    )
+                }
+            };
+            let all = Record {
+                transfers: true,
+                trace_cycles: 0,
+            };
+            let lean = Record {
+                transfers: false,
+                trace_cycles: 0,
+            };
+            let (ring, literal) = (go(true, all), go(false, all));
+            assert_eq!(ring, literal, "bubble {bubble}, stall {stall}, {stop:?}");
+            assert_eq!(go(true, lean).stats, ring.stats);
+            if bubble == 0.0 && stop == Stop::Cycles(250) {
+                // 88 in flight at the end.
+                assert_eq!(ring.stats.n_inputs - ring.stats.n_outputs, 88);
+            }
+        }
     }
 }
 
