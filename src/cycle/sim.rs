@@ -186,9 +186,19 @@ pub fn simulate_stream(
     stop: Stop,
     record: Record,
 ) -> SimResult {
-    match stream {
-        Stream::Random => simulate_with(dp, arch, random_inputs(dp, seed), stimulus, stop, record),
-        Stream::Sweep => simulate_with(dp, arch, sweep_inputs(dp), stimulus, stop, record),
+    match (stream, arch) {
+        (Stream::Random, _) => {
+            simulate_with(dp, arch, random_inputs(dp, seed), stimulus, stop, record)
+        }
+        // The sweep's columns written run by run, not input by input.
+        (Stream::Sweep, Arch::Pipelined) => {
+            let source = Source::of_ranges(dp, fill_sweep(dp));
+            run_source(dp, arch, Pipelined::new(dp), source, stimulus, stop, record)
+        }
+        (Stream::Sweep, Arch::Folded) => {
+            let source = Source::of_ranges(dp, fill_sweep(dp));
+            run_source(dp, arch, Folded::new(dp), source, stimulus, stop, record)
+        }
     }
 }
 
@@ -196,9 +206,13 @@ pub fn simulate_stream(
 /// inputs are grouped by n and evaluated with [`Datapath::eval_outputs`]. Blocks grow from
 /// [`Source::FIRST_BLOCK`] to [`Source::MAX_BLOCK`] inputs, so a short simulation reads little
 /// ahead of what it accepts.
-struct Source<'a, I> {
+struct Source<'a, F> {
     dp: &'a Datapath,
-    items: I,
+    /// Appends up to the given number of the stream's next inputs to the two columns (fewer
+    /// only when the stream ends).
+    fill: F,
+    /// The filler writes runs of one n whose codes are consecutive (each run a range).
+    ranges: bool,
     /// Inputs read and evaluated (column by column: each one's n index, raw code and
     /// output); those before `next` are accepted.
     n_idx: Vec<usize>,
@@ -215,14 +229,58 @@ struct Source<'a, I> {
     values: Vec<i64>,
 }
 
-impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
+/// The filler of [`Source`] that reads an iterator.
+fn fill_from<I: Iterator<Item = (usize, i64)>>(
+    mut items: I,
+) -> impl FnMut(&mut Vec<usize>, &mut Vec<i64>, usize) {
+    move |n_idx, codes, block| {
+        items.by_ref().take(block).for_each(|(n, c)| {
+            n_idx.push(n);
+            codes.push(c);
+        })
+    }
+}
+
+/// The filler of [`Source`] that writes [`sweep_inputs`]' stream run by run (each n's codes
+/// are one range), without an iterator's step per input.
+fn fill_sweep(dp: &Datapath) -> impl FnMut(&mut Vec<usize>, &mut Vec<i64>, usize) {
+    let (first, last) = (*dp.input_codes().start(), dp.one_code());
+    let n_count = dp.constants().len();
+    let (mut n, mut c) = (0, first);
+    move |n_idx, codes, block| {
+        let mut left = block;
+        while left > 0 {
+            let run = left.min((last - c + 1) as usize);
+            n_idx.resize(n_idx.len() + run, n);
+            codes.extend(c..c + run as i64);
+            left -= run;
+            c += run as i64;
+            if c > last {
+                c = first;
+                n = (n + 1) % n_count;
+            }
+        }
+    }
+}
+
+impl<'a, F: FnMut(&mut Vec<usize>, &mut Vec<i64>, usize)> Source<'a, F> {
     const FIRST_BLOCK: usize = 256;
     const MAX_BLOCK: usize = 1 << 16;
 
-    fn new(dp: &'a Datapath, items: I) -> Self {
+    fn new(dp: &'a Datapath, fill: F) -> Self {
+        Self::with(dp, fill, false)
+    }
+
+    /// A source whose filler writes runs of one n, each a range of codes.
+    fn of_ranges(dp: &'a Datapath, fill: F) -> Self {
+        Self::with(dp, fill, true)
+    }
+
+    fn with(dp: &'a Datapath, fill: F, ranges: bool) -> Self {
         Source {
             dp,
-            items,
+            fill,
+            ranges,
             n_idx: Vec::new(),
             codes: Vec::new(),
             outs: Vec::new(),
@@ -266,21 +324,15 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
         self.n_idx.clear();
         self.codes.clear();
         self.next = 0;
-        // Through separate borrows, so that the stream's state and the columns' lengths stay
-        // in registers.
-        let (n_idx, codes) = (&mut self.n_idx, &mut self.codes);
-        n_idx.reserve(self.block);
-        codes.reserve(self.block);
-        self.items.by_ref().take(self.block).for_each(|(n, c)| {
-            n_idx.push(n);
-            codes.push(c);
-        });
+        self.n_idx.reserve(self.block);
+        self.codes.reserve(self.block);
+        (self.fill)(&mut self.n_idx, &mut self.codes, self.block);
         let len = self.n_idx.len();
         self.exhausted = len < self.block;
         self.block = (self.block * 2).min(Self::MAX_BLOCK);
-        self.outs.clear();
+        // Every output is written below: the columns' old values need no clearing.
         self.outs.resize(len, 0);
-        if self.n_idx.windows(2).all(|w| w[0] <= w[1]) {
+        if self.ranges || self.n_idx.windows(2).all(|w| w[0] <= w[1]) {
             // Already grouped by n (the sweep stream): each run of one n is evaluated in
             // place.
             let mut start = 0;
@@ -293,6 +345,7 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
                     &self.codes[start..end],
                     &mut self.outs[start..end],
                     &mut self.scratch,
+                    self.ranges,
                 );
                 start = end;
             }
@@ -334,6 +387,7 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
                 &self.group,
                 &mut self.values,
                 &mut self.scratch,
+                false,
             );
             for (&i, &v) in group.iter().zip(&self.values) {
                 self.outs[i] = v;
@@ -344,17 +398,19 @@ impl<'a, I: Iterator<Item = (usize, i64)>> Source<'a, I> {
 
 /// The outputs of `codes` (non-empty) for exponent `n_idx`, into `values`: a run of
 /// consecutive codes by range (its cut prefix found by bisection and filled, not evaluated),
-/// any other codes one by one in a batch.
+/// any other codes one by one in a batch. `range`: the codes are known to be consecutive.
 fn evaluate(
     dp: &Datapath,
     n_idx: usize,
     codes: &[i64],
     values: &mut [i64],
     scratch: &mut crate::pipeline::OutputScratch,
+    range: bool,
 ) {
     let nc = &dp.constants()[n_idx];
     let (first, last) = (codes[0], codes[codes.len() - 1]);
-    if last - first + 1 == codes.len() as i64 && codes.windows(2).all(|w| w[1] == w[0] + 1) {
+    if range || last - first + 1 == codes.len() as i64 && codes.windows(2).all(|w| w[1] == w[0] + 1)
+    {
         dp.eval_outputs_range(nc, first..last + 1, values, scratch);
     } else {
         dp.eval_outputs(nc, codes, values, scratch);
@@ -388,24 +444,37 @@ pub fn run<M: Machine>(
     stop: Stop,
     record: Record,
 ) -> SimResult {
-    if stimulus.always_ready() && !record.transfers && record.trace_cycles == 0 {
-        run_loop::<M, _, true>(dp, arch, machine, items, stimulus, stop, record)
-    } else {
-        run_loop::<M, _, false>(dp, arch, machine, items, stimulus, stop, record)
-    }
+    let source = Source::new(dp, fill_from(items));
+    run_source(dp, arch, machine, source, stimulus, stop, record)
 }
 
-/// [`run`]'s loop; `STEADY`: the stimulus is always ready and nothing is recorded.
-fn run_loop<M: Machine, I: Iterator<Item = (usize, i64)>, const STEADY: bool>(
+/// [`run`] on a [`Source`].
+fn run_source<M: Machine, F: FnMut(&mut Vec<usize>, &mut Vec<i64>, usize)>(
     dp: &Datapath,
     arch: Arch,
-    mut machine: M,
-    items: I,
+    machine: M,
+    source: Source<'_, F>,
     stimulus: &mut Stimulus,
     stop: Stop,
     record: Record,
 ) -> SimResult {
-    let mut items = Source::new(dp, items);
+    if stimulus.always_ready() && !record.transfers && record.trace_cycles == 0 {
+        run_loop::<M, F, true>(dp, arch, machine, source, stimulus, stop, record)
+    } else {
+        run_loop::<M, F, false>(dp, arch, machine, source, stimulus, stop, record)
+    }
+}
+
+/// [`run`]'s loop; `STEADY`: the stimulus is always ready and nothing is recorded.
+fn run_loop<M: Machine, F: FnMut(&mut Vec<usize>, &mut Vec<i64>, usize), const STEADY: bool>(
+    dp: &Datapath,
+    arch: Arch,
+    mut machine: M,
+    mut items: Source<'_, F>,
+    stimulus: &mut Stimulus,
+    stop: Stop,
+    record: Record,
+) -> SimResult {
     let transfers = !STEADY && record.transfers;
     let trace_cycles = if STEADY { 0 } else { record.trace_cycles };
     // Room for a run that stops after a number of cycles (up to 2^22 of them; longer runs
@@ -659,4 +728,33 @@ pub fn random_inputs(dp: &Datapath, seed: u64) -> impl Iterator<Item = (usize, i
     let codes = dp.input_codes();
     let n_count = dp.constants().len();
     std::iter::repeat_with(move || (rng.gen_range(0..n_count), rng.gen_range(codes.clone())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::Config;
+
+    /// The sweep's run-by-run filler writes [`sweep_inputs`]' stream, whatever the blocks
+    /// (within one n, across several, past the last n back to the first).
+    #[test]
+    fn the_sweep_filler_writes_the_sweep_stream() {
+        let mut cfg = Config::from_toml("name = \"narrow\"\n[c]\nformat = \"u1.3\"\n").unwrap();
+        cfg.n = "16,17,300".parse().unwrap();
+        for dp in [
+            Datapath::new(cfg).unwrap(),
+            Datapath::new(Config::baseline()).unwrap(),
+        ] {
+            let mut fill = fill_sweep(&dp);
+            let mut want = sweep_inputs(&dp);
+            for block in [1, 2, 5, 9, 31, 70_000, 3, 200_000] {
+                let (mut n_idx, mut codes) = (vec![7], vec![-1]);
+                fill(&mut n_idx, &mut codes, block);
+                assert_eq!((n_idx.len(), codes.len()), (block + 1, block + 1));
+                let got: Vec<(usize, i64)> = n_idx.into_iter().zip(codes).skip(1).collect();
+                let expected: Vec<(usize, i64)> = want.by_ref().take(block).collect();
+                assert_eq!(got, expected, "a block of {block}");
+            }
+        }
+    }
 }
