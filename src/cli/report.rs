@@ -39,6 +39,11 @@ pub struct ReportArgs {
     /// quicker report.
     #[arg(long, default_value = "8,4,2,1,0.75,0.5", value_parser = super::tradeoff::parse_ladder)]
     ladder: super::tradeoff::Ladder,
+    /// The stability map samples the float paths at every c = j / 2^BITS (as `specfx
+    /// stability --c-bits`; the datapaths at every input code whatever BITS is). A coarser map
+    /// is a quicker report: at 12 the map takes about a quarter of its default time.
+    #[arg(long, value_name = "BITS", default_value_t = 15, value_parser = clap::value_parser!(u32).range(1..=24))]
+    stability_c_bits: u32,
 }
 
 /// Renders into a buffer and writes it atomically to `dir/name`; returns the path.
@@ -78,7 +83,7 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     let costs = r.costs(&dp)?;
     let budget = r.budget(&dp)?;
     let figures = r.tradeoff(&args.ladder.0)?;
-    let stability = r.stability()?;
+    let stability = r.stability(args.stability_c_bits)?;
     let scene = specfx::scene::Scene::default_scene();
     let render = r.render(&scene)?;
     let fit = r.fit(&scene)?;
@@ -88,7 +93,9 @@ pub fn run(args: &ReportArgs) -> Result<Outcome> {
     // Everything the report computes is built in: its inputs are the command alone (and the
     // version, which fixes the built-in configurations, scene and settings).
     let provenance = specfx::provenance::Provenance::new(
-        &specfx::provenance::Inputs::new("report").option("ladder", args.ladder.0.clone()),
+        &specfx::provenance::Inputs::new("report")
+            .option("ladder", args.ladder.0.clone())
+            .option("stability_c_bits", i64::from(args.stability_c_bits)),
     );
     super::output::write_provenance(r.dir, &provenance)?;
     r.written.push(r.dir.join(INPUTS_FILE));
@@ -163,9 +170,10 @@ impl<'a> Report<'a> {
         let nextpnr_version = specfx::tools::version("nextpnr-ice40", "--version");
         let hdl = super::hdl_ref::hdl_ref_dir(None);
         let key = super::resume::run_key(&format!(
-            "yosys {yosys_version:?}\nnextpnr-ice40 {nextpnr_version:?}\nhdl_ref {}\nladder {:?}",
+            "yosys {yosys_version:?}\nnextpnr-ice40 {nextpnr_version:?}\nhdl_ref {}\nladder {:?}\nstability_c_bits {}",
             hdl.display(),
-            args.ladder.0
+            args.ladder.0,
+            args.stability_c_bits
         ));
         let resume = super::resume::Resume::open(dir, key, resumed)?;
         if resumed {
@@ -387,7 +395,7 @@ impl<'a> Report<'a> {
         Ok(figures)
     }
 
-    fn stability(&mut self) -> Result<StabilitySummary> {
+    fn stability(&mut self, c_bits: u32) -> Result<StabilitySummary> {
         self.steps.start(
             "mapping where every method and datapath fails (n = 1..=4096, theta 0..90 degrees)",
         );
@@ -396,7 +404,10 @@ impl<'a> Report<'a> {
             let report = super::stability::stability(
                 &stability_dir,
                 &specfx::analysis::stability::default_paths(),
-                &specfx::analysis::stability::Grid::default(),
+                &specfx::analysis::stability::Grid {
+                    c_bits,
+                    ..Default::default()
+                },
             )?;
             Ok(StabilitySummary {
                 paths: report

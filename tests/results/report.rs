@@ -54,15 +54,17 @@ fn finished(dir: tempfile::TempDir, out: &Path, stdout: Vec<u8>) -> Run {
     Run { dir: inner, stdout }
 }
 
-/// `specfx report --out OUT --ladder 1` on two rayon threads: the trade-off's frontier at
-/// one budget (four algorithms reach 1 lsb8), not the default ladder's six (minutes more;
-/// `tradeoff.rs` tests the frontier itself).
+/// `specfx report --out OUT --ladder 1 --stability-c-bits 12` on two rayon threads: the
+/// trade-off's frontier at one budget (four algorithms reach 1 lsb8), not the default
+/// ladder's six (minutes more; `tradeoff.rs` tests the frontier itself), and the stability
+/// map's float paths at 2^12 + 1 cosines, not 2^15 + 1 (a quarter of its time; its default
+/// grid is the same code on more cosines; `stability.rs` tests the map).
 fn report_command(out: &Path) -> Command {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_specfx"));
     cmd.arg("report")
         .arg("--out")
         .arg(out)
-        .args(["--ladder", "1"]);
+        .args(["--ladder", "1", "--stability-c-bits", "12"]);
     cmd.env("RAYON_NUM_THREADS", "2");
     cmd
 }
