@@ -5,7 +5,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use specfx::analysis::check::check;
 use specfx::analysis::sweep::{evaluate, Space};
 use specfx::cycle::sim::{
-    random_inputs, simulate, simulate_with, sweep_inputs, Record, Stimulus, Stop,
+    random_inputs, simulate, simulate_stream, Record, Stimulus, Stop, Stream,
 };
 use specfx::cycle::Arch;
 use specfx::engine::output_sum;
@@ -80,7 +80,7 @@ fn sweep_point(c: &mut Criterion) {
 
 /// The cycle model, in cycles/s: both architectures on the sweep stream (every code for each
 /// n in turn, as `scripts/bench-peers`' Verilator harness streams them) without bubbles or
-/// stalls, keeping statistics only; and the pipelined one on the random stream under 10%
+/// stalls, keeping statistics only, as `specfx sim --stream sweep` runs it; and the pipelined one on the random stream under 10%
 /// bubbles and stalls, keeping every transfer as the co-simulation's stimulus does.
 fn cycle_model(c: &mut Criterion) {
     let dp = Datapath::new(Config::baseline()).unwrap();
@@ -97,7 +97,7 @@ fn cycle_model(c: &mut Criterion) {
             b.iter(|| {
                 let mut stimulus = Stimulus::new(1, 0.0, 0.0);
                 let stop = Stop::Cycles(CYCLES);
-                simulate_with(&dp, arch, sweep_inputs(&dp), &mut stimulus, stop, lean)
+                simulate_stream(&dp, arch, Stream::Sweep, 1, &mut stimulus, stop, lean)
             })
         });
     }
