@@ -397,12 +397,9 @@ impl Machine for Pipelined {
 
     #[inline]
     fn count_occupancy(&self, counts: &mut [u64]) {
-        // A full pipeline (every register valid: the usual case of a stream without
-        // bubbles) occupies every unit, an empty one none.
-        let full = u128::MAX >> (128 - self.ring.len());
-        if self.valid == full {
-            counts.iter_mut().for_each(|c| *c += 1);
-        } else if self.valid != 0 {
+        // An empty pipeline occupies no unit (a full one, the simulator counts through
+        // `full`).
+        if self.valid != 0 {
             for (count, &mask) in counts.iter_mut().zip(&self.unit_masks) {
                 *count += u64::from(self.valid & mask != 0);
             }
