@@ -264,15 +264,7 @@ fn outputs_one_n(
         r.norm = norm_peak * cn;
         r.norm_approx = norm_peak * cn;
     }
-    // The f64 lobe of code index i by the same algorithm (see `reference_probes`).
-    let f64_lobe = |i: usize| {
-        let t = nc.slope * shared.ref_d[i];
-        let mut s = reference_base(cfg.cutoff, t, nc.offset, codes[i].min(one) < threshold);
-        for _ in 0..nc.depth {
-            s *= s;
-        }
-        s
-    };
+    let f64_lobe = |i: usize| f64_lobe_at(dp, nc, shared, i);
     let n_zero = zero_run_end(dp, nc, codes, n_dead, &f64_lobe);
     if n_zero > n_dead {
         // Every fixed-point lobe and output of the run is 0, and the f64 lobe s, its output
@@ -289,15 +281,6 @@ fn outputs_one_n(
             (-(f64_lobe(i as usize) * nc.coef)).abs() > half
         });
         r.n_correct += (correct_end - n_dead as i64) as u64;
-        let approx_over = |range: std::ops::Range<usize>| {
-            range.fold((-1.0f64, -1.0f64), |(a, na), i| {
-                let (s, cn) = (f64_lobe(i), cos_n(i));
-                (
-                    a.max((s - cn).abs()),
-                    na.max((s * nc.coef - norm_peak * cn).abs()),
-                )
-            })
-        };
         // The f64 lobe's error over every code (0 in the dead prefix, which the f64 model
         // cuts too) is the datapath's floor: a cache holds it across datapaths.
         let (approx, norm_approx) = match cache {
@@ -312,9 +295,9 @@ fn outputs_one_n(
                     cfg.cutoff as u8,
                     cfg.coef.form as u8,
                 );
-                c.floor(key, || approx_over(0..codes.len()))
+                c.floor(key, || f64_floor(dp, nc, codes, norm_peak, &f64_lobe, &cos_n))
             }
-            None => approx_over(n_dead..n_zero),
+            None => floor_over(n_dead..n_zero, nc, norm_peak, &f64_lobe, &cos_n),
         };
         r.approx = r.approx.max(approx);
         r.norm_approx = r.norm_approx.max(norm_approx);
@@ -627,6 +610,83 @@ fn dead_prefix_end(dp: &Datapath, nc: &NConstants, codes: &[i64]) -> i64 {
         reference_base(cfg.cutoff, nc.slope * d, nc.offset, false) != 0.0
     };
     first_code_where(lo..fixed, positive)
+}
+
+/// The f64 lobe of code index `i` by the same algorithm (see `reference_probes`).
+#[inline]
+fn f64_lobe_at(dp: &Datapath, nc: &NConstants, shared: &CodeColumns, i: usize) -> f64 {
+    let cfg = dp.config();
+    let threshold = nc.threshold.unwrap_or(i64::MIN);
+    let t = nc.slope * shared.ref_d[i];
+    let below = shared.codes.codes[i].min(dp.one_code()) < threshold;
+    let mut s = reference_base(cfg.cutoff, t, nc.offset, below);
+    for _ in 0..nc.depth {
+        s *= s;
+    }
+    s
+}
+
+/// The f64 lobe `s`'s errors over the code indices `range`: `(max |s - cos^n|, max |s coef -
+/// peak cos^n|)`, -1 for an empty range.
+fn floor_over(
+    range: std::ops::Range<usize>,
+    nc: &NConstants,
+    norm_peak: f64,
+    s: &dyn Fn(usize) -> f64,
+    cos_n: &dyn Fn(usize) -> f64,
+) -> (f64, f64) {
+    range.fold((-1.0f64, -1.0f64), |(a, na), i| {
+        let (s, cn) = (s(i), cos_n(i));
+        (
+            a.max((s - cn).abs()),
+            na.max((s * nc.coef - norm_peak * cn).abs()),
+        )
+    })
+}
+
+/// [`floor_over`] every code: the datapath's floor, the same for every datapath with the
+/// same f64 lobe. Below the f64 model's own cut prefix ([`f64_zero_end`]) the f64 lobe is 0
+/// and each error is cos^n (times the peak), which grows with c: the prefix's last code
+/// stands for it.
+fn f64_floor(
+    dp: &Datapath,
+    nc: &NConstants,
+    codes: &[i64],
+    norm_peak: f64,
+    s: &dyn Fn(usize) -> f64,
+    cos_n: &dyn Fn(usize) -> f64,
+) -> (f64, f64) {
+    let z = f64_zero_end(dp, nc, codes);
+    let (a, na) = floor_over(z..codes.len(), nc, norm_peak, s, cos_n);
+    match z.checked_sub(1).map(cos_n) {
+        Some(cn) => (a.max(cn), na.max(norm_peak * cn)),
+        None => (a, na),
+    }
+}
+
+/// The end (a code index) of the prefix of `codes` whose f64 base is proven 0 (cut) for this
+/// n, whatever the fixed-point stages: below the threshold with the paper cutoff (the codes
+/// are increasing), where the f64 base is 0 with the clamp and a positive slope (found by
+/// bisection, as in [`dead_prefix_end`]); 0 otherwise.
+fn f64_zero_end(dp: &Datapath, nc: &NConstants, codes: &[i64]) -> usize {
+    let cfg = dp.config();
+    let (lo, end) = (codes[0], codes[codes.len() - 1] + 1);
+    let one = dp.one_code();
+    let first = match cfg.cutoff {
+        Cutoff::Paper => match nc.threshold {
+            Some(thr) => first_code_where(lo..end, |k| k.min(one) >= thr),
+            None => lo,
+        },
+        Cutoff::Clamp if nc.slope > 0.0 => {
+            let c_lsb = cfg.c.format.lsb();
+            first_code_where(lo..end, |k| {
+                let d = (k.min(one) as f64 * c_lsb) - 1.0;
+                reference_base(cfg.cutoff, nc.slope * d, nc.offset, false) != 0.0
+            })
+        }
+        _ => lo,
+    };
+    (first - lo) as usize
 }
 
 /// The end (a code index) of the zero run of one n: from `n_dead` on, the codes whose
@@ -958,4 +1018,54 @@ pub fn check_with_progress(
         n_cut,
         notes,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::Config;
+
+    /// The floor a cache keeps ([`f64_floor`]: from the f64 model's cut prefix on, the
+    /// prefix's last code standing for the rest) is the floor over every code, bit for bit:
+    /// on real datapaths (clamp, paper, none, minimax, a signed input), and with a `cos^n`
+    /// made up so that the prefix's last code is the maximum.
+    #[test]
+    fn the_floor_above_the_f64_cut_prefix_is_the_floor_over_every_code() {
+        let mut prefixes = 0;
+        for toml in [
+            "",
+            "cutoff = \"paper\"\nk = 5\n",
+            "cutoff = \"none\"\nk = 3\n",
+            "variant = \"minimax\"\n",
+            "[c]\nformat = \"s2.10\"\n[d]\nformat = \"s3.11\"\n",
+        ] {
+            let mut cfg = Config::from_toml(toml).unwrap();
+            cfg.n = "16,17,40,100,333,1000,1024".parse().unwrap();
+            let dp = Datapath::new(cfg).unwrap();
+            let shared = code_columns(&dp).unwrap();
+            let codes = &shared.codes.codes[..];
+            let c_lsb = dp.config().c.format.lsb();
+            for nc in dp.constants() {
+                let nf = f64::from(nc.n);
+                let peak = classic_coefficient(dp.config().coef.form, nf);
+                let s = |i: usize| f64_lobe_at(&dp, nc, &shared, i);
+                let cos_n = |i: usize| cos_n_of(codes[i], c_lsb, nf, shared.codes.ln_c[i]);
+                let z = f64_zero_end(&dp, nc, codes);
+                assert!((0..z).all(|i| s(i) == 0.0), "{toml} n={}", nc.n);
+                prefixes += usize::from(z > 0);
+                let want = floor_over(0..codes.len(), nc, peak, &s, &cos_n);
+                let got = f64_floor(&dp, nc, codes, peak, &s, &cos_n);
+                assert_eq!(got.0.to_bits(), want.0.to_bits(), "{toml} n={}", nc.n);
+                assert_eq!(got.1.to_bits(), want.1.to_bits(), "{toml} n={}", nc.n);
+                if z > 1 {
+                    let made_up = |i: usize| if i < z { 10.0 + i as f64 } else { 0.5 };
+                    let want = floor_over(0..codes.len(), nc, peak, &s, &made_up);
+                    let got = f64_floor(&dp, nc, codes, peak, &s, &made_up);
+                    assert_eq!(got, want, "{toml} n={}", nc.n);
+                    assert_eq!(got.0, 10.0 + (z - 1) as f64);
+                }
+            }
+        }
+        assert!(prefixes > 20, "the clamp and the paper cutoff cut a prefix");
+    }
 }

@@ -606,16 +606,19 @@ pub fn resources(cost: PointCost, points_per_task: u64, threads: u32) -> Resourc
 }
 
 /// The cost of a point of `space`: the slowest of its first, middle and last points, and the
-/// peak memory of this process after them.
+/// peak memory of this process after them (evaluated as a sweep's task evaluates its points,
+/// through one [`Evaluator`](crate::analysis::sweep::Evaluator), whose shared values the peak
+/// includes; the first point, which finds nothing shared yet, is the slowest).
 pub fn measure_point_cost(space: &crate::analysis::sweep::Space) -> PointCost {
     let n = space.n_points();
     let mut picks = vec![0, n / 2, n - 1];
     picks.dedup();
+    let evaluator = crate::analysis::sweep::Evaluator::new(space);
     let seconds = picks
         .iter()
         .map(|&i| {
             let start = std::time::Instant::now();
-            let _ = crate::analysis::sweep::evaluate(space, i);
+            let _ = evaluator.evaluate(i);
             start.elapsed().as_secs_f64()
         })
         .fold(0.0, f64::max);

@@ -9,7 +9,8 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::check::check_outputs;
+use crate::analysis::check::{check_outputs_cached, CosCache};
+use crate::analysis::optimize::COS_CACHE_VALUES;
 use crate::cycle::Arch;
 use crate::error::Error;
 use crate::fixed::Format;
@@ -425,63 +426,89 @@ pub struct PointResult {
     pub yosys_dsps: Option<u64>,
 }
 
-/// Evaluates point `index` of a space: exhaustive check and analytic cost.
+/// Evaluates point `index` of a space: exhaustive check and analytic cost. A sweep of many
+/// points evaluates them through one [`Evaluator`], which shares work between them.
 pub fn evaluate(space: &Space, index: u64) -> PointResult {
-    let values = space.point_label(index);
-    let empty = |invalid: String| PointResult {
-        index,
-        values: values.clone(),
-        invalid: Some(invalid),
-        shape_total_max_abs: None,
-        shape_quant_max_abs: None,
-        out_max_ulp: None,
-        out_correctly_rounded: None,
-        monotonic: None,
-        luts: None,
-        dsps: None,
-        ffs: None,
-        register_bits: None,
-        multiplier_bits: None,
-        latency: None,
-        initiation_interval: None,
-        pareto: false,
-        yosys_luts: None,
-        yosys_ffs: None,
-        yosys_dsps: None,
-    };
-    let (cfg, arch) = match space.point(index) {
-        Ok(p) => p,
-        Err(e) => return empty(e.to_string()),
-    };
-    let dp = match Datapath::new(cfg) {
-        Ok(dp) => dp,
-        Err(e) => return empty(e.to_string()),
-    };
-    let r = match check_outputs(&dp) {
-        Ok(r) => r,
-        Err(e) => return empty(e.to_string()),
-    };
-    let cost = analytic_cost(&dp, arch, space.target);
-    PointResult {
-        index,
-        values,
-        invalid: None,
-        shape_total_max_abs: Some(r.shape_total_max_abs),
-        shape_quant_max_abs: Some(r.shape_quant_max_abs),
-        out_max_ulp: Some(r.out_max_ulp),
-        out_correctly_rounded: Some(r.out_correctly_rounded),
-        monotonic: Some(r.monotonic),
-        luts: Some(cost.luts),
-        dsps: Some(cost.dsps),
-        ffs: Some(cost.ffs),
-        register_bits: Some(cost.features.register_bits),
-        multiplier_bits: Some(cost.features.multiplier_bits),
-        latency: Some(cost.latency),
-        initiation_interval: Some(cost.initiation_interval),
-        pareto: false,
-        yosys_luts: None,
-        yosys_ffs: None,
-        yosys_dsps: None,
+    Evaluator::new(space).evaluate(index)
+}
+
+/// Evaluates the points of one space, sharing between them what does not depend on their
+/// stages: the `cos^n` of the input codes and the f64 floors of each algorithm
+/// ([`CosCache`], 128 MiB at most). Every point's figures are those of [`evaluate`], bit for
+/// bit.
+pub struct Evaluator<'a> {
+    space: &'a Space,
+    cos: CosCache,
+}
+
+impl<'a> Evaluator<'a> {
+    /// An evaluator of `space`'s points, with nothing shared yet.
+    pub fn new(space: &'a Space) -> Evaluator<'a> {
+        Evaluator {
+            space,
+            cos: CosCache::new(COS_CACHE_VALUES),
+        }
+    }
+
+    /// Evaluates point `index`: exhaustive check and analytic cost.
+    pub fn evaluate(&self, index: u64) -> PointResult {
+        let space = self.space;
+        let values = space.point_label(index);
+        let empty = |invalid: String| PointResult {
+            index,
+            values: values.clone(),
+            invalid: Some(invalid),
+            shape_total_max_abs: None,
+            shape_quant_max_abs: None,
+            out_max_ulp: None,
+            out_correctly_rounded: None,
+            monotonic: None,
+            luts: None,
+            dsps: None,
+            ffs: None,
+            register_bits: None,
+            multiplier_bits: None,
+            latency: None,
+            initiation_interval: None,
+            pareto: false,
+            yosys_luts: None,
+            yosys_ffs: None,
+            yosys_dsps: None,
+        };
+        let (cfg, arch) = match space.point(index) {
+            Ok(p) => p,
+            Err(e) => return empty(e.to_string()),
+        };
+        let dp = match Datapath::new(cfg) {
+            Ok(dp) => dp,
+            Err(e) => return empty(e.to_string()),
+        };
+        let r = match check_outputs_cached(&dp, Some(&self.cos)) {
+            Ok(r) => r,
+            Err(e) => return empty(e.to_string()),
+        };
+        let cost = analytic_cost(&dp, arch, space.target);
+        PointResult {
+            index,
+            values,
+            invalid: None,
+            shape_total_max_abs: Some(r.shape_total_max_abs),
+            shape_quant_max_abs: Some(r.shape_quant_max_abs),
+            out_max_ulp: Some(r.out_max_ulp),
+            out_correctly_rounded: Some(r.out_correctly_rounded),
+            monotonic: Some(r.monotonic),
+            luts: Some(cost.luts),
+            dsps: Some(cost.dsps),
+            ffs: Some(cost.ffs),
+            register_bits: Some(cost.features.register_bits),
+            multiplier_bits: Some(cost.features.multiplier_bits),
+            latency: Some(cost.latency),
+            initiation_interval: Some(cost.initiation_interval),
+            pareto: false,
+            yosys_luts: None,
+            yosys_ffs: None,
+            yosys_dsps: None,
+        }
     }
 }
 

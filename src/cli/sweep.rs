@@ -14,7 +14,7 @@ use specfx::analysis::cluster::{
     assign, parse_shard_spec, shard_path, Emit, Plan, PointCost, ShardSpec, SHARD_PLACEHOLDER,
 };
 use specfx::analysis::sweep::{
-    check_shard_complete, check_shards, evaluate, mark_pareto, same_space, GivenShard, LogUse,
+    check_shard_complete, check_shards, mark_pareto, same_space, Evaluator, GivenShard, LogUse,
     PointResult, Space, SweepInfo, DEFAULT_SPACE,
 };
 use specfx::output::OutDir;
@@ -349,8 +349,9 @@ fn sweep_shard(
         .append(true)
         .open(&log_path)
         .with_context(cannot_write)?;
+    let evaluator = Evaluator::new(&info.space);
     for &index in &todo {
-        let p = evaluate(&info.space, index);
+        let p = evaluator.evaluate(index);
         let mut line = serde_json::to_string(&p)?;
         line.push('\n');
         log.write_all(line.as_bytes())

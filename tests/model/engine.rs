@@ -158,6 +158,45 @@ fn a_sweep_point_is_the_same_with_one_and_two_threads() {
     }
 }
 
+/// A sweep's points evaluated through one `Evaluator` (rows of cos^n and f64 floors shared
+/// between points, the floors over the codes above the f64 model's own cut prefix) give the
+/// figures of the plain, uncached `check_outputs` of each point: points that share the
+/// floors (same k, other formats), that do not (other k and cutoffs), a cutoff that leaves no
+/// f64 prefix (none), and the same evaluator for every point in turn.
+#[test]
+fn a_sweeps_shared_evaluator_gives_each_points_own_figures() {
+    use specfx::analysis::check::check_outputs;
+    use specfx::analysis::sweep::{Evaluator, Space};
+    let space = Space::from_toml(
+        "n = \"16,17,40,333,1024\"\n[vary]\nk = [3, 5]\ncutoff = [\"clamp\", \"paper\", \"none\"]\n\"square.frac\" = [6, 15]\n",
+    )
+    .unwrap();
+    let shared = Evaluator::new(&space);
+    for index in 0..space.n_points() {
+        let got = shared.evaluate(index);
+        let dp = Datapath::new(space.point(index).unwrap().0).unwrap();
+        let want = check_outputs(&dp).unwrap();
+        let label = &got.values;
+        assert_eq!(
+            got.shape_total_max_abs,
+            Some(want.shape_total_max_abs),
+            "{label}"
+        );
+        assert_eq!(
+            got.shape_quant_max_abs,
+            Some(want.shape_quant_max_abs),
+            "{label}"
+        );
+        assert_eq!(got.out_max_ulp, Some(want.out_max_ulp), "{label}");
+        assert_eq!(
+            got.out_correctly_rounded,
+            Some(want.out_correctly_rounded),
+            "{label}"
+        );
+        assert_eq!(got.monotonic, Some(want.monotonic), "{label}");
+    }
+}
+
 /// cos^n of a code follows one rule everywhere: 0 at and below c = 0 (the lobe is
 /// max(0, c)^n), so a signed input's negative codes give 0, not NaN, to every analysis
 /// streaming the engine's `ln c` (the budget's targets among them); above 0, `c^n` by `powi`.
