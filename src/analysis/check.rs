@@ -218,6 +218,8 @@ fn outputs_one_n(
     nc: &NConstants,
     shared: &CodeColumns,
     cache: Option<&CosCache>,
+    dead_end: i64,
+    tabulate: bool,
 ) -> OutputsOfN {
     let cfg = dp.config();
     let codes = &shared.codes.codes[..];
@@ -230,7 +232,6 @@ fn outputs_one_n(
     let threshold = nc.threshold.unwrap_or(i64::MIN);
     let one = dp.one_code();
     let cos_direct = |i: usize| cos_n_of(codes[i], c_lsb, nf, shared.codes.ln_c[i]);
-    let dead_end = dead_prefix_end(dp, nc, codes);
     let n_dead = (dead_end - lo) as usize;
     let row = cache.and_then(|c| {
         c.row(nc.n, n_dead, || {
@@ -295,7 +296,9 @@ fn outputs_one_n(
                     cfg.cutoff as u8,
                     cfg.coef.form as u8,
                 );
-                c.floor(key, || f64_floor(dp, nc, codes, norm_peak, &f64_lobe, &cos_n))
+                c.floor(key, || {
+                    f64_floor(dp, nc, codes, norm_peak, &f64_lobe, &cos_n)
+                })
             }
             None => floor_over(n_dead..n_zero, nc, norm_peak, &f64_lobe, &cos_n),
         };
@@ -312,7 +315,11 @@ fn outputs_one_n(
         let end = (start + CHUNK).min(codes.len());
         let chunk = &codes[start..end];
         let o_chunk = &mut outs[..chunk.len()];
-        dp.eval_outputs_untabulated(nc, chunk, o_chunk, &mut scratch);
+        if tabulate {
+            dp.eval_outputs(nc, chunk, o_chunk, &mut scratch);
+        } else {
+            dp.eval_outputs_untabulated(nc, chunk, o_chunk, &mut scratch);
+        }
         let lobes = scratch.lobes();
         for (j, &k) in chunk.iter().enumerate() {
             let i = start + j;
@@ -505,7 +512,31 @@ fn outputs_of(
     shared: &CodeColumns,
     cache: Option<&CosCache>,
 ) -> Result<OutputFigures, Error> {
-    let per_n = map_n(dp, |nc| outputs_one_n(dp, nc, shared, cache));
+    let codes = &shared.codes.codes;
+    let dead = map_n(dp, |nc| dead_prefix_end(dp, nc, codes));
+    // The squaring chain is looked up from b where its tables (one pass of its kernels over
+    // every b code, for each depth) cost fewer evaluations than running it on the codes above
+    // the dead prefixes (a bound on the live codes).
+    let end = codes[codes.len() - 1] + 1;
+    let above_dead: u128 = dead.iter().map(|&d| (end - d) as u128).sum();
+    let b = dp.config().b.format;
+    let b_codes = (i128::from(b.max_raw()) - i128::from(b.min_raw()) + 1) as u128;
+    let depths = dp
+        .constants()
+        .iter()
+        .map(|nc| nc.depth)
+        .collect::<std::collections::BTreeSet<_>>()
+        .len() as u128;
+    let tabulate = b_codes * depths <= above_dead;
+    let per_n = map_n(dp, |nc| {
+        let i = dp
+            .config()
+            .n
+            .values()
+            .binary_search(&nc.n)
+            .expect("an exponent of the set");
+        outputs_one_n(dp, nc, shared, cache, dead[i], tabulate)
+    });
     let mut f = OutputsOfN {
         quant: -1.0,
         approx: -1.0,

@@ -895,11 +895,16 @@ impl Datapath {
                 if codes > MAX_CHAIN_TABLE {
                     return None;
                 }
-                let last = (lo..=hi)
-                    .map(|x| {
-                        (0..self.config.k as usize).fold(x, |s, i| self.op_stage(i, depth, s).raw)
-                    })
-                    .collect();
+                // Every b code through the squaring stages' batch kernels (the same values as
+                // `op_stage`, the property tests say so), one column at a time.
+                let mut last: Vec<i64> = (lo..=hi).collect();
+                let mut next = vec![0; last.len()];
+                let mut counts = [0; 3];
+                for i in 0..self.plan.squares.len() {
+                    let (kernel, pre) = self.plan.square_stage(i, depth);
+                    kernel.run(pre, &last, &mut next, &mut counts);
+                    std::mem::swap(&mut last, &mut next);
+                }
                 Some(ChainTable { b_min: lo, last })
             })
             .as_ref()
@@ -930,9 +935,9 @@ impl Datapath {
     }
 
     /// [`Datapath::eval_outputs`] with the squaring chain run stage by stage, never tabulated:
-    /// for a datapath evaluated once over few live codes (an exhaustive check of one of the
-    /// optimiser's candidates), where building the table would cost more than it saves. The
-    /// lobes are left in the scratch ([`OutputScratch::lobes`]).
+    /// for a datapath evaluated once over fewer live codes than b has codes (the output-only
+    /// check of a datapath with few exponents or a wide b), where building the table would
+    /// cost more than it saves. The lobes are left in the scratch ([`OutputScratch::lobes`]).
     pub fn eval_outputs_untabulated(
         &self,
         nc: &NConstants,
