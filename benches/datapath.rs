@@ -1,9 +1,10 @@
 //! Criterion benchmarks of the bit-accurate datapath: one evaluation, the batch path, the
-//! outputs over every code and n, the exhaustive check, one sweep point and the cycle model.
+//! outputs over every code and n, the exhaustive check, one sweep point, the built-in sweep and
+//! the cycle model.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use specfx::analysis::check::check;
-use specfx::analysis::sweep::{evaluate, Space};
+use specfx::analysis::sweep::{evaluate, Evaluator, Space};
 use specfx::cycle::sim::{
     random_inputs, simulate, simulate_stream, Record, Stimulus, Stop, Stream,
 };
@@ -75,6 +76,17 @@ fn sweep_point(c: &mut Criterion) {
     let mut g = c.benchmark_group("sweep");
     g.sample_size(10);
     g.bench_function("point/baseline", |b| b.iter(|| evaluate(&space, 0)));
+    // The built-in space's 54 points through one evaluator, as `specfx sweep` runs them
+    // (cos^n and the f64 floors shared between the points).
+    let builtin = Space::builtin();
+    g.bench_function("builtin/54-points", |b| {
+        b.iter(|| {
+            let e = Evaluator::new(&builtin);
+            (0..builtin.n_points())
+                .map(|i| e.evaluate(i))
+                .collect::<Vec<_>>()
+        })
+    });
     g.finish();
 }
 
