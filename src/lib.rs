@@ -4,7 +4,8 @@
 //! `cs_m(c, n) = max(0, (n/m)(c - 1) + 1)^m` with m = 2^k squarings (k = 4 in the paper by
 //! Romanyuk, Pavlov and Abramchuk, 2016), times an energy-conserving coefficient coef(n).
 //!
-//! - [`reference`]: the f64 oracle (lobes, minimax constants, normalisation, quadrature).
+//! - [`reference`](mod@reference): the f64 oracle (lobes, minimax constants, normalisation,
+//!   quadrature).
 //! - [`analysis`]: computations over the reference, such as the reproduction of the paper.
 //! - [`report`]: renders results as text tables into any writer.
 //!

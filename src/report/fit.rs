@@ -191,7 +191,7 @@ fn floors_markdown(floors: &[Floor]) -> String {
     s
 }
 
-/// The floors as a terminal table (the same columns as [`floors_markdown`]).
+/// The floors as a terminal table (the same columns as the Markdown table of the fit report).
 pub fn floors_table(floors: &[Floor]) -> TextTable {
     let mut t = TextTable::new(&[
         ("k", Align::Right),
