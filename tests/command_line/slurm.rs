@@ -11,8 +11,14 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-/// 12 points; with every n of 16..=1024 a point takes long enough to cancel a task mid-run.
+/// 12 points, a few milliseconds each.
 const SPACE: &str = "n = \"16..=1024\"\n[vary]\nk = [3, 4, 5]\n\"square.rounding\" = [\"TRN\", \"RND\"]\narch = [\"pipelined\", \"folded\"]\n";
+
+/// The same 12 points on a 20-bit cosine: about half a second each on the 2-core AMD machine
+/// (more on slower ones), so the five points a task has left after its first one give it
+/// seconds to be cancelled mid-shard. `SPACE`'s points now take milliseconds (sweep points
+/// share their `cos^n`), a race the cancellation lost.
+const WIDE_SPACE: &str = "n = \"16..=1024\"\n[base.c]\nformat = \"u1.20\"\n[base.d]\nformat = \"s1.20\"\n[vary]\nk = [3, 4, 5]\n\"square.rounding\" = [\"TRN\", \"RND\"]\narch = [\"pipelined\", \"folded\"]\n";
 
 /// The daemons of a cluster, killed (and waited for) when dropped.
 struct Cluster {
@@ -217,11 +223,16 @@ impl Cluster {
     }
 }
 
-fn wait_for(what: &str, timeout: Duration, mut ready: impl FnMut() -> bool) {
+fn wait_for(what: &str, timeout: Duration, ready: impl FnMut() -> bool) {
+    poll(what, timeout, Duration::from_millis(100), ready);
+}
+
+/// `wait_for`, looking every `every`.
+fn poll(what: &str, timeout: Duration, every: Duration, mut ready: impl FnMut() -> bool) {
     let start = Instant::now();
     while !ready() {
         assert!(start.elapsed() < timeout, "timed out waiting for {what}");
-        std::thread::sleep(Duration::from_millis(100));
+        std::thread::sleep(every);
     }
 }
 
@@ -316,10 +327,21 @@ fn a_slurm_array_sweeps_and_calibrates_like_one_machine_through_a_cancelled_task
         .collect();
     assert_eq!(logs.len(), 4, "three tasks' and the merge's logs: {logs:?}");
 
-    // One task of 2 shards (12 points): cancelled once its first point is written, the merge
-    // that waited for it is never run; resubmitted, it resumes its shards.
+    // One task of 2 shards (12 points of the wide space): cancelled once its first point is
+    // written, the merge that waited for it is never run; resubmitted, it resumes its shards.
+    let wide = root.join("wide.toml");
+    std::fs::write(&wide, WIDE_SPACE).unwrap();
+    let wide_one = root.join("wide-one");
+    specfx(&[
+        "sweep",
+        "--space",
+        wide.to_str().unwrap(),
+        "--out",
+        wide_one.to_str().unwrap(),
+    ]);
+    let wide_one = files(&wide_one);
     let cancelled = root.join("cancelled");
-    plan(&space, &cancelled, "1");
+    plan(&wide, &cancelled, "1");
     let array = cluster.ok("sbatch", &["--parsable", "sweep.sbatch"], &cancelled);
     let array = array.trim().split(';').next().unwrap().to_string();
     let merge = cluster.ok(
@@ -332,9 +354,13 @@ fn a_slurm_array_sweeps_and_calibrates_like_one_machine_through_a_cancelled_task
         &cancelled,
     );
     let log = cancelled.join("shards/shard-0/points.jsonl");
-    wait_for("the task's first point", Duration::from_secs(120), || {
-        std::fs::read_to_string(&log).is_ok_and(|t| t.lines().count() >= 1)
-    });
+    let every = Duration::from_millis(10);
+    poll(
+        "the task's first point",
+        Duration::from_secs(120),
+        every,
+        || std::fs::read_to_string(&log).is_ok_and(|t| t.lines().count() >= 1),
+    );
     cluster.ok("scancel", &[&format!("{array}_0")], &cancelled);
     // The merge's dependency can never be met now: cancel it too.
     wait_for("the task to end", Duration::from_secs(60), || {
@@ -362,7 +388,7 @@ fn a_slurm_array_sweeps_and_calibrates_like_one_machine_through_a_cancelled_task
     cluster.ok("sbatch", &["--wait", "merge.sbatch"], &cancelled);
     cluster.wait_idle(Duration::from_secs(60));
     assert!(
-        files(&cancelled.join("merged")) == one,
+        files(&cancelled.join("merged")) == wide_one,
         "the merge after the resubmission is not the one-shot sweep"
     );
     let resumed = std::fs::read_dir(&cancelled)
