@@ -9,6 +9,7 @@
 use serde::Serialize;
 
 mod fold;
+mod screen;
 use fold::{check_one_n, Acc, PerN, Scratch};
 
 use crate::analysis::accumulate::MaxAt;

@@ -1,9 +1,10 @@
 //! The fold of one exponent's exhaustive check over the stream's chunks ([`NFold`]): each
 //! stage's running figures, the shape and normalisation maxima, the cuts and monotonicity.
 
+use super::screen;
 use super::{
-    dead_prefix_end, overflowed_chunks, reference_base, CodeColumns, MonotonicityViolation, CHUNK,
-    MAX_LISTED_VIOLATIONS,
+    cos_n_of, dead_prefix_end, overflowed_chunks, reference_base, CodeColumns,
+    MonotonicityViolation, CHUNK, MAX_LISTED_VIOLATIONS,
 };
 use crate::analysis::accumulate::MaxAt;
 use crate::analysis::column::{column_figures, Map, Raws, References};
@@ -427,42 +428,82 @@ impl<'a, 's> NFold<'a, 's> {
 
     /// The normalised output against the exact normalised cos^n, on the live inputs (`raws`
     /// the output's values, `live_refs` the f64 lobe times the f64 coefficient, `live_cos`
-    /// their cos^n).
+    /// [`screen::exp_near`] of their cos^n): screened, exact where it may matter.
     fn fold_normalised(&mut self, c: &Chunk<'_>, raws: &[i64]) {
         let lsb_out = self.lsb[self.out];
-        for (j, &i) in self.cols.live.iter().enumerate() {
-            let cos_n = self.cols.live_cos[j];
-            let o = raws[j] as f64 * lsb_out;
-            self.norm
-                .add((o - self.norm_peak * cos_n).abs(), (self.nc.n, c.codes[i]));
-            self.norm_approx = self
-                .norm_approx
-                .max((self.cols.live_refs[j] - self.norm_peak * cos_n).abs());
-        }
+        let cols = &mut *self.cols;
+        cols.live_vals.clear();
+        cols.live_vals
+            .extend(raws.iter().map(|&r| r as f64 * lsb_out));
+        let (peak, n, nf, c_lsb) = (self.norm_peak, self.nc.n, self.nf, self.c_lsb);
+        let (norm, norm_approx) = (&mut self.norm, &mut self.norm_approx);
+        screen::screen_two(
+            &cols.live_vals,
+            &cols.live_refs,
+            peak,
+            &cols.live_cos,
+            (norm.value, *norm_approx),
+            &mut cols.screen,
+            |j, for_norm, for_approx| {
+                let i = cols.live[j];
+                let cos_n = cos_n_of(c.codes[i], c_lsb, nf, c.ln_c[i]);
+                if for_norm {
+                    norm.add((cols.live_vals[j] - peak * cos_n).abs(), (n, c.codes[i]));
+                }
+                if for_approx {
+                    *norm_approx = norm_approx.max((cols.live_refs[j] - peak * cos_n).abs());
+                }
+            },
+        );
     }
 
     /// The lobe against cos^n on the live inputs (`raws` the last squaring's values,
-    /// `live_refs` their f64 references): its quantization, approximation and total error.
-    /// Leaves the live inputs' cos^n (0 at and below c = 0) in `live_cos`.
+    /// `live_refs` their f64 references): its quantization, approximation and total error, the
+    /// last two screened ([`screen`]) and exact where they may reach the maximum. Leaves the
+    /// live inputs' [`screen::exp_near`] of cos^n in `live_cos`.
     fn fold_lobe(&mut self, c: &Chunk<'_>, raws: &[i64]) {
         let lsb_sq = self.lsb[self.last_sq];
-        self.cols.live_cos.clear();
-        self.cols.live_cos.extend(self.cols.live.iter().map(|&i| {
-            if c.codes[i] as f64 * self.c_lsb <= 0.0 {
-                0.0
+        let (n, nf, c_lsb) = (self.nc.n, self.nf, self.c_lsb);
+        let cols = &mut *self.cols;
+        cols.live_vals.clear();
+        cols.live_vals
+            .extend(raws.iter().map(|&r| r as f64 * lsb_sq));
+        for (j, &i) in cols.live.iter().enumerate() {
+            self.quant.add(
+                (cols.live_vals[j] - cols.live_refs[j]).abs(),
+                (n, c.codes[i]),
+            );
+        }
+        // exp(n ln c) where c > 0; at and below 0, cos^n is 0 (exp_near of -inf is e^-700).
+        cols.live_cos.clear();
+        cols.live_cos.extend(cols.live.iter().map(|&i| {
+            if c.codes[i] as f64 * c_lsb <= 0.0 {
+                f64::NEG_INFINITY
             } else {
-                (self.nf * c.ln_c[i]).exp()
+                nf * c.ln_c[i]
             }
         }));
-        for (j, &i) in self.cols.live.iter().enumerate() {
-            let at = (self.nc.n, c.codes[i]);
-            let s_fixed = raws[j] as f64 * lsb_sq;
-            let s_ref = self.cols.live_refs[j];
-            let cos_n = self.cols.live_cos[j];
-            self.quant.add((s_fixed - s_ref).abs(), at);
-            self.approx.add((s_ref - cos_n).abs(), at);
-            self.total.add((s_fixed - cos_n).abs(), at);
-        }
+        screen::exp_near_all(&mut cols.live_cos);
+        let (approx, total) = (&mut self.approx, &mut self.total);
+        screen::screen_two(
+            &cols.live_refs,
+            &cols.live_vals,
+            1.0,
+            &cols.live_cos,
+            (approx.value, total.value),
+            &mut cols.screen,
+            |j, for_approx, for_total| {
+                let i = cols.live[j];
+                let cos_n = cos_n_of(c.codes[i], c_lsb, nf, c.ln_c[i]);
+                let at = (n, c.codes[i]);
+                if for_approx {
+                    approx.add((cols.live_refs[j] - cos_n).abs(), at);
+                }
+                if for_total {
+                    total.add((cols.live_vals[j] - cos_n).abs(), at);
+                }
+            },
+        );
     }
 
     /// Counts the cut inputs and the outputs below the one before them. A dead chunk is all
@@ -617,8 +658,12 @@ struct FoldColumns {
     live_codes: Vec<i64>,
     live_raws: Vec<i64>,
     live_refs: Vec<f64>,
-    /// cos^n of the live inputs.
+    /// [`screen::exp_near`] of the live inputs' cos^n.
     live_cos: Vec<f64>,
+    /// The live inputs' fixed-point values (the last squaring's, then the output's).
+    live_vals: Vec<f64>,
+    /// [`screen::screen_two`]'s scratch.
+    screen: Vec<f64>,
 }
 
 /// One exponent's exhaustive check: every chunk of the stream above the dead prefix's start,
