@@ -428,7 +428,7 @@ impl<'a, 's> NFold<'a, 's> {
 
     /// The normalised output against the exact normalised cos^n, on the live inputs (`raws`
     /// the output's values, `live_refs` the f64 lobe times the f64 coefficient, `live_cos`
-    /// [`screen::exp_near`] of their cos^n): screened, exact where it may matter.
+    /// [`screen::exp_near_all`] of their cos^n): screened, exact where it may matter.
     fn fold_normalised(&mut self, c: &Chunk<'_>, raws: &[i64]) {
         let lsb_out = self.lsb[self.out];
         let cols = &mut *self.cols;
@@ -460,7 +460,7 @@ impl<'a, 's> NFold<'a, 's> {
     /// The lobe against cos^n on the live inputs (`raws` the last squaring's values,
     /// `live_refs` their f64 references): its quantization, approximation and total error, the
     /// last two screened ([`screen`]) and exact where they may reach the maximum. Leaves the
-    /// live inputs' [`screen::exp_near`] of cos^n in `live_cos`.
+    /// live inputs' [`screen::exp_near_all`] of cos^n in `live_cos`.
     fn fold_lobe(&mut self, c: &Chunk<'_>, raws: &[i64]) {
         let lsb_sq = self.lsb[self.last_sq];
         let (n, nf, c_lsb) = (self.nc.n, self.nf, self.c_lsb);
@@ -658,7 +658,7 @@ struct FoldColumns {
     live_codes: Vec<i64>,
     live_raws: Vec<i64>,
     live_refs: Vec<f64>,
-    /// [`screen::exp_near`] of the live inputs' cos^n.
+    /// [`screen::exp_near_all`] of the live inputs' cos^n.
     live_cos: Vec<f64>,
     /// The live inputs' fixed-point values (the last squaring's, then the output's).
     live_vals: Vec<f64>,

@@ -1,10 +1,10 @@
 //! Maxima against `cos^n` with `exp` only where it can matter: a bounded approximation of
-//! `cos^n` ([`exp_near`]) screens out the inputs whose error is provably below the maximum, and
+//! `cos^n` ([`exp_near_all`]) screens out the inputs whose error is provably below the maximum, and
 //! only the others are computed exactly, in order, so that every maximum and the first input
 //! where it happened are the bits the plain loop gives.
 //!
 //! The screen. For a column of errors `E_j = |a_j - p cos_j|` (computed in f64 as
-//! `(a - p * cos).abs()`, `cos` = `exp(x_j)` by the libm), [`exp_near`] gives `cos'_j` with
+//! `(a - p * cos).abs()`, `cos` = `exp(x_j)` by the libm), [`exp_near_all`] gives `cos'_j` with
 //! `|cos'_j - cos_j| <= 2^-43 cos'_j + 2^-1009` (below). Then the error computed with `cos'`,
 //! `E'_j`, is within `M_j = 2^-36 (p cos'_j + E'_j) + (p + 1) 2^-1000` of `E_j`, with room to
 //! spare for the roundings of the products, the differences and the bound itself (each at most
