@@ -1,7 +1,7 @@
 //! Maxima against `cos^n` with `exp` only where it can matter: a bounded approximation of
-//! `cos^n` ([`exp_near_all`]) screens out the inputs whose error is provably below the maximum, and
-//! only the others are computed exactly, in order, so that every maximum and the first input
-//! where it happened are the bits the plain loop gives.
+//! `cos^n` ([`exp_near_all`]) screens out the inputs whose error is provably below the
+//! maximum, and only the others are computed exactly, in order, so that every maximum and the
+//! first input where it happened are the bits the plain loop gives.
 //!
 //! The screen. For a column of errors `E_j = |a_j - p cos_j|` (computed in f64 as
 //! `(a - p * cos).abs()`, `cos` = `exp(x_j)` by the libm), [`exp_near_all`] gives `cos'_j` with
