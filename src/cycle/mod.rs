@@ -292,6 +292,14 @@ pub trait Machine: Clone {
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView>;
 }
 
+/// What a pipeline register holds where no token entered (its valid bit is clear).
+const EMPTY: Item = Item {
+    tag: 0,
+    n_idx: 0,
+    c_raw: 0,
+    out: 0,
+};
+
 /// The `pipelined` architecture: one delay line of `latency` registers per operation, the
 /// first computing the operation on the token it takes in.
 ///
@@ -303,12 +311,15 @@ pub trait Machine: Clone {
 pub struct Pipelined {
     /// The operation each register belongs to (for names and stage values), input side first.
     owner: Vec<Op>,
-    /// The registers, as a ring: register `r` (input side first) is `ring[(head + r) % len]`.
-    ring: Vec<Option<Item>>,
+    /// The registers, as a ring: register `r` (input side first) is `ring[(head + r) % len]`,
+    /// its token when `valid`'s bit `r` is set, [`EMPTY`] where no token entered.
+    ring: Vec<Item>,
     /// Where register 0 sits in the ring.
     head: usize,
     /// Bit `r`: register `r` holds a token.
     valid: u128,
+    /// `valid` of a full pipeline: a bit for every register.
+    all: u128,
     /// The registers of each unit (of `op_units(owner)`) as a mask of `valid`'s bits.
     unit_masks: Vec<u128>,
 }
@@ -336,7 +347,8 @@ impl Pipelined {
             })
             .collect();
         Pipelined {
-            ring: vec![None; owner.len()],
+            all: u128::MAX >> (128 - owner.len()),
+            ring: vec![EMPTY; owner.len()],
             head: 0,
             valid: 0,
             unit_masks,
@@ -349,7 +361,7 @@ impl Pipelined {
     fn reg(&self, r: usize) -> Option<Item> {
         let i = self.head + r;
         let len = self.ring.len();
-        self.ring[if i >= len { i - len } else { i }]
+        (self.valid >> r & 1 == 1).then(|| self.ring[if i >= len { i - len } else { i }])
     }
 }
 
@@ -383,8 +395,7 @@ impl Machine for Pipelined {
             // Rule 5: a stalled pipeline holds everything (and accepts nothing).
             return;
         }
-        let len = self.ring.len();
-        self.valid = ((self.valid << 1) | u128::from(input.is_some())) & (u128::MAX >> (128 - len));
+        self.valid = ((self.valid << 1) | u128::from(input.is_some())) & self.all;
         // Register r takes register r - 1's token: the ring turns by one, and the slot of the
         // token leaving the last register becomes register 0.
         self.head = if self.head == 0 {
@@ -392,7 +403,7 @@ impl Machine for Pipelined {
         } else {
             self.head - 1
         };
-        self.ring[self.head] = input;
+        self.ring[self.head] = input.unwrap_or(EMPTY);
     }
 
     #[inline]
@@ -408,7 +419,7 @@ impl Machine for Pipelined {
 
     #[inline]
     fn full(&self) -> bool {
-        self.valid == u128::MAX >> (128 - self.ring.len())
+        self.valid == self.all
     }
 
     fn unit_names(&self) -> Vec<String> {
