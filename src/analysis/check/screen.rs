@@ -139,24 +139,17 @@ fn screen_two_on(
     let low = bounds(a, b, p, near, tiny, hi_a, hi_b);
     let (va, vb) = (floors.0.max(low.0), floors.1.max(low.1));
     let look = |i: usize| (may_reach(hi_a[i], va), may_reach(hi_b[i], vb));
-    let mut j = 0;
     // Four at a time: most quads have nothing to look at.
-    while j + 4 <= len {
-        let quiet = (j..j + 4).all(|i| hi_a[i] < va && hi_b[i] < vb);
-        if !quiet {
-            for i in j..j + 4 {
-                let (for_a, for_b) = look(i);
-                if for_a || for_b {
-                    visit(i, for_a, for_b);
-                }
-            }
+    for start in (0..len).step_by(4) {
+        let quad = start..(start + 4).min(len);
+        if quad.clone().all(|i| hi_a[i] < va && hi_b[i] < vb) {
+            continue;
         }
-        j += 4;
-    }
-    for i in j..len {
-        let (for_a, for_b) = look(i);
-        if for_a || for_b {
-            visit(i, for_a, for_b);
+        for i in quad {
+            let (for_a, for_b) = look(i);
+            if for_a || for_b {
+                visit(i, for_a, for_b);
+            }
         }
     }
 }
