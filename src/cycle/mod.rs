@@ -311,8 +311,9 @@ const EMPTY: Item = Item {
 pub struct Pipelined {
     /// The operation each register belongs to (for names and stage values), input side first.
     owner: Vec<Op>,
-    /// The registers, as a ring: register `r` (input side first) is `ring[(head + r) % len]`,
-    /// its token when `valid`'s bit `r` is set, [`EMPTY`] where no token entered.
+    /// The registers, as a ring of a power-of-two length at least theirs: register `r` (input
+    /// side first) is `ring[(head + r) & (ring.len() - 1)]`, its token when `valid`'s bit `r` is
+    /// set, [`EMPTY`] where no token entered (the slots past the last register hold nothing).
     ring: Vec<Item>,
     /// Where register 0 sits in the ring.
     head: usize,
@@ -348,7 +349,7 @@ impl Pipelined {
             .collect();
         Pipelined {
             all: u128::MAX >> (128 - owner.len()),
-            ring: vec![EMPTY; owner.len()],
+            ring: vec![EMPTY; owner.len().next_power_of_two()],
             head: 0,
             valid: 0,
             unit_masks,
@@ -359,9 +360,7 @@ impl Pipelined {
     /// Register `r`, input side first.
     #[inline]
     fn reg(&self, r: usize) -> Option<Item> {
-        let i = self.head + r;
-        let len = self.ring.len();
-        (self.valid >> r & 1 == 1).then(|| self.ring[if i >= len { i - len } else { i }])
+        (self.valid >> r & 1 == 1).then(|| self.ring[(self.head + r) & (self.ring.len() - 1)])
     }
 }
 
@@ -383,10 +382,11 @@ impl Machine for Pipelined {
 
     #[inline]
     fn output(&self) -> Option<(u64, i64)> {
-        if self.valid >> (self.ring.len() - 1) & 1 == 0 {
+        let last = self.owner.len() - 1;
+        if self.valid >> last & 1 == 0 {
             return None;
         }
-        self.reg(self.ring.len() - 1).map(|it| (it.tag, it.out))
+        self.reg(last).map(|it| (it.tag, it.out))
     }
 
     #[inline]
@@ -396,13 +396,9 @@ impl Machine for Pipelined {
             return;
         }
         self.valid = ((self.valid << 1) | u128::from(input.is_some())) & self.all;
-        // Register r takes register r - 1's token: the ring turns by one, and the slot of the
-        // token leaving the last register becomes register 0.
-        self.head = if self.head == 0 {
-            self.ring.len() - 1
-        } else {
-            self.head - 1
-        };
+        // Register r takes register r - 1's token: the ring turns by one, and the slot before
+        // register 0 becomes register 0.
+        self.head = self.head.wrapping_sub(1) & (self.ring.len() - 1);
         self.ring[self.head] = input.unwrap_or(EMPTY);
     }
 

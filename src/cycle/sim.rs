@@ -488,10 +488,12 @@ fn run_loop<M: Machine, F: FnMut(&mut Vec<usize>, &mut Vec<i64>, usize), const S
     let mut ready_bits = Vec::with_capacity(room);
     let mut trace = Vec::new();
     // The inputs in flight, tags `first_in_flight..n_inputs`: the cycle each transferred and
-    // the functional model's output for it, tag `t` at `in_flight[t & mask]` (a ring that
-    // doubles when full). Outputs leave in order, so the oldest leaves first.
+    // the functional model's output for it, tag `t` at `in_flight[t % len]` (a ring of a
+    // power-of-two length that doubles when full). Outputs leave in order, so the oldest
+    // leaves first.
     let mut in_flight: Vec<(u64, i64)> = vec![(0, 0); 64];
-    let mut mask = in_flight.len() as u64 - 1;
+    // The slot of a tag (masked by the ring's own length, so its index needs no check).
+    let slot = |tag: u64, len: usize| tag as usize & (len - 1);
     let mut first_in_flight = 0u64;
     let (mut n_inputs, mut n_outputs) = (0u64, 0u64);
     let (mut latency_min, mut latency_max) = (u64::MAX, 0);
@@ -552,11 +554,11 @@ fn run_loop<M: Machine, F: FnMut(&mut Vec<usize>, &mut Vec<i64>, usize), const S
                 items.advance();
                 let tag = n_inputs;
                 n_inputs += 1;
-                if tag - first_in_flight > mask {
+                if tag - first_in_flight >= in_flight.len() as u64 {
                     in_flight = grow_ring(&in_flight, first_in_flight, tag);
-                    mask = in_flight.len() as u64 - 1;
                 }
-                in_flight[(tag & mask) as usize] = (cycle, out);
+                let at = slot(tag, in_flight.len());
+                in_flight[at] = (cycle, out);
                 Some(Item {
                     tag,
                     n_idx,
@@ -574,7 +576,7 @@ fn run_loop<M: Machine, F: FnMut(&mut Vec<usize>, &mut Vec<i64>, usize), const S
                 n_outputs += 1;
                 // An output whose tag names no input in flight is an order error only.
                 let at = (tag >= first_in_flight && tag < n_inputs)
-                    .then(|| in_flight[(tag & mask) as usize]);
+                    .then(|| in_flight[slot(tag, in_flight.len())]);
                 let latency = at.map_or(0, |(accepted, _)| cycle - accepted);
                 if at.is_some_and(|(_, want)| want != value) {
                     mismatches += 1;
