@@ -317,8 +317,12 @@ pub struct Pipelined {
     ring: Vec<Item>,
     /// Where register 0 sits in the ring.
     head: usize,
-    /// Bit `r`: register `r` holds a token.
+    /// Bit `128 - len + r` (the bits of the registers at the top, the last register's bit
+    /// 127): register `r` holds a token. A clock edge shifts it left by one, the leaving
+    /// token's bit out of the word.
     valid: u128,
+    /// `valid`'s bit of register 0.
+    entry: u128,
     /// `valid` of a full pipeline: a bit for every register.
     all: u128,
     /// The registers of each unit (of `op_units(owner)`) as a mask of `valid`'s bits.
@@ -339,16 +343,18 @@ impl Pipelined {
             .collect();
         // At most 8 registers per operation and k + 4 <= 11 operations.
         assert!(owner.len() <= 128, "a pipeline of at most 128 registers");
+        let low = 128 - owner.len();
         let unit_masks = op_units(&owner)
             .iter()
             .map(|&op| {
                 (0..owner.len())
                     .filter(|&r| owner[r] == op)
-                    .fold(0u128, |m, r| m | 1 << r)
+                    .fold(0u128, |m, r| m | 1 << (low + r))
             })
             .collect();
         Pipelined {
-            all: u128::MAX >> (128 - owner.len()),
+            entry: 1 << low,
+            all: u128::MAX << low,
             ring: vec![EMPTY; owner.len().next_power_of_two()],
             head: 0,
             valid: 0,
@@ -360,7 +366,8 @@ impl Pipelined {
     /// Register `r`, input side first.
     #[inline]
     fn reg(&self, r: usize) -> Option<Item> {
-        (self.valid >> r & 1 == 1).then(|| self.ring[(self.head + r) & (self.ring.len() - 1)])
+        let bit = 128 - self.owner.len() + r;
+        (self.valid >> bit & 1 == 1).then(|| self.ring[(self.head + r) & (self.ring.len() - 1)])
     }
 }
 
@@ -382,11 +389,11 @@ impl Machine for Pipelined {
 
     #[inline]
     fn output(&self) -> Option<(u64, i64)> {
-        let last = self.owner.len() - 1;
-        if self.valid >> last & 1 == 0 {
+        if self.valid >> 127 == 0 {
             return None;
         }
-        self.reg(last).map(|it| (it.tag, it.out))
+        let it = self.ring[(self.head + self.owner.len() - 1) & (self.ring.len() - 1)];
+        Some((it.tag, it.out))
     }
 
     #[inline]
@@ -395,7 +402,7 @@ impl Machine for Pipelined {
             // Rule 5: a stalled pipeline holds everything (and accepts nothing).
             return;
         }
-        self.valid = ((self.valid << 1) | u128::from(input.is_some())) & self.all;
+        self.valid = self.valid << 1 | if input.is_some() { self.entry } else { 0 };
         // Register r takes register r - 1's token: the ring turns by one, and the slot before
         // register 0 becomes register 0.
         self.head = self.head.wrapping_sub(1) & (self.ring.len() - 1);
