@@ -300,6 +300,9 @@ const EMPTY: Item = Item {
     out: 0,
 };
 
+/// The slots of [`Pipelined`]'s ring: its most registers.
+const RING: usize = 128;
+
 /// The `pipelined` architecture: one delay line of `latency` registers per operation, the
 /// first computing the operation on the token it takes in.
 ///
@@ -311,10 +314,11 @@ const EMPTY: Item = Item {
 pub struct Pipelined {
     /// The operation each register belongs to (for names and stage values), input side first.
     owner: Vec<Op>,
-    /// The registers, as a ring of a power-of-two length at least theirs: register `r` (input
-    /// side first) is `ring[(head + r) & (ring.len() - 1)]`, its token when `valid`'s bit `r` is
-    /// set, [`EMPTY`] where no token entered (the slots past the last register hold nothing).
-    ring: Vec<Item>,
+    /// The registers, as a ring of [`RING`] slots (at least as many as registers, a power of
+    /// two: an index masked by `RING - 1` needs no check): register `r` (input side first) is
+    /// `ring[(head + r) % RING]`, its token when `valid`'s bit for `r` is set, [`EMPTY`] where
+    /// no token entered (the slots past the last register hold nothing).
+    ring: Box<[Item; RING]>,
     /// Where register 0 sits in the ring.
     head: usize,
     /// Bit `128 - len + r` (the bits of the registers at the top, the last register's bit
@@ -342,7 +346,7 @@ impl Pipelined {
             .flat_map(|&(op, l)| std::iter::repeat_n(op, l as usize))
             .collect();
         // At most 8 registers per operation and k + 4 <= 11 operations.
-        assert!(owner.len() <= 128, "a pipeline of at most 128 registers");
+        assert!(owner.len() <= RING, "a pipeline of at most 128 registers");
         let low = 128 - owner.len();
         let unit_masks = op_units(&owner)
             .iter()
@@ -355,7 +359,7 @@ impl Pipelined {
         Pipelined {
             entry: 1 << low,
             all: u128::MAX << low,
-            ring: vec![EMPTY; owner.len().next_power_of_two()],
+            ring: Box::new([EMPTY; RING]),
             head: 0,
             valid: 0,
             unit_masks,
@@ -367,7 +371,7 @@ impl Pipelined {
     #[inline]
     fn reg(&self, r: usize) -> Option<Item> {
         let bit = 128 - self.owner.len() + r;
-        (self.valid >> bit & 1 == 1).then(|| self.ring[(self.head + r) & (self.ring.len() - 1)])
+        (self.valid >> bit & 1 == 1).then(|| self.ring[(self.head + r) % RING])
     }
 }
 
@@ -392,7 +396,7 @@ impl Machine for Pipelined {
         if self.valid >> 127 == 0 {
             return None;
         }
-        let it = self.ring[(self.head + self.owner.len() - 1) & (self.ring.len() - 1)];
+        let it = self.ring[(self.head + self.owner.len() - 1) % RING];
         Some((it.tag, it.out))
     }
 
@@ -405,7 +409,7 @@ impl Machine for Pipelined {
         self.valid = self.valid << 1 | if input.is_some() { self.entry } else { 0 };
         // Register r takes register r - 1's token: the ring turns by one, and the slot before
         // register 0 becomes register 0.
-        self.head = self.head.wrapping_sub(1) & (self.ring.len() - 1);
+        self.head = self.head.wrapping_sub(1) % RING;
         self.ring[self.head] = input.unwrap_or(EMPTY);
     }
 
