@@ -492,7 +492,7 @@ fn run_loop<M: Machine, F: FnMut(&mut Vec<usize>, &mut Vec<i64>, usize), const S
     // power-of-two length that doubles when full). Outputs leave in order, so the oldest
     // leaves first.
     let mut in_flight: Vec<(u64, i64)> = vec![(0, 0); 64];
-    // The slot of a tag (masked by the ring's own length, so its index needs no check).
+    // The slot of a tag (masked by the ring's own length: no mask kept beside it to spill).
     let slot = |tag: u64, len: usize| tag as usize & (len - 1);
     let mut first_in_flight = 0u64;
     let (mut n_inputs, mut n_outputs) = (0u64, 0u64);
