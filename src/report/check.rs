@@ -157,6 +157,27 @@ pub fn write_check_table(
     Ok(())
 }
 
+/// The output's largest error in LSBs (with `decimals` digits) for a summary line, with what it
+/// means when it is more than one LSB: `1953.53 ulp (the lobe's error times the coefficient:
+/// 1.72e-4 of the largest output, 12.5 bits agree with f64)`; `s` the output stage's
+/// statistics.
+pub(crate) fn out_ulp_brief(s: &crate::analysis::check::StageStats, decimals: usize) -> String {
+    let ulp = format!("{:.*} ulp", decimals, s.max_ulp);
+    let largest = s
+        .format
+        .parse::<crate::fixed::Format>()
+        .map_or(0.0, |f| f.to_f64(s.raw_max));
+    if s.max_ulp <= 1.0 || largest <= 0.0 {
+        return ulp;
+    }
+    let relative = s.max_abs_err / largest;
+    format!(
+        "{ulp} (the lobe's error times the coefficient: {relative:.2e} of the largest output, \
+         {:.1} bits agree with f64)",
+        -relative.log2()
+    )
+}
+
 /// What the output's error in LSBs means: the lobe's error times the coefficient, so many of
 /// the output's fraction bits are noise; its effective fraction bits and relative accuracy.
 fn effective_bits(s: &crate::analysis::check::StageStats) -> Option<String> {
@@ -177,4 +198,48 @@ fn effective_bits(s: &crate::analysis::check::StageStats) -> Option<String> {
         largest,
         -relative.log2()
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::out_ulp_brief;
+    use crate::analysis::check::{Input, StageStats};
+
+    /// The baseline's output stage as `specfx check` reports it (u8.16, its largest output
+    /// 173.1606, its largest error 2.981e-2 = 1953.53 LSBs).
+    fn out(max_abs_err: f64, max_ulp: f64) -> StageStats {
+        StageStats {
+            stage: "out".into(),
+            format: "u8.16".into(),
+            max_abs_err,
+            mean_err: 0.0,
+            mean_abs_err: 0.0,
+            rms_err: 0.0,
+            max_ulp,
+            correctly_rounded: 0.9623,
+            faithfully_rounded: 0.9658,
+            worst: Input {
+                n: 959,
+                c_raw: 32764,
+                c: 32764.0 / 32768.0,
+            },
+            raw_min: 0,
+            raw_max: (173.1606f64 * 65536.0).round() as i64,
+            wrapped: 0,
+            saturated: 0,
+            zeroed: 0,
+        }
+    }
+
+    #[test]
+    fn an_output_error_of_many_lsbs_says_what_it_is() {
+        // By hand: 2.981e-2 / 173.1606 = 1.7215e-4, and -log2 of that is 12.504.
+        assert_eq!(
+            out_ulp_brief(&out(2.981e-2, 1953.5349), 2),
+            "1953.53 ulp (the lobe's error times the coefficient: 1.72e-4 of the largest \
+             output, 12.5 bits agree with f64)"
+        );
+        // Within one LSB there is nothing to explain.
+        assert_eq!(out_ulp_brief(&out(1.0e-5, 0.6554), 3), "0.655 ulp");
+    }
 }

@@ -238,10 +238,10 @@ pub fn write_answer(
     }
     writeln!(
         w,
-        "proved by an exhaustive check: shape_total {:.4e}, shape_quant {:.4e}, out {:.3} ulp, {:.3}% correctly rounded",
+        "proved by an exhaustive check: shape_total {:.4e}, shape_quant {:.4e}, out {}, {:.3}% correctly rounded",
         proof.shape_total_max_abs,
         proof.shape_quant_max_abs,
-        proof.out_max_ulp,
+        super::check::out_ulp_brief(&proof.stages[dp.stage_out()], 3),
         100.0 * proof.stages[dp.stage_out()].correctly_rounded
     )?;
     // Overflow: a stage left to wrap must never overflow on any input (the exhaustive check
