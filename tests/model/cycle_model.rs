@@ -170,13 +170,14 @@ proptest! {
 
     /// The ring of tokens is the register-by-register pipeline: the same outputs on the same
     /// cycles, the same statistics and occupancy, and the same value in every register of the
-    /// trace on every cycle, for any latencies, k, cutoff, stream and stall pattern (the
-    /// stream's inputs reach past 1.0 and into the cut region). Half the cases run at full
-    /// rate (no bubbles, no stalls), where statistics alone take `run`'s steady loop.
+    /// trace on every cycle, for any latencies validation accepts (1..=8 each), k, cutoff,
+    /// stream and stall pattern (the stream's inputs reach past 1.0 and into the cut region).
+    /// Half the cases run at full rate (no bubbles, no stalls), where statistics alone take
+    /// `run`'s steady loop. The deepest pipeline has its own test below.
     #[test]
     fn the_pipeline_ring_equals_the_literal_pipeline(
         k in 1u32..=7,
-        lat in (1u32..=3, 1u32..=4, 1u32..=3),
+        lat in (1u32..=8, 1u32..=8, 1u32..=8),
         cutoff in 0usize..3,
         seed in any::<u64>(),
         bubble in 0.0f64..0.9,
@@ -186,23 +187,7 @@ proptest! {
         per_n in any::<bool>(),
     ) {
         let (bubble, stall) = if steady { (0.0, 0.0) } else { (bubble, stall) };
-        let mut cfg = with_depth(datapath(k, lat, "16,300,1024"), per_n).config().clone();
-        cfg.cutoff = specfx::reference::lobe::Cutoff::ALL[cutoff];
-        let dp = Datapath::new(cfg).unwrap();
-        let cycles = Stop::Cycles(2 * inputs.len() as u64 + 40);
-        let trace = Record { transfers: true, trace_cycles: u64::MAX };
-        let ring = run(&dp, Arch::Pipelined, Pipelined::new(&dp), inputs.iter().copied(),
-            &mut Stimulus::new(seed, bubble, stall), cycles, trace);
-        let literal = run(&dp, Arch::Pipelined, Literal::new(&dp), inputs.iter().copied(),
-            &mut Stimulus::new(seed, bubble, stall), cycles, trace);
-        prop_assert!(ring.trace.iter().any(|c| c.registers.iter().any(|r| r.value.is_some())));
-        // Statistics do not depend on what is recorded.
-        let lean = Record { transfers: false, trace_cycles: 0 };
-        let stats = run(&dp, Arch::Pipelined, Pipelined::new(&dp), inputs.iter().copied(),
-            &mut Stimulus::new(seed, bubble, stall), cycles, lean);
-        prop_assert!(stats.outputs.is_empty() && stats.trace.is_empty());
-        prop_assert_eq!(&stats.stats, &ring.stats);
-        prop_assert_eq!(ring, literal);
+        ring_equals_literal(k, lat, cutoff, per_n, &inputs, (seed, bubble, stall));
     }
 }
 
@@ -479,4 +464,77 @@ fn an_output_under_an_unknown_tag_is_an_order_error_only() {
     assert_eq!((s.n_inputs, s.n_outputs), (300, 300));
     assert_eq!((s.order_errors, s.mismatches), (1, 0));
     assert_eq!((s.latency_min, s.latency_max), (0, 14));
+}
+
+/// [`the_pipeline_ring_equals_the_literal_pipeline`]'s comparison for one case (`stim`: the
+/// stimulus' seed, bubble and stall probabilities).
+fn ring_equals_literal(
+    k: u32,
+    lat: (u32, u32, u32),
+    cutoff: usize,
+    per_n: bool,
+    inputs: &[(usize, i64)],
+    stim: (u64, f64, f64),
+) {
+    let mut cfg = with_depth(datapath(k, lat, "16,300,1024"), per_n)
+        .config()
+        .clone();
+    cfg.cutoff = specfx::reference::lobe::Cutoff::ALL[cutoff];
+    let dp = Datapath::new(cfg).unwrap();
+    let cycles = Stop::Cycles(2 * inputs.len() as u64 + 40);
+    let go = |m, record| {
+        run(
+            &dp,
+            Arch::Pipelined,
+            m,
+            inputs.iter().copied(),
+            &mut Stimulus::new(stim.0, stim.1, stim.2),
+            cycles,
+            record,
+        )
+    };
+    let trace = Record {
+        transfers: true,
+        trace_cycles: u64::MAX,
+    };
+    let ring = go(Pipelined::new(&dp), trace);
+    let literal = run(
+        &dp,
+        Arch::Pipelined,
+        Literal::new(&dp),
+        inputs.iter().copied(),
+        &mut Stimulus::new(stim.0, stim.1, stim.2),
+        cycles,
+        trace,
+    );
+    assert!(ring
+        .trace
+        .iter()
+        .any(|c| c.registers.iter().any(|r| r.value.is_some())));
+    // Statistics do not depend on what is recorded.
+    let lean = Record {
+        transfers: false,
+        trace_cycles: 0,
+    };
+    let stats = go(Pipelined::new(&dp), lean);
+    assert!(stats.outputs.is_empty() && stats.trace.is_empty());
+    assert_eq!(stats.stats, ring.stats);
+    assert_eq!(ring, literal);
+}
+
+/// The deepest pipeline validation accepts (k = 7, every latency 8: 88 registers), full for
+/// most of the run at full rate, and under bubbles and stalls: the ring is the literal
+/// pipeline.
+#[test]
+fn the_deepest_pipeline_ring_equals_the_literal_pipeline() {
+    let inputs: Vec<(usize, i64)> = (0..300).map(|i| (i % 3, 65535 - 97 * i as i64)).collect();
+    let dp = datapath(7, (8, 8, 8), "16,300,1024");
+    assert_eq!(Arch::Pipelined.latency(dp.config()), 88);
+    for (cutoff, per_n, stim) in [
+        (0, false, (1, 0.0, 0.0)),
+        (1, true, (2, 0.3, 0.3)),
+        (2, false, (3, 0.05, 0.6)),
+    ] {
+        ring_equals_literal(7, (8, 8, 8), cutoff, per_n, &inputs, stim);
+    }
 }
