@@ -163,31 +163,29 @@ pub fn write_check_table(
 /// statistics.
 pub(crate) fn out_ulp_brief(s: &crate::analysis::check::StageStats, decimals: usize) -> String {
     let ulp = format!("{:.*} ulp", decimals, s.max_ulp);
-    let largest = s
-        .format
-        .parse::<crate::fixed::Format>()
-        .map_or(0.0, |f| f.to_f64(s.raw_max));
-    if s.max_ulp <= 1.0 || largest <= 0.0 {
-        return ulp;
+    match many_lsbs(s) {
+        Some((_, _, relative)) => format!(
+            "{ulp} (the lobe's error times the coefficient: {relative:.2e} of the largest \
+             output, {:.1} bits agree with f64)",
+            -relative.log2()
+        ),
+        None => ulp,
     }
-    let relative = s.max_abs_err / largest;
-    format!(
-        "{ulp} (the lobe's error times the coefficient: {relative:.2e} of the largest output, \
-         {:.1} bits agree with f64)",
-        -relative.log2()
-    )
+}
+
+/// For an output whose largest error is more than one LSB (and whose largest value is
+/// positive): its format, its largest value, and its largest error relative to that value.
+fn many_lsbs(s: &crate::analysis::check::StageStats) -> Option<(crate::fixed::Format, f64, f64)> {
+    let format: crate::fixed::Format = s.format.parse().ok()?;
+    let largest = format.to_f64(s.raw_max);
+    (s.max_ulp > 1.0 && largest > 0.0).then(|| (format, largest, s.max_abs_err / largest))
 }
 
 /// What the output's error in LSBs means: the lobe's error times the coefficient, so many of
 /// the output's fraction bits are noise; its effective fraction bits and relative accuracy.
 fn effective_bits(s: &crate::analysis::check::StageStats) -> Option<String> {
-    let format: crate::fixed::Format = s.format.parse().ok()?;
-    let largest = format.to_f64(s.raw_max);
-    if s.max_ulp <= 1.0 || largest <= 0.0 {
-        return None;
-    }
+    let (format, largest, relative) = many_lsbs(s)?;
     let noise_bits = s.max_ulp.log2();
-    let relative = s.max_abs_err / largest;
     Some(format!(
         "{:.1} output LSBs: the lobe's error times the coefficient; about {:.1} of its {} fraction bits are noise ({:.1} effective), a relative error of {:.2e} of the largest output {:.4} ({:.1} bits agree with the same algorithm in f64; against cos^n see the normalised output below)",
         s.max_ulp,
