@@ -355,34 +355,37 @@ fn vcd_trace_parses_back() {
     assert!(n_commands > 100 * 8);
 }
 
-/// A folded unit whose output is off by one for input 17: the simulator's mismatch count
-/// compares every output with the functional model and finds exactly that one.
+/// A machine whose outputs pass through `tamper` (tag, value) on their way out: the
+/// simulator must count what the tampering breaks.
 #[derive(Clone)]
-struct OffByOne(specfx::cycle::Folded);
+struct Tampered<M> {
+    machine: M,
+    tamper: fn((u64, i64)) -> (u64, i64),
+}
 
-impl Machine for OffByOne {
+impl<M: Machine> Machine for Tampered<M> {
     fn in_ready(&self, out_ready: bool) -> bool {
-        self.0.in_ready(out_ready)
+        self.machine.in_ready(out_ready)
     }
     fn output(&self) -> Option<(u64, i64)> {
-        self.0
-            .output()
-            .map(|(tag, v)| (tag, if tag == 17 { v + 1 } else { v }))
+        self.machine.output().map(self.tamper)
     }
     fn step(&mut self, dp: &Datapath, input: Option<Item>, out_ready: bool) {
-        self.0.step(dp, input, out_ready)
+        self.machine.step(dp, input, out_ready)
     }
     fn unit_names(&self) -> Vec<String> {
-        self.0.unit_names()
+        self.machine.unit_names()
     }
     fn occupancy(&self) -> Vec<bool> {
-        self.0.occupancy()
+        self.machine.occupancy()
     }
     fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
-        self.0.registers(dp)
+        self.machine.registers(dp)
     }
 }
 
+/// A folded unit whose output is off by one for input 17: the simulator's mismatch count
+/// compares every output with the functional model and finds exactly that one.
 #[test]
 fn a_wrong_output_is_counted_as_a_mismatch() {
     let dp = datapath(4, (1, 2, 1), "16,64,1000");
@@ -405,40 +408,17 @@ fn a_wrong_output_is_counted_as_a_mismatch() {
         )
         .stats
     };
-    let honest = go(OffByOne(specfx::cycle::Folded::new(&dp)));
+    let honest = go(Tampered {
+        machine: specfx::cycle::Folded::new(&dp),
+        tamper: |(tag, v)| (tag, if tag == 17 { v + 1 } else { v }),
+    });
     assert_eq!(honest.n_outputs, 300);
     assert_eq!(honest.mismatches, 1);
     assert_eq!(honest.order_errors, 0);
 }
 
-/// A pipelined unit that shows input 10's output under the tag 10,000 (no input in flight).
-#[derive(Clone)]
-struct LostTag(Pipelined);
-
-impl Machine for LostTag {
-    fn in_ready(&self, out_ready: bool) -> bool {
-        self.0.in_ready(out_ready)
-    }
-    fn output(&self) -> Option<(u64, i64)> {
-        self.0
-            .output()
-            .map(|(tag, v)| (if tag == 10 { 10_000 } else { tag }, v))
-    }
-    fn step(&mut self, dp: &Datapath, input: Option<Item>, out_ready: bool) {
-        self.0.step(dp, input, out_ready)
-    }
-    fn unit_names(&self) -> Vec<String> {
-        self.0.unit_names()
-    }
-    fn occupancy(&self) -> Vec<bool> {
-        self.0.occupancy()
-    }
-    fn registers(&self, dp: &Datapath) -> Vec<RegisterView> {
-        self.0.registers(dp)
-    }
-}
-
-/// An output whose tag names no input in flight is one order error, compared with nothing
+/// A pipelined unit that shows input 10's output under the tag 10,000 (no input in flight):
+/// an output whose tag names no input in flight is one order error, compared with nothing
 /// (latency 0, no mismatch), and input 10 stays in flight: every later input with it, so the
 /// simulator's record of them outgrows its first 64 places and grows while the run goes on.
 #[test]
@@ -452,7 +432,10 @@ fn an_output_under_an_unknown_tag_is_an_order_error_only() {
     let s = run(
         &dp,
         Arch::Pipelined,
-        LostTag(Pipelined::new(&dp)),
+        Tampered {
+            machine: Pipelined::new(&dp),
+            tamper: |(tag, v)| (if tag == 10 { 10_000 } else { tag }, v),
+        },
         inputs.iter().copied(),
         &mut Stimulus::new(3, 0.0, 0.0),
         Stop::Drained(100_000),
