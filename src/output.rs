@@ -163,6 +163,13 @@ pub fn last_committed() -> Option<PathBuf> {
 /// wrote the directory, so that the command may replace its own earlier result.
 pub const MARKER: &str = ".specfx-result";
 
+/// The specfx command whose result `dir` holds: its [`MARKER`]'s first line (`sweep plan`,
+/// `report`), or `None` where there is no marker.
+pub fn result_of(dir: &Path) -> Option<String> {
+    let marker = std::fs::read_to_string(dir.join(MARKER)).ok()?;
+    Some(marker.lines().next().unwrap_or("").trim().to_string())
+}
+
 /// Staging directories of this process not yet committed, removed on Ctrl-C or SIGTERM.
 static STAGING: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
@@ -256,13 +263,21 @@ impl OutDir {
                     target.display()
                 );
             }
-            let marker = std::fs::read_to_string(target.join(MARKER)).unwrap_or_default();
             let empty = std::fs::read_dir(target).is_ok_and(|mut d| d.next().is_none());
-            if !force && !empty && marker.split_whitespace().next() != Some(command) {
-                bail!(
-                    "{} already exists and is not an earlier `specfx {command}` result: pass --force to replace it",
-                    target.display()
-                );
+            let holder = result_of(target);
+            if !force && !empty && holder.as_deref() != Some(command) {
+                // What a run computed is never replaced at a message's suggestion: only a
+                // directory of the user's own is offered to --force.
+                match holder {
+                    Some(other) => bail!(
+                        "{} holds a `specfx {other}` result, not an earlier `specfx {command}` one: choose another --out, or move it away first",
+                        target.display()
+                    ),
+                    None => bail!(
+                        "{} already exists and is not an earlier `specfx {command}` result: pass --force to replace it",
+                        target.display()
+                    ),
+                }
             }
             probe_move_aside(target, &parent, &name)?;
         }
@@ -285,10 +300,7 @@ impl OutDir {
             && stale(&parent, &name)
                 .into_iter()
                 .filter(|(p, partial)| {
-                    *partial
-                        && p.is_dir()
-                        && std::fs::read_to_string(p.join(MARKER))
-                            .is_ok_and(|m| m.split_whitespace().next() == Some(command))
+                    *partial && p.is_dir() && result_of(p).as_deref() == Some(command)
                 })
                 .max_by_key(|(p, _)| {
                     std::fs::metadata(p)

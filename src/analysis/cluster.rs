@@ -5,6 +5,14 @@
 
 use crate::error::Error;
 
+/// The most array tasks a run is spread over (`sweep plan --tasks`, and a scheduler's count).
+pub const MAX_TASKS: u64 = 100_000;
+/// The most shards one array task runs (`--shards-per-task`).
+pub const MAX_SHARDS_PER_TASK: u64 = 1000;
+/// The most shards a run has (`--shard I/N`, `auto/N`): [`MAX_TASKS`] tasks of
+/// [`MAX_SHARDS_PER_TASK`] shards.
+pub const MAX_SHARDS: u64 = MAX_TASKS * MAX_SHARDS_PER_TASK;
+
 /// How a run is sharded, as `--shard` gives it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ShardSpec {
@@ -191,7 +199,15 @@ pub fn task_from_env(env: &dyn Fn(&str) -> Option<String>) -> Result<Option<Task
             )));
         }
         let count = match s.count_var.and_then(|var| env(var).map(|v| (var, v))) {
-            Some((var, v)) => Some(number(var, &v, "number of array tasks")?),
+            Some((var, v)) => match number(var, &v, "number of array tasks")? {
+                0 => {
+                    return Err(env_error(format!(
+                        "{var}=0: expected 1 or more ({}'s number of array tasks)",
+                        s.name
+                    )))
+                }
+                n => Some(n),
+            },
             None => None,
         };
         let task = Task {
@@ -275,12 +291,24 @@ pub fn assign(
     per_task: u64,
     env: &dyn Fn(&str) -> Option<String>,
 ) -> Result<Assignment, Error> {
-    if per_task == 0 {
+    if !(1..=MAX_SHARDS_PER_TASK).contains(&per_task) {
         return Err(Error::Cluster {
             option: "--shards-per-task".into(),
-            problem: "expected 1 or more, got 0".into(),
+            problem: format!("expected 1 to {MAX_SHARDS_PER_TASK}, got {per_task}"),
         });
     }
+    let bounded = |count: u64| {
+        if count > MAX_SHARDS {
+            Err(Error::Cluster {
+                option: "--shard".into(),
+                problem: format!(
+                    "expected at most {MAX_SHARDS} shards ({MAX_TASKS} tasks of {MAX_SHARDS_PER_TASK}), got {count}"
+                ),
+            })
+        } else {
+            Ok(count)
+        }
+    };
     match spec {
         ShardSpec::Given { index, count } => {
             if per_task != 1 {
@@ -291,6 +319,7 @@ pub fn assign(
                     ),
                 });
             }
+            bounded(count)?;
             Ok(Assignment {
                 count,
                 shards: vec![index],
@@ -317,6 +346,7 @@ pub fn assign(
                     )))
                 }
             };
+            let count = bounded(count)?;
             let tasks = count.div_ceil(per_task);
             if task.index >= tasks {
                 let spread = if per_task == 1 {
@@ -369,6 +399,27 @@ pub fn shard_path(template: &str, index: u64, count: u64, required: bool) -> Res
             });
         }
         return Ok(template.to_string());
+    }
+    // `o/{shard}/../x` names `o/x` for every shard: the placeholder must survive the path's
+    // `..` components.
+    let mut kept: Vec<&str> = Vec::new();
+    for part in template.split('/') {
+        match part {
+            "" | "." => {}
+            ".." if kept.last().is_some_and(|p| *p != "..") => {
+                kept.pop();
+            }
+            _ => kept.push(part),
+        }
+    }
+    if !kept.iter().any(|p| p.contains(SHARD_PLACEHOLDER)) {
+        return Err(Error::Cluster {
+            option: "--out".into(),
+            problem: format!(
+                "'{}': a '..' after {SHARD_PLACEHOLDER} cancels it, so every shard would write one directory: expected {SHARD_PLACEHOLDER} in the directory's own path",
+                crate::error::OneLine(template)
+            ),
+        });
     }
     let width = (count - 1).max(1).to_string().len();
     Ok(template.replace(SHARD_PLACEHOLDER, &format!("{index:0width$}")))
@@ -511,6 +562,105 @@ mod tests {
         assert_eq!(
             a.describe(),
             "LSF array task 3 of 4 (LSB_JOBINDEX=4): shards 3, 7 of 8"
+        );
+    }
+
+    #[test]
+    fn shard_numbers_past_the_plans_bounds_are_refused_not_allocated() {
+        let slurm0 = env_of(&[("SLURM_ARRAY_TASK_ID", "0")]);
+        // u64::MAX shards of u64::MAX per task: one task of every shard (a capacity overflow).
+        let e = assign(
+            ShardSpec::Auto {
+                count: Some(u64::MAX),
+            },
+            u64::MAX,
+            &slurm0,
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("expected 1 to 1000, got 18446744073709551615"),
+            "{e}"
+        );
+        // The largest run `sweep plan` writes: 100,000 tasks of 1,000 shards; one more refused.
+        let a = assign(
+            ShardSpec::Auto {
+                count: Some(100_000_000),
+            },
+            1000,
+            &slurm0,
+        )
+        .unwrap();
+        assert_eq!((a.tasks, a.shards.len()), (100_000, 1000));
+        let e = assign(
+            ShardSpec::Auto {
+                count: Some(100_000_001),
+            },
+            1000,
+            &slurm0,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("at most 100000000 shards"), "{e}");
+        let e = assign(
+            ShardSpec::Given {
+                index: 0,
+                count: u64::MAX,
+            },
+            1,
+            &slurm0,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("at most 100000000 shards"), "{e}");
+        let e = assign(ShardSpec::Auto { count: Some(4) }, 0, &slurm0).unwrap_err();
+        assert!(e.to_string().contains("expected 1 to 1000, got 0"), "{e}");
+        // A scheduler that counts no tasks.
+        let none = env_of(&[
+            ("SLURM_ARRAY_TASK_ID", "0"),
+            ("SLURM_ARRAY_TASK_COUNT", "0"),
+        ]);
+        let e = assign(ShardSpec::Auto { count: None }, 1, &none).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("SLURM_ARRAY_TASK_COUNT=0: expected 1 or more"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_plan_refuses_a_specfx_command_a_script_cannot_run() {
+        let cost = PointCost {
+            seconds: 1.0,
+            peak_mib: 0,
+            measured: false,
+        };
+        let plan =
+            |specfx: &str| Plan::new(Emit::K8s, &"0".repeat(64), 10, (2, 1), cost, 1, specfx);
+        for bad in ["", "  ", "-x/specfx", "spec\nfx"] {
+            let e = plan(bad).unwrap_err().to_string();
+            assert!(
+                e.starts_with("--specfx: expected the command that runs specfx"),
+                "{e}"
+            );
+        }
+        assert!(plan("-x").unwrap_err().to_string().contains("write ./-x"));
+        assert!(plan("/opt/specfx@2/bin/specfx").is_ok());
+    }
+
+    #[test]
+    fn a_placeholder_cancelled_by_dot_dot_is_refused() {
+        assert!(shard_path("o/{shard}/../x", 1, 4, true)
+            .unwrap_err()
+            .to_string()
+            .contains("a '..' after {shard} cancels it"));
+        assert!(shard_path("o/x-{shard}/a/../..", 1, 4, false).is_err());
+        // A '..' that cancels another component, or comes first, keeps the placeholder.
+        assert_eq!(
+            shard_path("../o/a/../s{shard}", 1, 4, true).unwrap(),
+            "../o/a/../s1"
+        );
+        assert_eq!(
+            shard_path("o/{shard}/x/..", 1, 4, true).unwrap(),
+            "o/1/x/.."
         );
     }
 }
@@ -709,6 +859,25 @@ impl Plan {
         threads: u32,
         specfx: &str,
     ) -> Result<Plan, Error> {
+        if specfx.trim().is_empty()
+            || specfx.starts_with('-')
+            || specfx.chars().any(char::is_control)
+        {
+            let why = if specfx.starts_with('-') {
+                " (a command starting with '-' reads as an option: write ./".to_string()
+                    + &crate::error::OneLine(specfx).to_string()
+                    + ")"
+            } else {
+                String::new()
+            };
+            return Err(Error::Cluster {
+                option: "--specfx".into(),
+                problem: format!(
+                    "expected the command that runs specfx on the nodes (a path, or a name on their PATH, without control characters), got '{}'{why}",
+                    crate::error::OneLine(specfx)
+                ),
+            });
+        }
         let shards = split(n_points, tasks, shards_per_task)?;
         let points_per_task = n_points.div_ceil(shards) * shards_per_task;
         Ok(Plan {

@@ -430,6 +430,21 @@ fn calibrate(args: &CalibrateArgs, data: &Path, shard: Option<(u64, u64)>) -> Re
 /// `data`, in index order; refused before writing anything when a record was drawn with
 /// another seed or one index has two different records.
 fn merge(args: &CalibrateArgs, data: &Path, seed: u64, shards: &[PathBuf]) -> Result<Outcome> {
+    // A shard is a records directory `specfx calibrate --shard` wrote: a missing one, or a
+    // file, is a mistake in the command (a shard not run, a typo), never "no records".
+    for dir in shards {
+        if !dir.is_dir() {
+            bail!(
+                "calibrate merge: shard {}: {}, expected a records directory of `specfx calibrate --shard`",
+                dir.display(),
+                if dir.exists() || dir.is_symlink() {
+                    "is not a directory"
+                } else {
+                    "does not exist"
+                }
+            );
+        }
+    }
     let mut merged = Vec::new();
     for &target in &args.targets {
         let mut sets = Vec::new();

@@ -11,7 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use super::Outcome;
 use specfx::analysis::cluster::{
-    assign, parse_shard_spec, shard_path, Emit, Plan, PointCost, ShardSpec, SHARD_PLACEHOLDER,
+    assign, parse_shard_spec, shard_path, Emit, Plan, PointCost, ShardSpec, MAX_SHARDS_PER_TASK,
+    MAX_TASKS, SHARD_PLACEHOLDER,
 };
 use specfx::analysis::sweep::{
     check_shard_complete, check_shards, mark_pareto, same_space, Evaluator, GivenShard, LogUse,
@@ -78,10 +79,10 @@ pub struct PlanArgs {
     #[arg(long)]
     space: Option<PathBuf>,
     /// Number of array tasks.
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=MAX_TASKS))]
     tasks: u64,
     /// Shards per task: the sweep has tasks x shards-per-task shards.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=MAX_SHARDS_PER_TASK))]
     shards_per_task: u64,
     /// The scheduler: slurm, lsf, sge, k8s or shell.
     #[arg(long, default_value = "slurm")]
@@ -128,16 +129,17 @@ fn plan(args: &PlanArgs) -> Result<Outcome> {
     let n_points = space.n_points();
     let shards = specfx::analysis::cluster::split(n_points, args.tasks, args.shards_per_task)?;
     let sha = specfx::analysis::sweep::sweep_sha256(&space, shards);
-    let out_dir = OutDir::begin(
-        &args.out,
-        "sweep plan",
-        args.force,
-        &args
-            .space
-            .iter()
-            .map(|p| ("--space", p.clone()))
-            .collect::<Vec<_>>(),
-    )?;
+    let inputs: Vec<(&str, PathBuf)> = args.space.iter().map(|p| ("--space", p.clone())).collect();
+    // An earlier plan whose tasks ran is re-planned in place, its results kept; otherwise the
+    // plan is staged and committed whole.
+    let kept = earlier_plan_results(&args.out, &sha)?;
+    let out_dir = match kept {
+        Some(_) => {
+            specfx::output::refuse_over_inputs(&args.out, "--out", &inputs)?;
+            None
+        }
+        None => Some(OutDir::begin(&args.out, "sweep plan", args.force, &inputs)?),
+    };
     let point_cost = match args.seconds_per_point {
         Some(seconds) => PointCost {
             seconds,
@@ -169,8 +171,33 @@ fn plan(args: &PlanArgs) -> Result<Outcome> {
         .option("peak_mib", point_cost.peak_mib.to_string());
     let mut files = specfx::report::cluster::plan_files(&plan, &text)?;
     files.extend(Provenance::new(&inputs).files());
-    specfx::output::write_all_shown(out_dir.path(), &args.out, &files)?;
-    out_dir.commit()?;
+    match out_dir {
+        Some(out_dir) => {
+            specfx::output::write_all_shown(out_dir.path(), &args.out, &files)?;
+            out_dir.commit()?;
+        }
+        None => {
+            specfx::output::write_all_shown(&args.out, &args.out, &files)?;
+            // The earlier plan's scripts for another scheduler, gone from this plan.
+            for entry in plan_entries(&args.out)? {
+                if specfx::report::cluster::is_plan_file(&entry)
+                    && !files.iter().any(|(name, _)| *name == entry)
+                    && entry != specfx::output::MARKER
+                {
+                    let path = args.out.join(&entry);
+                    fs::remove_file(&path)
+                        .with_context(|| format!("cannot remove {}", path.display()))?;
+                }
+            }
+        }
+    }
+    if let Some(results) = &kept {
+        log::info!(
+            "sweep plan: {} re-planned in place; kept what its tasks computed: {}",
+            args.out.display(),
+            summarise(results)
+        );
+    }
     let r = &plan.resources;
     super::output::outln!(
         "sweep plan: {} points in {} shards over {} {} tasks ({} threads, {} MiB, {} min each) in {}; run {}/submit.sh",
@@ -185,6 +212,65 @@ fn plan(args: &PlanArgs) -> Result<Outcome> {
         args.out.display()
     )?;
     Ok(Outcome::Ok)
+}
+
+/// The names of the entries of the directory `dir`, sorted.
+fn plan_entries(dir: &Path) -> Result<Vec<String>> {
+    let mut names = Vec::new();
+    for entry in fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))? {
+        let entry = entry.with_context(|| format!("cannot read {}", dir.display()))?;
+        names.push(entry.file_name().to_string_lossy().into_owned());
+    }
+    names.sort();
+    Ok(names)
+}
+
+/// A few of `names`, for a message: `shards/, merged/, slurm-1_0.out and 3 more`.
+fn summarise(names: &[String]) -> String {
+    let shown: Vec<String> = names.iter().take(3).cloned().collect();
+    match names.len() - shown.len() {
+        0 => shown.join(", "),
+        more => format!("{} and {more} more", shown.join(", ")),
+    }
+}
+
+/// What re-planning into `out` must keep. `None` where `out` holds no plan's results: it is
+/// absent, empty, not a plan (left to [`OutDir`]'s rules), or a plan that nothing ran from.
+/// `Some(entries)` where it is an earlier plan of the same sweep (`sweep_sha256`) whose tasks,
+/// merge or scheduler wrote `entries` (`shards/`, `merged/`, logs): they are kept in place.
+/// Refused, even with `--force`, where they belong to another sweep: replacing the plan would
+/// delete what a cluster computed.
+fn earlier_plan_results(out: &Path, sweep_sha256: &str) -> Result<Option<Vec<String>>> {
+    if !out.is_dir() || specfx::output::result_of(out).as_deref() != Some("sweep plan") {
+        return Ok(None);
+    }
+    let results: Vec<String> = plan_entries(out)?
+        .into_iter()
+        .filter(|name| !specfx::report::cluster::is_plan_file(name))
+        .collect();
+    if results.is_empty() {
+        return Ok(None);
+    }
+    let earlier = fs::read_to_string(out.join("plan.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .and_then(|v| v["sweep_sha256"].as_str().map(str::to_string));
+    match earlier {
+        Some(earlier) if earlier == sweep_sha256 => Ok(Some(results)),
+        earlier => bail!(
+            "{} holds what an earlier plan's tasks computed ({}) for {}: re-planning there would lose it, with or without --force; choose another --out, or move those results away first",
+            out.display(),
+            summarise(&results),
+            match earlier {
+                Some(e) => format!(
+                    "another sweep ({} there, {} now)",
+                    &e[..e.len().min(12)],
+                    &sweep_sha256[..12]
+                ),
+                None => "a sweep whose plan.json is unreadable".to_string(),
+            }
+        ),
+    }
 }
 
 /// Reads and checks a sweep directory's `space.json` ([`SweepInfo::from_json`]).
@@ -495,8 +581,7 @@ fn resolved(path: &Path) -> Result<PathBuf> {
 
 /// Whether `out` is an earlier merge of the sweep `sweep` (which a merge may replace).
 fn earlier_merge_of(out: &Path, sweep: &str) -> bool {
-    let marker = fs::read_to_string(out.join(specfx::output::MARKER)).unwrap_or_default();
-    marker.split_whitespace().next() == Some(MERGE_MARKER)
+    specfx::output::result_of(out).as_deref() == Some(MERGE_MARKER)
         && read_info(out).is_ok_and(|i| i.sweep_sha256 == sweep)
 }
 
@@ -544,10 +629,22 @@ fn merge(out: &Path, shards: &[PathBuf], force: bool) -> Result<Outcome> {
     let merged = SweepInfo::new(first.space.clone(), 0, 1);
     let occupied = fs::read_dir(out).is_ok_and(|mut d| d.next().is_some());
     if occupied && !force && !earlier_merge_of(out, &merged.sweep_sha256) {
-        bail!(
-            "{} already exists and is not an earlier merge of this sweep: pass --force to replace it",
-            out.display()
-        );
+        // A result there (another sweep's merge, any command's) is never offered to --force.
+        match specfx::output::result_of(out) {
+            Some(holder) => bail!(
+                "{} holds {}, not an earlier merge of this sweep: choose another --out, or move it away first",
+                out.display(),
+                if holder == MERGE_MARKER {
+                    "the merge of another sweep".to_string()
+                } else {
+                    format!("a `specfx {holder}` result")
+                }
+            ),
+            None => bail!(
+                "{} already exists and is not an earlier merge of this sweep: pass --force to replace it",
+                out.display()
+            ),
+        }
     }
     let staged = OutDir::begin(out, MERGE_MARKER, true, &[])?;
     let target = merged.space.target;

@@ -13,6 +13,36 @@ pub const MERGED_DIR: &str = "merged";
 /// The space file the tasks read, beside the scripts.
 pub const SPACE_FILE: &str = "space.toml";
 
+/// The scripts a plan for `emit` writes beside [`SPACE_FILE`] and `plan.json`, by name (a test
+/// holds [`plan_files`] to it).
+pub fn script_names(emit: Emit) -> &'static [&'static str] {
+    match emit {
+        Emit::Slurm => &["sweep.sbatch", "merge.sbatch", "submit.sh", "resubmit.sh"],
+        Emit::Lsf => &["sweep.lsf", "merge.lsf", "submit.sh"],
+        Emit::Sge => &["sweep.sge", "merge.sge", "submit.sh"],
+        Emit::K8s => &["sweep-job.json", "merge-job.json", "submit.sh"],
+        Emit::Shell => &["submit.sh"],
+    }
+}
+
+/// Whether `name`, an entry of a plan's directory, is a file `sweep plan` writes (for any
+/// scheduler: the space, the scripts, `plan.json`, the provenance and the result marker) and
+/// not something the plan's tasks, its merge or its scheduler wrote there (`shards/`,
+/// `merged/`, logs), which re-planning must keep.
+pub fn is_plan_file(name: &str) -> bool {
+    [
+        SPACE_FILE,
+        "plan.json",
+        crate::provenance::INPUTS_FILE,
+        crate::provenance::PROVENANCE_FILE,
+        crate::output::MARKER,
+    ]
+    .contains(&name)
+        || Emit::ALL
+            .into_iter()
+            .any(|e| script_names(e).contains(&name))
+}
+
 /// `s` quoted for a POSIX shell (as is when it needs no quoting).
 ///
 /// # Examples
@@ -136,10 +166,36 @@ fn slurm(plan: &Plan) -> Vec<File> {
          echo \"submitted the array $array and its merge ${{merge%%;*}}\"\n",
         header = header(plan, "Submits the sweep's array and its merge (Slurm)"),
     );
+    // A cancelled, failed or timed-out task leaves the merge's `afterok` unmet for ever
+    // (DependencyNeverSatisfied): the resubmission cancels that merge and submits another
+    // after the resubmitted tasks and whatever tasks of the first array still run.
+    let resubmit = format!(
+        "#!/bin/sh\n\
+         {header}# Usage: ./resubmit.sh TASKS, the array tasks to run again as sbatch --array takes\n\
+         # them (5, 3,7 or 0-2): each resumes its shards where they stopped.\n\
+         set -eu\n\
+         cd \"$(dirname \"$0\")\"\n\
+         if [ \"$#\" -ne 1 ]; then\n  \
+           echo \"usage: $0 TASKS (array task indexes as sbatch --array takes them: 5, 3,7 or 0-2)\" >&2\n  \
+           exit 2\n\
+         fi\n\
+         # The merge submitted before waits on a task that will never succeed: cancel it.\n\
+         scancel --name={name}-merge --state=PENDING\n\
+         # Tasks of the earlier submissions that still run or wait: the new merge waits for them too.\n\
+         earlier=$(squeue --noheader --name={name} --format=%F | sort -u | paste -sd: -)\n\
+         array=$(sbatch --parsable --array=\"$1\" sweep.sbatch)\n\
+         array=${{array%%;*}}\n\
+         after=afterok:$array\n\
+         [ -z \"$earlier\" ] || after=$after,afterany:$earlier\n\
+         merge=$(sbatch --parsable --dependency=\"$after\" merge.sbatch)\n\
+         echo \"resubmitted tasks $1 as $array and the merge ${{merge%%;*}} after them\"\n",
+        header = header(plan, "Resubmits array tasks of the sweep, and its merge after them (Slurm)"),
+    );
     vec![
         ("sweep.sbatch".into(), script(sweep)),
         ("merge.sbatch".into(), script(merge)),
         ("submit.sh".into(), script(submit)),
+        ("resubmit.sh".into(), script(resubmit)),
     ]
 }
 
@@ -325,6 +381,13 @@ fn k8s(plan: &Plan) -> Vec<File> {
 
 fn shell(plan: &Plan) -> Vec<File> {
     let threads = plan.resources.threads;
+    let cmd = sweep_command(plan);
+    // xargs -I replaces its token everywhere in the command: one that the command (the
+    // --specfx path) does not hold.
+    let mut token = "@".to_string();
+    while cmd.contains(&token) {
+        token.push('@');
+    }
     let run = format!(
         "#!/bin/sh\n\
          {header}# Tasks run side by side, as many as the machine has cores for ({threads} threads each;\n\
@@ -333,11 +396,10 @@ fn shell(plan: &Plan) -> Vec<File> {
          cd \"$(dirname \"$0\")\"\n\
          jobs=${{SPECFX_JOBS:-$(( $(nproc) / {threads} ))}}\n\
          [ \"$jobs\" -ge 1 ] || jobs=1\n\
-         seq 0 {last} | xargs -P \"$jobs\" -I @ env SPECFX_TASK_ID=@ RAYON_NUM_THREADS={threads} \\\n  {cmd}\n\
+         seq 0 {last} | xargs -P \"$jobs\" -I {token} env SPECFX_TASK_ID={token} RAYON_NUM_THREADS={threads} \\\n  {cmd}\n\
          {merge}\n",
         header = header(plan, "Runs the sweep's tasks, then the merge, on this machine"),
         last = plan.tasks - 1,
-        cmd = sweep_command(plan),
         merge = merge_command(plan),
     );
     vec![("submit.sh".into(), script(run))]
@@ -355,4 +417,48 @@ pub fn plan_files(plan: &Plan, space_toml: &str) -> Result<Vec<File>, Error> {
     });
     files.push(crate::report::json_file("plan.json", plan)?);
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::cluster::PointCost;
+
+    fn plan(emit: Emit, specfx: &str) -> Plan {
+        let cost = PointCost {
+            seconds: 1.0,
+            peak_mib: 0,
+            measured: false,
+        };
+        Plan::new(emit, &"ab".repeat(32), 12, (4, 1), cost, 2, specfx).unwrap()
+    }
+
+    #[test]
+    fn the_script_names_are_those_each_plan_writes() {
+        for emit in Emit::ALL {
+            let names: Vec<String> = plan_files(&plan(emit, "specfx"), "")
+                .unwrap()
+                .into_iter()
+                .map(|f| f.0)
+                .collect();
+            let mut want = vec![SPACE_FILE.to_string()];
+            want.extend(script_names(emit).iter().map(|s| s.to_string()));
+            want.push("plan.json".into());
+            assert_eq!(names, want, "{emit:?}");
+            assert!(names.iter().all(|n| is_plan_file(n)));
+        }
+        assert!(!is_plan_file("shards") && !is_plan_file("merged"));
+        assert!(!is_plan_file("specfx-sweep-ababab-12_3.out"));
+    }
+
+    #[test]
+    fn the_shell_plans_xargs_token_is_not_in_its_command() {
+        let files = plan_files(&plan(Emit::Shell, "/opt/a@b/specfx"), "").unwrap();
+        let submit = String::from_utf8(files[1].1.clone()).unwrap();
+        assert!(
+            submit.contains("xargs -P \"$jobs\" -I @@ env SPECFX_TASK_ID=@@ "),
+            "{submit}"
+        );
+        assert!(submit.contains("/opt/a@b/specfx sweep"), "{submit}");
+    }
 }

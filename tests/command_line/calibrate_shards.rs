@@ -133,4 +133,28 @@ fn calibration_shards_merge_into_the_one_file_and_conflicts_are_refused() {
         ]),
         "--shard: a shard synthesises its part of the sample",
     );
+    // A shard that was not run, or a file named as one: a mistake in the command, refused
+    // (not merged as "no records") before --data is touched.
+    std::fs::write(root.join("afile"), "x").unwrap();
+    let before = std::fs::read(out.join("ice40.jsonl")).unwrap();
+    for (shard, why) in [
+        ("missing", "does not exist"),
+        ("afile", "is not a directory"),
+    ] {
+        refused(
+            &specfx(&[
+                "calibrate",
+                "merge",
+                "--data",
+                &s(&out),
+                &s(&root.join("shard-0")),
+                &s(&root.join(shard)),
+            ]),
+            &format!(
+                "calibrate merge: shard {}: {why}, expected a records directory",
+                root.join(shard).display()
+            ),
+        );
+    }
+    assert_eq!(std::fs::read(out.join("ice40.jsonl")).unwrap(), before);
 }

@@ -342,17 +342,13 @@ fn a_slurm_array_sweeps_and_calibrates_like_one_machine_through_a_cancelled_task
     let wide_one = files(&wide_one);
     let cancelled = root.join("cancelled");
     plan(&wide, &cancelled, "1");
-    let array = cluster.ok("sbatch", &["--parsable", "sweep.sbatch"], &cancelled);
-    let array = array.trim().split(';').next().unwrap().to_string();
-    let merge = cluster.ok(
-        "sbatch",
-        &[
-            "--parsable",
-            &format!("--dependency=afterok:{array}"),
-            "merge.sbatch",
-        ],
-        &cancelled,
-    );
+    // Submitted by its submit.sh: the array, and the merge after it (`afterok`).
+    let said = cluster.ok("sh", &["submit.sh"], &cancelled);
+    let array = said
+        .strip_prefix("submitted the array ")
+        .and_then(|r| r.split_whitespace().next())
+        .unwrap_or_else(|| panic!("{said}"))
+        .to_string();
     let log = cancelled.join("shards/shard-0/points.jsonl");
     let every = Duration::from_millis(10);
     poll(
@@ -362,7 +358,6 @@ fn a_slurm_array_sweeps_and_calibrates_like_one_machine_through_a_cancelled_task
         || std::fs::read_to_string(&log).is_ok_and(|t| t.lines().count() >= 1),
     );
     cluster.ok("scancel", &[&format!("{array}_0")], &cancelled);
-    // The merge's dependency can never be met now: cancel it too.
     wait_for("the task to end", Duration::from_secs(60), || {
         cluster
             .run("squeue", &["-h", "-j", &array])
@@ -374,18 +369,16 @@ fn a_slurm_array_sweeps_and_calibrates_like_one_machine_through_a_cancelled_task
         "the task finished its shard before it was cancelled"
     );
     assert!(!cancelled.join("merged").exists());
-    cluster.ok(
-        "scancel",
-        &[merge.trim().split(';').next().unwrap()],
-        &cancelled,
+    // The merge's dependency can never be met now: it waits, for ever.
+    let pending = cluster.ok("squeue", &["-h", "-o", "%j %T"], &cancelled);
+    assert!(
+        pending.trim().ends_with("-merge PENDING"),
+        "the merge is not waiting: {pending}"
     );
-    // Resubmitted alone (its array has one task), it takes the same shards and resumes.
-    cluster.ok(
-        "sbatch",
-        &["--array=0", "--wait", "sweep.sbatch"],
-        &cancelled,
-    );
-    cluster.ok("sbatch", &["--wait", "merge.sbatch"], &cancelled);
+    // resubmit.sh, as docs/cluster.md says: the task again (its array has one task, it takes
+    // the same shards and resumes them), and the merge after it, the stale one cancelled.
+    let said = cluster.ok("sh", &["resubmit.sh", "0"], &cancelled);
+    assert!(said.starts_with("resubmitted tasks 0 as "), "{said}");
     cluster.wait_idle(Duration::from_secs(60));
     assert!(
         files(&cancelled.join("merged")) == wide_one,

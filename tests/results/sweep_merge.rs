@@ -260,11 +260,14 @@ fn merge_never_writes_over_its_inputs_nor_an_existing_result() {
         std::os::unix::fs::symlink(c, &link).unwrap();
         refused(&merge(&link, &[a, b, c], force), "is the shard");
     }
-    // Onto another sweep's result: only with --force.
+    // Onto another command's result: only with --force, which the message never offers
+    // (it would delete what that run computed).
+    let o = merge(&w.one, &[a, b, c], &[]);
     refused(
-        &merge(&w.one, &[a, b, c], &[]),
-        "already exists and is not an earlier merge of this sweep: pass --force",
+        &o,
+        "holds a `specfx sweep` result, not an earlier merge of this sweep: choose another --out",
     );
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("--force"));
     let after: Vec<_> = w.shards.iter().map(|d| snapshot(d)).collect();
     assert!(before == after, "a shard changed");
     assert!(snapshot(&w.one) == one_before, "the one-shot sweep changed");
@@ -551,5 +554,81 @@ fn each_schedulers_array_tasks_take_their_shards_and_merge_to_the_one_shot_sweep
         "--out: expected a {shard} placeholder",
     );
     assert!(!root.join("refused-0").exists() && !root.join("refused-4").exists());
+    // Shard numbers past the bounds of `sweep plan` (100,000 tasks of 1,000 shards): refused,
+    // where u64::MAX once overflowed a capacity (a panic) and a million shards per task made a
+    // directory each.
+    let huge = root.join("huge").join("s{shard}");
+    for (shard, per_task, want) in [
+        (
+            "auto/18446744073709551615",
+            "18446744073709551615",
+            "--shards-per-task: expected 1 to 1000, got 18446744073709551615",
+        ),
+        (
+            "auto/1000000",
+            "1000000",
+            "--shards-per-task: expected 1 to 1000, got 1000000",
+        ),
+        (
+            "auto/100000001",
+            "1",
+            "--shard: expected at most 100000000 shards (100000 tasks of 1000), got 100000001",
+        ),
+    ] {
+        let args = [
+            "--space",
+            s(&space),
+            "--shard",
+            shard,
+            "--shards-per-task",
+            per_task,
+        ];
+        refused(
+            &as_task(
+                "SLURM_ARRAY_TASK_ID",
+                0,
+                0,
+                &args
+                    .into_iter()
+                    .chain(["--out", s(&huge)])
+                    .collect::<Vec<_>>(),
+            ),
+            want,
+        );
+    }
+    assert!(!root.join("huge").exists());
+    // A '..' after the placeholder cancels it: every task would write `o/x`.
+    let cancelled = format!("{}/o/{{shard}}/../x", s(&root));
+    refused(
+        &as_task(
+            "SLURM_ARRAY_TASK_ID",
+            0,
+            0,
+            &[
+                "--space",
+                s(&space),
+                "--shard",
+                "auto/4",
+                "--out",
+                &cancelled,
+            ],
+        ),
+        "a '..' after {shard} cancels it",
+    );
+    assert!(!root.join("o").exists());
+    // A scheduler that says there are no tasks.
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_specfx"));
+    cmd.arg("sweep")
+        .args(["--space", s(&space), "--shard", "auto", "--out", s(&out)]);
+    for (v, _) in SCHEDULER_VARS {
+        cmd.env_remove(v);
+    }
+    cmd.env_remove("SPECFX_TASK_ID");
+    cmd.env("SLURM_ARRAY_TASK_ID", "0")
+        .env("SLURM_ARRAY_TASK_COUNT", "0");
+    refused(
+        &cmd.output().unwrap(),
+        "SLURM_ARRAY_TASK_COUNT=0: expected 1 or more (Slurm's number of array tasks)",
+    );
     std::fs::remove_dir_all(&root).unwrap();
 }

@@ -292,3 +292,114 @@ fn a_plan_is_the_same_bytes_on_every_run_and_refuses_more_shards_than_points() {
     assert!(!root.join("c").exists());
     std::fs::remove_dir_all(&root).unwrap();
 }
+
+/// `sweep plan` with a `--specfx` of our own and extra arguments, into `dir`.
+fn plan_with(space: &Path, dir: &Path, specfx_path: &Path, extra: &[&str]) -> Output {
+    specfx()
+        .args(["sweep", "plan", "--space", space.to_str().unwrap()])
+        .args([
+            "--emit",
+            "shell",
+            "--tasks",
+            "4",
+            "--seconds-per-point",
+            "0.5",
+        ])
+        .args(["--specfx", specfx_path.to_str().unwrap(), "--out"])
+        .arg(dir)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// Every file under `dir`, recursively, with its bytes.
+fn tree(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                todo.push(p);
+            } else {
+                out.push((
+                    p.strip_prefix(dir).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                ));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn a_replan_keeps_what_the_tasks_computed_and_never_offers_to_delete_it() {
+    let root = temp("replan");
+    let space = root.join("space.toml");
+    std::fs::write(&space, SPACE).unwrap();
+    // A --specfx path holding '@', which the shell plan's `xargs -I @` once replaced by the
+    // task index (every task then ran a program that does not exist).
+    let bin = root.join("tools@2");
+    std::fs::create_dir_all(&bin).unwrap();
+    std::os::unix::fs::symlink(env!("CARGO_BIN_EXE_specfx"), bin.join("specfx")).unwrap();
+    let dir = root.join("plan");
+    ok(plan_with(&space, &dir, &bin.join("specfx"), &[]));
+    // An earlier plan nothing ran from is replaced without --force (its marker, `sweep plan`,
+    // is this command's: a check of its first word once refused it).
+    ok(plan_with(&space, &dir, &bin.join("specfx"), &[]));
+    run_script(&dir, "submit.sh", None);
+    assert!(dir.join("merged/sweep.csv").is_file());
+    std::fs::write(dir.join("slurm-7_0.out"), "a scheduler's log\n").unwrap();
+    let results = |t: Vec<(PathBuf, Vec<u8>)>| -> Vec<(PathBuf, Vec<u8>)> {
+        t.into_iter()
+            .filter(|(p, _)| {
+                p.starts_with("shards") || p.starts_with("merged") || p.ends_with("slurm-7_0.out")
+            })
+            .collect()
+    };
+    let computed = results(tree(&dir));
+    assert!(computed.len() > 10, "{computed:?}");
+    // The same sweep planned again, for another scheduler: in place, every result kept, the
+    // shell's scripts replaced by Slurm's.
+    let o = specfx()
+        .args(["sweep", "plan", "--space", space.to_str().unwrap()])
+        .args([
+            "--emit",
+            "slurm",
+            "--tasks",
+            "4",
+            "--seconds-per-point",
+            "0.5",
+        ])
+        .args(["--specfx", bin.join("specfx").to_str().unwrap(), "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    ok(o);
+    assert!(results(tree(&dir)) == computed, "a result changed");
+    assert!(dir.join("sweep.sbatch").is_file() && dir.join("resubmit.sh").is_file());
+    assert!(
+        !read(&dir, "submit.sh").contains("xargs"),
+        "the shell's submit.sh is left"
+    );
+    // Another sweep (another space) there: refused, with or without --force, and the message
+    // offers no flag that would delete the results.
+    let other = root.join("other.toml");
+    std::fs::write(&other, SPACE.replace("[3, 4, 5]", "[3, 4]")).unwrap();
+    for extra in [&[][..], &["--force"][..]] {
+        let o = plan_with(&other, &dir, &bin.join("specfx"), extra);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.contains(
+                "holds what an earlier plan's tasks computed (merged, shards, slurm-7_0.out)"
+            ) && err.contains("re-planning there would lose it"),
+            "{err}"
+        );
+        assert!(!err.contains("pass --force"), "{err}");
+        assert!(results(tree(&dir)) == computed, "a result changed");
+    }
+    std::fs::remove_dir_all(&root).unwrap();
+}
