@@ -175,7 +175,9 @@ void specfx_dpi_machine_free(void *machine);
 // DPI: one clock cycle of the cycle model. Given this cycle's `in_valid` (with the input
 // `c`, `n` it offers) and `out_ready`, writes what `specfx_top`'s ports must show during the
 // cycle (`in_ready`, `out_valid`, `out_data`, and `out_tag`, the 0-based number of the input
-// the output belongs to), then takes the clock edge.
+// the output belongs to), then takes the clock edge. A failure (a null pointer, an input
+// outside the model's domain while `in_valid` is high) writes nothing and takes no edge: the
+// machine is as before the call.
 int specfx_dpi_machine_cycle(void *machine,
                              int in_valid,
                              long long c,

@@ -5,7 +5,9 @@
 //!
 //! Every function catches panics and checks its pointers: a failure returns
 //! `SPECFX_ERROR` (or a null pointer) and leaves its one-line message in
-//! `specfx_last_error`, per thread. A model is immutable once made: any number of threads
+//! `specfx_last_error`, per thread. Every argument is checked before anything is written or
+//! moves: a failed call writes through none of its out pointers and leaves a cycle model
+//! (`specfx_dpi_machine_cycle`) exactly as it was. A model is immutable once made: any number of threads
 //! may evaluate it at once. Raw codes cross as 64-bit two's complement integers: every format
 //! (up to 64 bits signed, 63 unsigned) crosses exactly.
 
@@ -128,16 +130,32 @@ fn text<'a>(p: *const c_char, what: &str) -> Result<&'a str, String> {
     })
 }
 
-/// Writes through an out pointer that must not be null.
-fn put<T>(p: *mut T, value: T, what: &str) -> Result<(), String> {
+/// An out pointer checked for null: every place a function writes is checked before it writes
+/// any (and before a stateful one changes state), so a failure writes nothing.
+struct Place<T>(*mut T);
+
+impl<T> Place<T> {
+    /// Writes the result.
+    fn set(self, value: T) {
+        // SAFETY: non-null (checked by `place`), and the caller gives a valid, aligned place
+        // of type T (the documented contract).
+        unsafe { self.0.write(value) }
+    }
+}
+
+/// An out pointer that must not be null, or the error naming it.
+fn place<T>(p: *mut T, what: &str) -> Result<Place<T>, String> {
     if p.is_null() {
         return Err(format!(
             "{what}: a null pointer, expected a place for the result"
         ));
     }
-    // SAFETY: non-null, and the caller gives a valid, aligned place of type T.
-    unsafe { p.write(value) };
-    Ok(())
+    Ok(Place(p))
+}
+
+/// An out pointer that may be null (the result is then not wanted).
+fn optional_place<T>(p: *mut T) -> Option<Place<T>> {
+    (!p.is_null()).then_some(Place(p))
 }
 
 fn boxed(dp: Datapath) -> *mut specfx_model {
@@ -233,9 +251,10 @@ pub extern "C" fn specfx_input_codes(
 ) -> c_int {
     guard(SPECFX_ERROR, || {
         let dp = &deref(model)?.dp;
-        put(min, *dp.input_codes().start(), "min")?;
-        put(max, *dp.input_codes().end(), "max")?;
-        put(one, dp.one_code(), "one")?;
+        let (min, max, one) = (place(min, "min")?, place(max, "max")?, place(one, "one")?);
+        min.set(*dp.input_codes().start());
+        max.set(*dp.input_codes().end());
+        one.set(dp.one_code());
         Ok(SPECFX_OK)
     })
 }
@@ -279,14 +298,19 @@ pub extern "C" fn specfx_stage_format(
 ) -> c_int {
     guard(SPECFX_ERROR, || {
         let m = deref(model)?;
+        let (is_signed, int_bits, frac_bits) = (
+            place(is_signed, "is_signed")?,
+            place(int_bits, "int_bits")?,
+            place(frac_bits, "frac_bits")?,
+        );
         let f = if stage == -1 {
             m.dp.config().c.format
         } else {
             m.dp.stages()[stage_index(m, stage)?].format
         };
-        put(is_signed, c_int::from(f.is_signed()), "is_signed")?;
-        put(int_bits, f.int_bits(), "int_bits")?;
-        put(frac_bits, f.frac_bits(), "frac_bits")?;
+        is_signed.set(c_int::from(f.is_signed()));
+        int_bits.set(f.int_bits());
+        frac_bits.set(f.frac_bits());
         Ok(SPECFX_OK)
     })
 }
@@ -299,6 +323,7 @@ pub extern "C" fn specfx_constants_of(
     out: *mut specfx_constants,
 ) -> c_int {
     guard(SPECFX_ERROR, || {
+        let out = place(out, "out")?;
         let nc = deref(model)?
             .dp
             .constants_checked(n, "n")
@@ -314,7 +339,7 @@ pub extern "C" fn specfx_constants_of(
             coef: nc.coef_raw,
             depth: nc.depth,
         };
-        put(out, c, "out")?;
+        out.set(c);
         Ok(SPECFX_OK)
     })
 }
@@ -325,8 +350,9 @@ pub extern "C" fn specfx_constants_of(
 pub extern "C" fn specfx_eval(model: *const specfx_model, c: i64, n: u32, out: *mut i64) -> c_int {
     guard(SPECFX_ERROR, || {
         let dp = &deref(model)?.dp;
+        let out = place(out, "out")?;
         let p = pairs::eval_one(dp, c, n).map_err(|e| e.to_string())?;
-        put(out, p.values[dp.stage_out()], "out")?;
+        out.set(p.values[dp.stage_out()]);
         Ok(SPECFX_OK)
     })
 }
@@ -360,11 +386,11 @@ pub extern "C" fn specfx_eval_probes(
                 *e = pairs::event_code(p);
             }
         }
-        if !cut.is_null() {
-            put(cut, c_int::from(p.cut), "cut")?;
+        if let Some(cut) = optional_place(cut) {
+            cut.set(c_int::from(p.cut));
         }
-        if !clamped.is_null() {
-            put(clamped, c_int::from(p.input_clamped), "clamped")?;
+        if let Some(clamped) = optional_place(clamped) {
+            clamped.set(c_int::from(p.input_clamped));
         }
         Ok(SPECFX_OK)
     })
@@ -468,6 +494,7 @@ pub extern "C" fn specfx_dpi_constant(
     value: *mut c_longlong,
 ) -> c_int {
     guard(SPECFX_ERROR, || {
+        let value = place(value, "value")?;
         let nc = dpi_model(model)?
             .dp
             .constants_checked(n_of(n)?, "n")
@@ -484,7 +511,7 @@ pub extern "C" fn specfx_dpi_constant(
                 ))
             }
         };
-        put(value, v, "value")?;
+        value.set(v);
         Ok(SPECFX_OK)
     })
 }
@@ -517,9 +544,10 @@ pub extern "C" fn specfx_dpi_probe(
     guard(SPECFX_ERROR, || {
         let m = dpi_model(model)?;
         let s = stage_index(m, stage)?;
+        let (value, event) = (place(value, "value")?, place(event, "event")?);
         let p = pairs::eval_one(&m.dp, c, n_of(n)?).map_err(|e| e.to_string())?;
-        put(value, p.values[s], "value")?;
-        put(event, c_int::from(pairs::event_code(p.events[s])), "event")?;
+        value.set(p.values[s]);
+        event.set(c_int::from(pairs::event_code(p.events[s])));
         Ok(SPECFX_OK)
     })
 }
@@ -535,15 +563,12 @@ pub extern "C" fn specfx_dpi_first_live(
 ) -> c_int {
     guard(SPECFX_ERROR, || {
         let dp = &dpi_model(model)?.dp;
+        let code = place(code, "code")?;
         let nc = dp
             .constants_checked(n_of(n)?, "n")
             .map_err(|e| e.to_string())?;
         let codes = dp.input_codes();
-        put(
-            code,
-            dp.first_live_code(nc, *codes.start()..*codes.end() + 1),
-            "code",
-        )?;
+        code.set(dp.first_live_code(nc, *codes.start()..*codes.end() + 1));
         Ok(SPECFX_OK)
     })
 }
@@ -587,7 +612,9 @@ pub extern "C" fn specfx_dpi_machine_free(machine: *mut c_void) {
 /// DPI: one clock cycle of the cycle model. Given this cycle's `in_valid` (with the input
 /// `c`, `n` it offers) and `out_ready`, writes what `specfx_top`'s ports must show during the
 /// cycle (`in_ready`, `out_valid`, `out_data`, and `out_tag`, the 0-based number of the input
-/// the output belongs to), then takes the clock edge.
+/// the output belongs to), then takes the clock edge. A failure (a null pointer, an input
+/// outside the model's domain while `in_valid` is high) writes nothing and takes no edge: the
+/// machine is as before the call.
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
 pub extern "C" fn specfx_dpi_machine_cycle(
@@ -606,6 +633,14 @@ pub extern "C" fn specfx_dpi_machine_cycle(
         // thread at a time (the caller's contract).
         let m = unsafe { (machine as *mut specfx_machine).as_mut() }
             .ok_or("machine: a null pointer, expected a cycle model")?;
+        // Every argument is checked before the clock edge: a failed call leaves the machine
+        // as it was (Lockstep::cycle refuses an input outside the domain before it moves).
+        let (in_ready, out_valid, out_data, out_tag) = (
+            place(in_ready, "in_ready")?,
+            place(out_valid, "out_valid")?,
+            place(out_data, "out_data")?,
+            place(out_tag, "out_tag")?,
+        );
         let input = if in_valid != 0 {
             Some((c, n_of(n)?))
         } else {
@@ -615,11 +650,11 @@ pub extern "C" fn specfx_dpi_machine_cycle(
             .lockstep
             .cycle(&m.dp, input, out_ready != 0)
             .map_err(|e| e.to_string())?;
-        put(in_ready, c_int::from(ports.in_ready), "in_ready")?;
-        put(out_valid, c_int::from(ports.out.is_some()), "out_valid")?;
+        in_ready.set(c_int::from(ports.in_ready));
+        out_valid.set(c_int::from(ports.out.is_some()));
         let (tag, data) = ports.out.unwrap_or((0, 0));
-        put(out_data, data, "out_data")?;
-        put(out_tag, tag as c_longlong, "out_tag")?;
+        out_data.set(data);
+        out_tag.set(tag as c_longlong);
         Ok(SPECFX_OK)
     })
 }
@@ -665,13 +700,14 @@ pub extern "C" fn specfx_dpi_directed_at(
     c: *mut c_longlong,
 ) -> c_int {
     guard(SPECFX_ERROR, || {
+        let (n, c) = (place(n, "n")?, place(c, "c")?);
         let all = directed(dpi_model(model)?)?;
         let &(nv, cv) = usize::try_from(i)
             .ok()
             .and_then(|i| all.get(i))
             .ok_or_else(|| format!("i = {i} is not a directed case (expected 0..{})", all.len()))?;
-        put(n, nv as c_int, "n")?;
-        put(c, cv, "c")?;
+        n.set(nv as c_int);
+        c.set(cv);
         Ok(SPECFX_OK)
     })
 }

@@ -1,7 +1,8 @@
 //! Bad input over the C boundary gets an error value and one line in `specfx_last_error`,
 //! never a crash: a configuration refused with the command line's own message, null pointers,
 //! an n outside the set, a code outside the input format, a stage or index out of range,
-//! invalid UTF-8; and the error is per thread.
+//! invalid UTF-8; and the error is per thread. A failed call writes through none of its out
+//! pointers, and a failed cycle leaves a cycle model exactly as it was.
 
 use std::ffi::{c_char, CStr, CString};
 use std::ptr::{null, null_mut};
@@ -156,5 +157,146 @@ fn a_model_answers_what_a_testbench_asks() {
         SPECFX_OK
     );
     assert_eq!((depth, k.depth), (4, 4));
+    specfx_free(m);
+}
+
+/// One cycle of `machine` with every out pointer given: `(in_ready, out_valid, out_data,
+/// out_tag)`, or None when the call failed.
+fn cycle(
+    machine: *mut std::ffi::c_void,
+    input: Option<(i64, i32)>,
+    out_ready: bool,
+) -> Option<(i32, i32, i64, i64)> {
+    let (mut in_ready, mut out_valid, mut data, mut tag) = (-5, -5, -5i64, -5i64);
+    let (c, n) = input.unwrap_or((0, 0));
+    let rc = specfx_dpi_machine_cycle(
+        machine,
+        i32::from(input.is_some()),
+        c,
+        n,
+        i32::from(out_ready),
+        &mut in_ready,
+        &mut out_valid,
+        &mut data,
+        &mut tag,
+    );
+    (rc == SPECFX_OK).then_some((in_ready, out_valid, data, tag))
+}
+
+#[test]
+fn a_failed_machine_cycle_leaves_the_machine_as_it_was() {
+    let m = open("baseline");
+    assert!(!m.is_null());
+    let one = 32768; // u1.15's 1.0
+    for arch in [0, 1] {
+        let failing = specfx_dpi_machine_new(m.cast(), arch);
+        let twin = specfx_dpi_machine_new(m.cast(), arch);
+        assert!(!failing.is_null() && !twin.is_null());
+        // The same stimulus to both: a few inputs with out_ready low and high.
+        let stimulus: Vec<(Option<(i64, i32)>, bool)> = (0..40)
+            .map(|i| {
+                let input = (i % 3 != 2).then_some((one - i64::from(i) * 17, 16 + i));
+                (input, i % 5 != 4)
+            })
+            .collect();
+        for (i, &(input, out_ready)) in stimulus.iter().enumerate() {
+            if i % 4 == 1 {
+                // Failing calls before this cycle's real one: each out pointer null in turn
+                // (with a valid input offered, which would transfer), then inputs outside the
+                // domain; each writes nothing and takes no clock edge.
+                let (mut a, mut b, mut d, mut t) = (-5, -5, -5i64, -5i64);
+                let places = [
+                    (
+                        null_mut(),
+                        &mut b as *mut i32,
+                        &mut d as *mut i64,
+                        &mut t as *mut i64,
+                    ),
+                    (
+                        &mut a as *mut i32,
+                        null_mut(),
+                        &mut d as *mut i64,
+                        &mut t as *mut i64,
+                    ),
+                    (
+                        &mut a as *mut i32,
+                        &mut b as *mut i32,
+                        null_mut(),
+                        &mut t as *mut i64,
+                    ),
+                    (
+                        &mut a as *mut i32,
+                        &mut b as *mut i32,
+                        &mut d as *mut i64,
+                        null_mut(),
+                    ),
+                ];
+                for (name, (ir, ov, od, ot)) in ["in_ready", "out_valid", "out_data", "out_tag"]
+                    .iter()
+                    .zip(places)
+                {
+                    let rc = specfx_dpi_machine_cycle(failing, 1, one, 64, 1, ir, ov, od, ot);
+                    assert_eq!(rc, SPECFX_ERROR);
+                    assert_eq!(
+                        last_error(),
+                        format!("{name}: a null pointer, expected a place for the result")
+                    );
+                }
+                assert_eq!((a, b, d, t), (-5, -5, -5, -5), "nothing written on failure");
+                assert_eq!(cycle(failing, Some((one, 7)), true), None);
+                assert_eq!(
+                    last_error(),
+                    "n = 7 is not in the configuration's exponent set 16..=1024"
+                );
+                assert_eq!(cycle(failing, Some((one, -16)), true), None);
+                assert_eq!(last_error(), "n = -16 is not an exponent (expected n >= 0)");
+                assert_eq!(cycle(failing, Some((65536, 64)), false), None);
+            }
+            let got = cycle(failing, input, out_ready);
+            let want = cycle(twin, input, out_ready);
+            assert!(want.is_some(), "cycle {i}: {}", last_error());
+            assert_eq!(got, want, "arch {arch}, cycle {i}");
+        }
+        specfx_dpi_machine_free(failing);
+        specfx_dpi_machine_free(twin);
+    }
+    specfx_free(m);
+}
+
+#[test]
+fn a_failed_call_writes_through_none_of_its_pointers() {
+    let m = open("baseline");
+    let (mut lo, mut hi) = (-5i64, -5i64);
+    assert_eq!(
+        specfx_input_codes(m, &mut lo, &mut hi, null_mut()),
+        SPECFX_ERROR
+    );
+    assert_eq!(
+        last_error(),
+        "one: a null pointer, expected a place for the result"
+    );
+    assert_eq!((lo, hi), (-5, -5));
+    let (mut s, mut i) = (-5, -5);
+    assert_eq!(
+        specfx_stage_format(m, 0, &mut s, &mut i, null_mut()),
+        SPECFX_ERROR
+    );
+    assert_eq!((s, i), (-5, -5));
+    let mut v = -5i64;
+    assert_eq!(
+        specfx_dpi_probe(m.cast(), 32768, 64, 0, &mut v, null_mut()),
+        SPECFX_ERROR
+    );
+    assert_eq!(
+        last_error(),
+        "event: a null pointer, expected a place for the result"
+    );
+    assert_eq!(v, -5);
+    let mut n = -5;
+    assert_eq!(
+        specfx_dpi_directed_at(m.cast(), 0, &mut n, null_mut()),
+        SPECFX_ERROR
+    );
+    assert_eq!(n, -5);
     specfx_free(m);
 }

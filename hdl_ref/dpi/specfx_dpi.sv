@@ -5,7 +5,9 @@
 // static library into a Verilator build (pass libspecfx_c.a on the command line with
 // -LDFLAGS "-lstdc++ -lpthread -ldl"), or load the shared one with -sv_lib. Two-state types
 // only; no context functions. Every function that can fail returns 0 on success and -1 on
-// failure, with the reason in specfx_dpi_last_error(); a handle is null on failure.
+// failure, with the reason in specfx_dpi_last_error(); a handle is null on failure. A failed
+// call writes none of its outputs, and a failed specfx_dpi_machine_cycle takes no clock edge
+// (the cycle model is exactly as before it).
 // tb_specfx_dpi.sv is a constrained-random testbench with a scoreboard built on them.
 `timescale 1ns / 1ps
 package specfx_dpi;
