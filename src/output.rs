@@ -237,6 +237,7 @@ impl OutDir {
         // `dir/..` have no name of their own and are refused below.
         let target = &target.components().collect::<PathBuf>();
         refuse_over_inputs(target, "--out", inputs)?;
+        refuse_looping_link(target, "--out")?;
         let name = target
             .file_name()
             .ok_or_else(|| refused(format!("{}: expected a directory name", target.display())))?
@@ -565,6 +566,7 @@ pub fn check_file_output(
     force: bool,
 ) -> Result<()> {
     refuse_over_inputs(out, flag, inputs)?;
+    refuse_looping_link(out, flag)?;
     if out.is_dir() {
         bail!(
             "{flag} {}: is a directory, expected a file path",
@@ -626,6 +628,7 @@ fn parent_of(path: &Path) -> &Path {
 /// Checks before any work that the directory `dir` can be created (or, if it exists, written
 /// into): its nearest existing ancestor is a directory that takes a new entry.
 pub fn check_can_create(dir: &Path, flag: &str) -> Result<()> {
+    refuse_looping_link(dir, flag)?;
     let existing = dir
         .ancestors()
         .find(|d| d.as_os_str().is_empty() || d.exists())
@@ -645,6 +648,24 @@ pub fn check_can_create(dir: &Path, flag: &str) -> Result<()> {
         );
     }
     probe(existing, dir, flag)
+}
+
+/// Refuses an output path that is, or lies under, a symbolic link that loops (`a -> b -> a`):
+/// it can neither be written through nor replaced, and the system's own word for it ("File
+/// exists", "Too many levels of symbolic links") names neither the link nor the flag.
+fn refuse_looping_link(out: &Path, flag: &str) -> Result<()> {
+    for link in out.ancestors().filter(|a| !a.as_os_str().is_empty()) {
+        let is_link = std::fs::symlink_metadata(link).is_ok_and(|m| m.file_type().is_symlink());
+        if is_link && std::fs::metadata(link).is_err_and(|e| e.raw_os_error() == Some(libc::ELOOP))
+        {
+            bail!(
+                "{flag} {}: {} is a symbolic link that loops (too many levels of links): pass another {flag}",
+                out.display(),
+                link.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Creates and removes a probe file in `dir`: whether it takes a new entry (permissions, a
@@ -681,10 +702,37 @@ fn begins_with(path: &Path, header: Option<&str>) -> bool {
         .is_ok_and(|_| head == header.as_bytes())
 }
 
-/// The inputs of a command reading `--config` and an optional `--scene`, for
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_symbolic_link_that_loops_is_refused_by_name() {
+        let tmp = tempfile::tempdir().unwrap();
+        let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+        std::os::unix::fs::symlink(&b, &a).unwrap();
+        std::os::unix::fs::symlink(&a, &b).unwrap();
+        let want = format!(
+            "{} is a symbolic link that loops (too many levels of links): pass another --out",
+            a.display()
+        );
+        let errors = [
+            OutDir::begin(&a, "report", false, &[]).err().unwrap(),
+            OutDir::begin(&a.join("x"), "report", false, &[])
+                .err()
+                .unwrap(),
+            check_file_output(&a, "--out", &[], None, true).unwrap_err(),
+            check_can_create(&a.join("x"), "--out").unwrap_err(),
+        ];
+        for e in errors {
+            assert!(e.to_string().contains(&want), "{e}");
+        }
+        // A link to a directory is an ordinary path.
+        let real = tmp.path().join("real");
+        std::fs::create_dir(&real).unwrap();
+        std::os::unix::fs::symlink(&real, tmp.path().join("link")).unwrap();
+        check_can_create(&tmp.path().join("link/x"), "--out").unwrap();
+    }
 
     /// A staging directory a dead process left for `target`, with `command`'s marker.
     fn left(target: &Path, tag: &str, command: &str) -> PathBuf {
