@@ -40,8 +40,10 @@ pub(crate) fn one_line(message: &str) -> String {
     message.replace(['\n', '\r'], " ").trim().to_string()
 }
 
-/// Errors from parsing and validating user input. Arithmetic never fails.
+/// Errors from parsing and validating user input. Arithmetic never fails. New kinds of
+/// refusal may be added: match the ones you handle and keep a catch-all arm.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Error {
     /// A name (form, cutoff, source, ...) that is not one of the known ones.
     #[error("unknown {what} '{}': expected {expected}", OneLine(.got))]

@@ -683,6 +683,28 @@ impl Datapath {
         p
     }
 
+    /// The output code of one pair, the pair checked first: `c_raw` a code of the input
+    /// format, `n` in the configuration's exponent set. What a testbench compares with
+    /// `out_data`, and what the C and Python faces return for one pair.
+    ///
+    /// # Errors
+    /// [`Error::Domain`] for a code outside the input format or an n outside the set.
+    ///
+    /// # Examples
+    /// ```
+    /// let dp = specfx::load_datapath("baseline", None).unwrap();
+    /// // c = 0 at n = 16: (16/16)(0 - 1) + 1 = 0, so the output is 0.
+    /// assert_eq!(dp.eval_out(0, 16).unwrap(), 0);
+    /// // c = 1.0: the lobe is 1 and the output is the coefficient itself.
+    /// assert_eq!(dp.eval_out(dp.one_code(), 64).unwrap(), dp.constants_for(64).unwrap().coef_raw);
+    /// assert!(dp.eval_out(0, 7).is_err());
+    /// ```
+    pub fn eval_out(&self, c_raw: i64, n: u32) -> Result<i64, Error> {
+        let nc = self.constants_checked(n, "n")?;
+        self.check_code(c_raw, "c")?;
+        Ok(self.eval(c_raw, nc).values[self.stage_out()])
+    }
+
     /// The exact sum `t + offset` on the larger of their fraction bits (`b_frac`).
     #[inline]
     fn exact_sum(&self, t: i64, nc: &NConstants) -> i128 {
