@@ -28,7 +28,9 @@
 // while out_valid is high and out_ready low (rule 5), and with RESET_DATA = 1 be 0 in cycle 0.
 // Prints the first 10 mismatches, a
 // coverage line, then exactly one line `N passed, N failed` (a vector passes when its output
-// has the expected value on the expected cycle; protocol errors count as failures too).
+// has the expected value on the expected cycle; protocol errors count as failures too); then
+// ends with $finish when every vector passed, and with $fatal when a check failed or nothing
+// was checked (a non-zero exit status: the model Verilator builds aborts).
 `timescale 1ns / 1ps
 `default_nettype none
 /* verilator lint_off BLKSEQ */
@@ -285,6 +287,7 @@ module tb_specfx_dpi #(
         $display("%0d passed, %0d failed", n_passed, n_failed);
         specfx_dpi_machine_free(machine);
         specfx_dpi_free(model);
+        if (n_failed != 0 || n_passed == 0) $fatal(1, "tb_specfx_dpi: the check failed");
         $finish;
     endtask
 

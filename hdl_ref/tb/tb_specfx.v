@@ -7,8 +7,12 @@
 // (one 32-bit word per vector) from that of +stimulus=DIR; each defaults to the current
 // directory (paths up to 500 characters). Parameters (set per run: iverilog -Ptb_specfx.<NAME>=<value>, verilator
 // -G<NAME>=<value>; `specfx hdl params --format iverilog --top tb_specfx` prints them):
-// NVEC (vectors), NCYC (lines of the stimulus files) and every parameter of specfx_top, passed
-// to the DUT instance `dut`. Defining SPECFX_VCD dumps every signal to rtl.vcd.
+// NVEC (vectors: n_vectors of the vector directory's manifest.json), NCYC (lines of the
+// stimulus files: n_cycles of stim.json) and every parameter of specfx_top, passed to the DUT
+// instance `dut`. NVEC and NCYC have no default: the testbench counts the words of in_c.hex
+// and stim_valid.hex, and refuses to run ($fatal, with the count it found) when NVEC or NCYC
+// is not set or differs from its file's count, or when the file cannot be opened.
+// Defining SPECFX_VCD dumps every signal to rtl.vcd.
 //
 // During cycle t (cycle 0 is the first after reset): in_valid = (vectors left) &&
 // stim_valid[t], out_ready = stim_ready[t] (both 1 past the end of the files); the input ports
@@ -18,7 +22,9 @@
 // timeout (the missing outputs count as failed). A change of out_data or a drop of out_valid
 // while out_valid is high and out_ready low (docs/cycle.md, rule 5) counts as one more
 // failure, and so does, with RESET_DATA = 1, an out_data other than 0 in cycle 0. Prints the
-// first 10 mismatches, then exactly one line `N passed, N failed`.
+// first 10 mismatches, then exactly one line `N passed, N failed`; then ends with $finish when
+// every vector passed, and with $fatal (a non-zero exit status: vvp exits with 1, a Verilator
+// model aborts) when a check failed or nothing was checked.
 `timescale 1ns / 1ps
 `default_nettype none
 // A testbench: blocking counters in the clocked checker and a nonblocking reset release are
@@ -27,7 +33,7 @@
 /* verilator lint_off INITIALDLY */
 
 module tb_specfx #(
-    parameter integer NVEC = 1, parameter integer NCYC = 1,
+    parameter integer NVEC = -1, parameter integer NCYC = -1,
     parameter integer ARCH = 0, parameter integer K = 4, parameter integer CUTOFF = 0,
     parameter integer C_W = 16, parameter integer C_F = 15, parameter integer C_S = 0,
     parameter integer D_W = 16, parameter integer D_F = 15, parameter integer SLOPE_W = 11,
@@ -80,9 +86,55 @@ module tb_specfx #(
     // The directories of the vector and the stimulus files (plusargs), and a file's path.
     reg [8*500-1:0] vec_dir, stim_dir;
     reg [8*520-1:0] path;
+    // The number of hex words in a file, -1 when it cannot be opened.
+    task count_words(input [8*520-1:0] file, output integer n);
+        integer fd, got;
+        reg [63:0] word;
+        begin
+            n = 0;
+            fd = $fopen(file, "r");
+            if (fd == 0) begin
+                n = -1;
+            end else begin
+                got = $fscanf(fd, "%h", word);
+                while (got == 1) begin
+                    n = n + 1;
+                    got = $fscanf(fd, "%h", word);
+                end
+                $fclose(fd);
+            end
+        end
+    endtask
+
+    // Refuses a count parameter that is not set or does not match its file.
+    task check_count(input [8*520-1:0] file, input integer words, input integer want,
+                     input [8*4-1:0] name, input [8*40-1:0] source);
+        begin
+            if (words < 0) begin
+                $display("tb_specfx: cannot open %0s", file);
+                $fatal(1, "tb_specfx: a file is missing");
+            end else if (want < 0) begin
+                $display("tb_specfx: %0s is not set: expected %0s (%0s holds %0d words)", name,
+                         source, file, words);
+                $fatal(1, "tb_specfx: a count is not set");
+            end else if (words != want) begin
+                $display("tb_specfx: %0s = %0d, but %0s holds %0d words (expected %0s)", name,
+                         want, file, words, source);
+                $fatal(1, "tb_specfx: a count does not match its file");
+            end
+        end
+    endtask
+
+    integer n_words;
     initial begin
         if (!$value$plusargs("vectors=%s", vec_dir)) vec_dir = ".";
         if (!$value$plusargs("stimulus=%s", stim_dir)) stim_dir = ".";
+        $sformat(path, "%0s/in_c.hex", vec_dir);
+        count_words(path, n_words);
+        check_count(path, n_words, NVEC, "NVEC", "n_vectors of manifest.json");
+        $sformat(path, "%0s/stim_valid.hex", stim_dir);
+        count_words(path, n_words);
+        check_count(path, n_words, NCYC, "NCYC", "n_cycles of stim.json");
         if (NVEC > 0) begin
             $sformat(path, "%0s/in_c.hex", vec_dir);         $readmemh(path, mem_c);
             $sformat(path, "%0s/in_n.hex", vec_dir);         $readmemh(path, mem_n);
@@ -168,6 +220,8 @@ module tb_specfx #(
     task report_and_finish;
         begin
             $display("%0d passed, %0d failed", n_passed, n_failed);
+            if (n_failed != 0 || n_passed == 0)
+                $fatal(1, "tb_specfx: the check failed");
             $finish;
         end
     endtask

@@ -170,8 +170,8 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     if sim == tools::simulator::Simulator::Verilator {
         log::info!("cosim: building with verilator (a minute or less)");
     }
-    let log = tools::simulator::simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
-    let verdict = parse_log(&log);
+    let out = tools::simulator::simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
+    let verdict = parse_log(&out.log);
     // The RTL's trace: a testbench that ran to its summary must have written it; one that
     // died may have written none, and then there is nothing to compare.
     let traces = match &args.vcd {
@@ -192,7 +192,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         let kept = work.keep();
         log::info!("cosim: work directory {}", kept.display());
     }
-    let failure = print_verdict(&verdict)?;
+    let failure = print_verdict(&verdict, out.failure.as_deref())?;
     let traces_differ = match &traces {
         Some((model, rtl)) => compare_traces(model, rtl, failure.is_some())?,
         None => None,
@@ -280,9 +280,11 @@ fn lint_clean(rtl: &[PathBuf], params: &[(String, i64)]) -> Result<bool> {
 }
 
 /// Prints the testbench's verdict (its problems, then `N passed, N failed`); returns why the
-/// run failed, if it did.
+/// run failed, if it did: a failed vector or nothing checked by the count, or a testbench
+/// whose process failed (`exit_failure`, its exit status: a `$fatal`) whatever it counted.
 pub(super) fn print_verdict(
     verdict: &std::result::Result<specfx::hdl::testbench::Tally, specfx::Error>,
+    exit_failure: Option<&str>,
 ) -> Result<Option<String>> {
     Ok(match verdict {
         Ok(v) => {
@@ -299,10 +301,18 @@ pub(super) fn print_verdict(
             } else if v.passed == 0 {
                 Some("nothing was checked".to_string())
             } else {
-                None
+                exit_failure.map(|status| {
+                    format!(
+                        "the testbench counted {} passed, 0 failed but ended with {status}",
+                        v.passed
+                    )
+                })
             }
         }
-        Err(e) => Some(e.to_string()),
+        Err(e) => Some(match exit_failure {
+            Some(status) => format!("{e} (it ended with {status})"),
+            None => e.to_string(),
+        }),
     })
 }
 

@@ -13,27 +13,36 @@ use specfx::hdl::testbench::parse_log;
 use specfx::hdl::top_parameters;
 use specfx::tools;
 
+/// A library the user named (`what` says how): a regular file that begins as a static
+/// library (an ar archive, `!<arch>`) or a shared one (ELF) does, checked before Verilator
+/// builds anything (a linker error would not name it).
+fn checked_library(p: &Path, what: &str) -> Result<PathBuf> {
+    use std::io::Read as _;
+    if !p.is_file() {
+        bail!("{what}: no such file, expected libspecfx_c.a");
+    }
+    let mut magic = [0u8; 8];
+    let n = std::fs::File::open(p)
+        .and_then(|mut f| f.read(&mut magic))
+        .with_context(|| format!("{what}: cannot read it"))?;
+    let magic = &magic[..n];
+    if !(magic == b"!<arch>\n" || magic == b"!<thin>\n" || magic.starts_with(b"\x7fELF")) {
+        bail!(
+            "{what}: not a library, expected libspecfx_c.a (an ar archive, beginning with !<arch>) or libspecfx_c.so"
+        );
+    }
+    Ok(std::path::absolute(p)?)
+}
+
 /// The C library the testbench links: `--dpi-lib`, `$SPECFX_DPI_LIB`, or `libspecfx_c.a`
 /// beside the specfx executable (where `cargo build` puts both).
 fn dpi_library(arg: Option<&Path>) -> Result<PathBuf> {
     if let Some(p) = arg {
-        if !p.is_file() {
-            bail!(
-                "--dpi-lib {}: no such file, expected libspecfx_c.a",
-                p.display()
-            );
-        }
-        return Ok(std::path::absolute(p)?);
+        return checked_library(p, &format!("--dpi-lib {}", p.display()));
     }
     if let Some(v) = std::env::var_os("SPECFX_DPI_LIB").filter(|v| !v.is_empty()) {
         let p = PathBuf::from(v);
-        if !p.is_file() {
-            bail!(
-                "SPECFX_DPI_LIB={}: no such file, expected libspecfx_c.a",
-                p.display()
-            );
-        }
-        return Ok(std::path::absolute(p)?);
+        return checked_library(&p, &format!("SPECFX_DPI_LIB={}", p.display()));
     }
     let exe = std::env::current_exe().context("cannot find the specfx executable's directory")?;
     let dir = exe.parent().unwrap_or(Path::new("."));
@@ -138,7 +147,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         "cosim --dpi: building with verilator and {}",
         library.display()
     );
-    let log = tools::simulator::simulate_dpi(
+    let out = tools::simulator::simulate_dpi(
         wd,
         &tools::simulator::DpiRun {
             testbench: &testbench,
@@ -149,12 +158,12 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             optimize: exhaustive,
         },
     )?;
-    let verdict = parse_log(&log);
+    let verdict = parse_log(&out.log);
     if args.keep {
         let kept = work.keep();
         log::info!("cosim --dpi: work directory {}", kept.display());
     }
-    match print_verdict(&verdict)? {
+    match print_verdict(&verdict, out.failure.as_deref())? {
         None => Ok(Outcome::Ok),
         Some(why) => {
             log::error!("cosim --dpi: FAIL (verilator, {}): {why}", run.arch);

@@ -174,9 +174,29 @@ fn verilator_build(wd: &Path, top: &str, args: &[String], makeflags: &[&str]) ->
     Ok(())
 }
 
+/// What a testbench printed and how its process ended.
+#[derive(Debug, Clone)]
+pub struct SimOutput {
+    /// Its output: stdout, then stderr.
+    pub log: String,
+    /// Its exit status: `None` when it exited with 0, else how it ended (`exit status 1`,
+    /// `signal 6 (SIGABRT)`; a testbench's `$fatal` ends it so).
+    pub failure: Option<String>,
+}
+
+impl SimOutput {
+    fn of(o: &Output) -> SimOutput {
+        SimOutput {
+            log: String::from_utf8_lossy(&o.stdout).into_owned()
+                + &String::from_utf8_lossy(&o.stderr),
+            failure: (!o.status.success()).then(|| o.status.to_string()),
+        }
+    }
+}
+
 /// Compiles the testbench `tb` with the `rtl` files and runs it in `wd` (which holds its hex
 /// files) with the testbench's parameters `params` (`-P` for Icarus, `-G` for Verilator),
-/// defining `SPECFX_VCD` when `vcd`; returns the simulation's output (stdout, then stderr).
+/// defining `SPECFX_VCD` when `vcd`; returns the simulation's output and exit status.
 pub fn simulate(
     sim: Simulator,
     wd: &Path,
@@ -184,10 +204,7 @@ pub fn simulate(
     rtl: &[PathBuf],
     params: &[(String, i64)],
     vcd: bool,
-) -> Result<String, Error> {
-    let text = |o: &Output| {
-        String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr)
-    };
+) -> Result<SimOutput, Error> {
     match sim {
         Simulator::Icarus => {
             let mut cmd = Command::new("iverilog");
@@ -207,7 +224,7 @@ pub fn simulate(
                 ));
             }
             let o = run(Command::new("vvp").args(["-n", "tb.vvp"]), wd, "vvp", "vvp")?;
-            Ok(text(&o))
+            Ok(SimOutput::of(&o))
         }
         Simulator::Verilator => {
             let mut args: Vec<String> = ["-Wno-fatal", "-Wno-lint", "-Wno-style"]
@@ -227,7 +244,7 @@ pub fn simulate(
                 "verilator",
                 "the model",
             )?;
-            Ok(text(&o))
+            Ok(SimOutput::of(&o))
         }
     }
 }
@@ -250,8 +267,8 @@ pub struct DpiRun<'a> {
 }
 
 /// Builds `tb_specfx_dpi` with Verilator (`--binary`, the C library linked) in `wd` and runs it;
-/// returns its output (stdout, then stderr). Icarus Verilog has no DPI-C support.
-pub fn simulate_dpi(wd: &Path, run_spec: &DpiRun) -> Result<String, Error> {
+/// returns its output and exit status. Icarus Verilog has no DPI-C support.
+pub fn simulate_dpi(wd: &Path, run_spec: &DpiRun) -> Result<SimOutput, Error> {
     let opt = [
         if run_spec.optimize {
             "OPT_FAST=-O2"
@@ -289,5 +306,5 @@ pub fn simulate_dpi(wd: &Path, run_spec: &DpiRun) -> Result<String, Error> {
         "verilator",
         "the model",
     )?;
-    Ok(String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr))
+    Ok(SimOutput::of(&o))
 }

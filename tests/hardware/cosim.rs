@@ -293,3 +293,52 @@ fn a_kept_work_directory_outlives_later_runs() {
         kept.display()
     );
 }
+
+/// `specfx cosim` reads the testbench's exit status as well as its count: a testbench that
+/// counts every vector passed but ends with `$fatal` (a check the count does not show) fails
+/// the run, and the reason names the status.
+#[test]
+fn a_testbench_that_fails_its_exit_status_fails_the_run() {
+    let hdl = temp_dir("fatal-tb");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("hdl_ref");
+    for sub in ["rtl", "tb"] {
+        std::fs::create_dir_all(hdl.join(sub)).unwrap();
+        for e in std::fs::read_dir(root.join(sub)).unwrap() {
+            let p = e.unwrap().path();
+            std::fs::copy(&p, hdl.join(sub).join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    let tb = hdl.join("tb/tb_specfx.v");
+    let text = std::fs::read_to_string(&tb).unwrap();
+    let from = "            $finish;\n        end\n    endtask";
+    assert_eq!(
+        text.matches(from).count(),
+        1,
+        "the testbench's ending moved"
+    );
+    let to =
+        "            $fatal(1, \"a check the count does not show\");\n        end\n    endtask";
+    std::fs::write(&tb, text.replace(from, to)).unwrap();
+    let o = specfx(&[
+        "cosim",
+        "--sim",
+        "icarus",
+        "--n",
+        "16,17",
+        "--cases",
+        "corner",
+        "--hdl-ref",
+        hdl.to_str().unwrap(),
+    ]);
+    let (passed, failed) = summary(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(passed > 0 && failed == 0, "{err}");
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!(
+            "the testbench counted {passed} passed, 0 failed but ended with exit status: 1"
+        )),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&hdl).unwrap();
+}

@@ -189,3 +189,37 @@ fn icarus_has_no_dpi_and_says_so() {
         String::from_utf8_lossy(&o.stderr)
     );
 }
+
+/// A `--dpi-lib` (or `$SPECFX_DPI_LIB`) that is not a library is refused before Verilator
+/// builds anything, in one line naming it, exit code 2 (it used to fail after the build, with
+/// a linker error that did not name it).
+#[test]
+fn a_text_file_as_the_dpi_library_is_refused_up_front() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let text = dir.path().join("notes.txt");
+    std::fs::write(&text, "not a library\n").unwrap();
+    let text = text.to_str().unwrap();
+    let o = specfx(&["cosim", "--dpi", "--dpi-lib", text]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains(&format!(
+            "--dpi-lib {text}: not a library, expected libspecfx_c.a"
+        )),
+        "{err}"
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args(["cosim", "--dpi"])
+        .env("SPECFX_DPI_LIB", text)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&format!("SPECFX_DPI_LIB={text}: not a library")),
+        "{err}"
+    );
+    // Nothing was built: the run stopped before its work directory was made.
+    assert!(!err.contains("verilator failed"), "{err}");
+}

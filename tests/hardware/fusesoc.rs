@@ -233,3 +233,82 @@ fn the_lint_target_fails_on_a_warning() {
     assert!(text(&o).contains("%Warning-WIDTH"), "{}", text(&o));
     let _ = std::fs::remove_dir_all(&work);
 }
+
+/// A copy of `hdl_ref/` (the core, the RTL, the testbenches) under `work`, with the output
+/// multiplier of the pipelined core taking the previous stage's coefficient (a coefficient
+/// register skipped).
+fn broken_core(work: &Path) -> PathBuf {
+    let cores = work.join("hdl_ref");
+    for sub in ["rtl", "tb", "dpi"] {
+        std::fs::create_dir_all(cores.join(sub)).unwrap();
+        for e in std::fs::read_dir(root().join("hdl_ref").join(sub)).unwrap() {
+            let p = e.unwrap().path();
+            std::fs::copy(&p, cores.join(sub).join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    std::fs::copy(
+        root().join("hdl_ref/specfx.core"),
+        cores.join("specfx.core"),
+    )
+    .unwrap();
+    let file = cores.join("rtl/specfx_pipelined.v");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let (from, to) = (
+        ".coef(coefs[K*COEF_W +: COEF_W])",
+        ".coef(coefs[(K-1)*COEF_W +: COEF_W])",
+    );
+    assert_eq!(text.matches(from).count(), 1, "the mutated piece moved");
+    std::fs::write(&file, text.replace(from, to)).unwrap();
+    cores
+}
+
+/// A CI job can trust FuseSoC's exit code: with a broken RTL, the sim and dpi targets count
+/// failed vectors and end with a failing status (the testbenches' `$fatal`); and the sim
+/// target without `--NVEC`/`--NCYC` refuses to run (it used to check one vector and pass).
+#[test]
+fn fusesoc_fails_on_a_broken_rtl_and_without_the_vector_count() {
+    let work = temp_dir("broken");
+    let cores = broken_core(&work);
+    let sim = vectors(
+        &work,
+        &["--n", "16,17,100,1024", "--seed", "3"],
+        "pipelined",
+    );
+    let o = fusesoc(&cores, &work, "sim", &sim);
+    let (_, failed) = summary(&o);
+    assert!(failed > 0 && !ok(&o), "sim on a broken RTL:\n{}", text(&o));
+
+    let o = fusesoc(
+        &cores,
+        &work,
+        "dpi",
+        &["--nvec=200".into(), "--seed=9".into()],
+    );
+    let (_, failed) = summary(&o);
+    assert!(failed > 0 && !ok(&o), "dpi on a broken RTL:\n{}", text(&o));
+
+    // The unbroken core without the counts: a refusal naming what to pass, not a pass (in a
+    // build root of its own: FuseSoC would reuse the broken core's build, docs: README).
+    let good = root().join("hdl_ref");
+    let fresh = work.join("unbroken");
+    std::fs::create_dir_all(&fresh).unwrap();
+    for (drop, name, want) in [
+        ("--NVEC=", "NVEC", "n_vectors of manifest.json"),
+        ("--NCYC=", "NCYC", "n_cycles of stim.json"),
+    ] {
+        let flags: Vec<String> = sim
+            .iter()
+            .filter(|f| !f.starts_with(drop))
+            .cloned()
+            .collect();
+        let o = fusesoc(&good, &fresh, "sim", &flags);
+        assert!(!ok(&o), "sim without {name}:\n{}", text(&o));
+        assert!(
+            text(&o).contains(&format!("tb_specfx: {name} is not set: expected {want}")),
+            "sim without {name}:\n{}",
+            text(&o)
+        );
+        assert!(!text(&o).contains(" passed, "), "{}", text(&o));
+    }
+    let _ = std::fs::remove_dir_all(&work);
+}
