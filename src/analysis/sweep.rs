@@ -280,12 +280,17 @@ impl Space {
             .join(";")
     }
 
-    /// The configuration and architecture of point `index`.
+    /// The configuration and architecture of point `index`: the `arch` axis's value, else the
+    /// base's `arch` key, else pipelined (a base that records an architecture records the
+    /// point's).
     pub fn point(&self, index: u64) -> Result<(Config, Arch), Error> {
         let mut cfg = self.base.clone();
-        let mut arch = Arch::Pipelined;
+        let mut arch = self.base.resolve_arch(None);
         for (key, v) in self.point_values(index) {
             apply(&mut cfg, &mut arch, &key, &v)?;
+        }
+        if cfg.arch.is_some() {
+            cfg.arch = Some(arch);
         }
         cfg.name = format!("point{index}");
         Ok((cfg, arch))

@@ -126,6 +126,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     let opened = specfx::input::open_vectors(&vectors)?;
     let dp = specfx::pipeline::Datapath::new(opened.config.clone())
         .context("the manifest's configuration")?;
+    let arch = dp.config().resolve_arch(args.run.arch);
     // The --vcd directory is made with the model's trace, once the stimulus is known to fit.
     let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
     let stim = write_stimulus(&opened, args.run, wd, model_vcd.as_deref())?;
@@ -147,14 +148,14 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         ("NVEC".to_string(), stim.n_vectors as i64),
         ("NCYC".to_string(), stim.n_cycles as i64),
     ];
-    params.extend(top_parameters(&dp, args.run.arch, args.reset_data));
+    params.extend(top_parameters(&dp, arch, args.reset_data));
     if args.lint && !lint_clean(&rtl, &params)? {
         return Ok(Outcome::CheckFailed);
     }
     log::info!(
         "cosim: {}, {}, {} vectors ({}), {} stimulus cycles (seed {}, bubble {}, stall {}){}",
         sim.name(),
-        args.run.arch,
+        arch,
         stim.n_vectors,
         dp.config().name,
         stim.n_cycles,
@@ -197,7 +198,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
         Some((model, rtl)) => compare_traces(model, rtl, failure.is_some())?,
         None => None,
     };
-    let at = format!("({}, {})", sim.name(), args.run.arch);
+    let at = format!("({}, {})", sim.name(), arch);
     match (failure, traces_differ) {
         (None, None) => Ok(Outcome::Ok),
         (failure, differ) => {

@@ -105,6 +105,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     let config = wd.join("config.toml");
     specfx::output::write_atomic(&config, dp.config().to_toml().as_bytes())?;
     let run = &args.run;
+    let arch = dp.config().resolve_arch(run.arch);
     let mut plusargs = vec![
         format!("config={}", config.display()),
         format!("seed={}", run.seed),
@@ -130,10 +131,10 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     };
     plusargs.push(format!("bubble={}", percent(bubble)));
     plusargs.push(format!("stall={}", percent(stall)));
-    let params = top_parameters(&dp, run.arch, args.reset_data);
+    let params = top_parameters(&dp, arch, args.reset_data);
     log::info!(
         "cosim --dpi: verilator, {}, {} ({}), seed {}{}",
-        run.arch,
+        arch,
         what,
         dp.config().name,
         run.seed,
@@ -166,7 +167,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     match print_verdict(&verdict, out.failure.as_deref())? {
         None => Ok(Outcome::Ok),
         Some(why) => {
-            log::error!("cosim --dpi: FAIL (verilator, {}): {why}", run.arch);
+            log::error!("cosim --dpi: FAIL (verilator, {}): {why}", arch);
             Ok(Outcome::CheckFailed)
         }
     }

@@ -19,9 +19,10 @@ pub struct CostArgs {
     /// A TOML configuration file, a vector directory, or a built-in name: baseline.
     #[arg(long, default_value = "baseline")]
     config: String,
-    /// Microarchitecture: pipelined or folded.
-    #[arg(long, default_value = "pipelined")]
-    arch: Arch,
+    /// Microarchitecture: pipelined or folded [default: the configuration's `arch` key, else
+    /// pipelined].
+    #[arg(long)]
+    arch: Option<Arch>,
     /// Synthesis target: generic (gates and a CMOS transistor estimate), ice40 or xilinx.
     #[arg(long, default_value = "ice40")]
     target: Target,
@@ -65,6 +66,7 @@ pub fn run(args: &CostArgs) -> Result<Outcome> {
     }
     let device = args.device.unwrap_or(specfx::hdl::pnr::Device::Up5k);
     let dp = specfx::input::load_datapath(&args.config, None)?;
+    let arch = dp.config().resolve_arch(args.arch);
     let dir = if args.analytic_only {
         hdl_ref_dir(args.hdl_ref.as_deref())
     } else {
@@ -75,7 +77,7 @@ pub fn run(args: &CostArgs) -> Result<Outcome> {
         }
         dir
     };
-    let mut r = tools::yosys::cost_report(&dp, args.arch, args.target, &dir, args.analytic_only)?;
+    let mut r = tools::yosys::cost_report(&dp, arch, args.target, &dir, args.analytic_only)?;
     if args.target == Target::Ice40 {
         let (dsps, luts, ffs) = match &r.yosys {
             Some(y) => (y.dsps, y.luts, y.ffs),
@@ -85,9 +87,7 @@ pub fn run(args: &CostArgs) -> Result<Outcome> {
         r.over_limit = specfx::hdl::pnr::device_check(dsps, luts, ffs, device);
     }
     if args.timing {
-        r.timing = Some(tools::nextpnr::place_and_route(
-            &dp, args.arch, device, &dir,
-        )?);
+        r.timing = Some(tools::nextpnr::place_and_route(&dp, arch, device, &dir)?);
     }
     if args.json {
         print_json(&r)?;

@@ -73,9 +73,10 @@ struct ParamsArgs {
     /// A vector directory: use the configuration of its manifest.
     #[arg(long)]
     vectors: Option<PathBuf>,
-    /// Microarchitecture: pipelined or folded.
-    #[arg(long, default_value = "pipelined")]
-    arch: Arch,
+    /// Microarchitecture: pipelined or folded [default: the configuration's `arch` key, else
+    /// pipelined].
+    #[arg(long)]
+    arch: Option<Arch>,
     /// How to render the parameters of `specfx_top`: define (the `specfx_params.vh` header of
     /// `specfx_dut.v`), json, iverilog (`-P` flags), verilator (`-G` flags) or instance (a
     /// Verilog instantiation).
@@ -113,9 +114,10 @@ struct RomArgs {
 /// (`specfx hdl stimulus`, `specfx cosim`).
 #[derive(Debug, Clone, Copy, Args)]
 pub struct RunOpts {
-    /// Microarchitecture: pipelined or folded.
-    #[arg(long, default_value = "pipelined")]
-    pub arch: Arch,
+    /// Microarchitecture: pipelined or folded [default: the `arch` key of the configuration
+    /// (of the vectors' manifest), else pipelined].
+    #[arg(long)]
+    pub arch: Option<Arch>,
     /// Seed of the bubble/stall patterns (`cosim`: also of the vectors it writes).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -203,7 +205,7 @@ fn params(args: &ParamsArgs) -> Result<Outcome> {
     };
     let text = render_parameters(
         &dp,
-        args.arch,
+        dp.config().resolve_arch(args.arch),
         args.reset_data,
         args.format.into(),
         &args.top,
@@ -252,6 +254,8 @@ pub struct StimulusInfo {
     pub n_cycles: u64,
     /// Shortest and longest input-to-output latency of the run, in cycles.
     pub latency: (u64, u64),
+    /// The microarchitecture of the run (`--arch`, else the manifest's `arch` key).
+    pub arch: Arch,
 }
 
 /// Writes the co-simulation stimulus of an opened vector directory into `out`
@@ -271,6 +275,7 @@ pub fn write_stimulus(
         bubble,
         stall,
     } = run;
+    let arch = dp.config().resolve_arch(arch);
     let run = StimulusRun {
         arch,
         seed,
@@ -292,6 +297,7 @@ pub fn write_stimulus(
         n_vectors: s.n_vectors,
         n_cycles: s.n_cycles,
         latency: s.latency,
+        arch,
     })
 }
 
@@ -340,7 +346,7 @@ fn stimulus(args: &StimulusArgs) -> Result<Outcome> {
         "{} vectors over {} cycles ({}, latency {}..{})",
         s.n_vectors,
         s.n_cycles,
-        args.run.arch,
+        s.arch,
         s.latency.0,
         s.latency.1
     )?;

@@ -61,8 +61,9 @@ pub struct OptimizeArgs {
     /// Fraction bits every searched stage starts from (must meet the budget).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(i32).range(1..=48))]
     start_frac: i32,
-    /// Microarchitecture costed: pipelined or folded. Left out: pipelined, and folded for an
-    /// algorithm whose pipelined answer does not fit the device.
+    /// Microarchitecture costed: pipelined or folded. Left out: the base configuration's `arch`
+    /// key; without one, pipelined, and folded for an algorithm whose pipelined answer does
+    /// not fit the device. The answer's TOML records the one it was costed with (`arch`).
     #[arg(long)]
     arch: Option<Arch>,
     /// The device every answer must fit (its DSP blocks, LUTs and flip-flops, by the analytic
@@ -109,6 +110,8 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         args.force,
     )?;
     let base = dp.config().clone();
+    // --arch, else the base configuration's own (an earlier answer's); neither: auto.
+    let chosen_arch = args.arch.or(base.arch);
     if let Some(&k) = args
         .k
         .values()
@@ -119,7 +122,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     }
     let yosys = args.objective == Objective::Yosys;
     let hdl = super::hdl_ref::hdl_ref_dir(None);
-    let arch = args.arch.unwrap_or(Arch::Pipelined);
+    let arch = base.resolve_arch(args.arch);
     let target = args.target;
     let device = match args.device {
         Some(DeviceLimit(d)) => d,
@@ -141,7 +144,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     }
     let fit = device.map(|device| DeviceFit {
         device,
-        fold_when_needed: args.arch.is_none(),
+        fold_when_needed: chosen_arch.is_none(),
     });
     let unit = match dsp_weight(target) {
         w if w > 0.0 => format!(
@@ -243,6 +246,9 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     budget.arch = arch;
     let mut config = best.config.clone();
     config.name = "optimized".into();
+    // The answer records the microarchitecture it was costed with: cost, timing, sim, hdl,
+    // vectors and cosim read it as their default.
+    config.arch = Some(arch);
     let dp = Datapath::new(config.clone())?;
     let proof = check(&dp)?;
     if !budget.met_by(&proof.output_figures(), &dp)
@@ -290,7 +296,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             .option("depth", args.depth.name())
             .option(
                 "arch",
-                args.arch.map_or("auto".to_string(), |a| a.to_string()),
+                chosen_arch.map_or("auto".to_string(), |a| a.to_string()),
             )
             .option("device", device.map_or("none", |d| d.name())),
     );

@@ -20,9 +20,10 @@ pub struct TimingArgs {
     /// A TOML configuration file, a vector directory, or a built-in name: baseline.
     #[arg(long, default_value = "baseline")]
     config: String,
-    /// Microarchitecture: pipelined or folded.
-    #[arg(long, default_value = "pipelined")]
-    arch: Arch,
+    /// Microarchitecture: pipelined or folded [default: the configuration's `arch` key, else
+    /// pipelined].
+    #[arg(long)]
+    arch: Option<Arch>,
     /// Device: up5k (iCE40 UltraPlus UP5K, SG48, 8 DSPs) or hx8k (iCE40 HX8K, CT256, no DSPs).
     #[arg(long, default_value = "up5k")]
     device: Device,
@@ -38,9 +39,10 @@ pub struct TimingArgs {
 /// Runs `specfx timing`.
 pub fn run(args: &TimingArgs) -> Result<Outcome> {
     let dp = specfx::input::load_datapath(&args.config, None)?;
+    let arch = dp.config().resolve_arch(args.arch);
     let dir = hdl_ref(args.hdl_ref.as_deref())?;
     tools::yosys::check()?;
-    let t = tools::nextpnr::place_and_route(&dp, args.arch, args.device, &dir)?;
+    let t = tools::nextpnr::place_and_route(&dp, arch, args.device, &dir)?;
     if args.json {
         print_json(&t)?;
     } else {

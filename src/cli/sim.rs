@@ -27,9 +27,10 @@ pub struct SimArgs {
     /// A TOML configuration file, a vector directory, or a built-in name: baseline.
     #[arg(long, default_value = "baseline")]
     config: String,
-    /// Microarchitecture: pipelined or folded.
-    #[arg(long, default_value = "pipelined")]
-    arch: Arch,
+    /// Microarchitecture: pipelined or folded [default: the configuration's `arch` key, else
+    /// pipelined].
+    #[arg(long)]
+    arch: Option<Arch>,
     /// Cycles to simulate.
     #[arg(long, default_value_t = 10_000)]
     cycles: u64,
@@ -73,6 +74,7 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
         bail!("--cycles: expected 1..={MAX_CYCLES}, got {}", args.cycles);
     }
     let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
+    let arch = dp.config().resolve_arch(args.arch);
     if let Some(path) = &args.vcd {
         specfx::output::check_file_output(
             path,
@@ -95,7 +97,7 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
     };
     let result = simulate_stream(
         &dp,
-        args.arch,
+        arch,
         args.stream,
         args.seed,
         &mut stim,
@@ -104,7 +106,7 @@ pub fn run(args: &SimArgs) -> Result<Outcome> {
     );
     if let Some(path) = &args.vcd {
         let mut buf = Vec::new();
-        write_vcd(&mut buf, &dp, args.arch, &result.trace)?;
+        write_vcd(&mut buf, &dp, arch, &result.trace)?;
         specfx::output::write_atomic(path, &buf)?;
     }
     let s = &result.stats;

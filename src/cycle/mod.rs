@@ -30,62 +30,12 @@ pub mod sim;
 pub mod stimulus;
 pub mod vcd;
 
-use serde::Serialize;
-
 use crate::pipeline::walk::Stage;
 use crate::pipeline::Datapath;
 
-/// The two microarchitectures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Arch {
-    /// One new input per cycle; every operation its own stage with its register latency.
-    Pipelined,
-    /// One shared multiplier for all k + 2 products, driven by an FSM.
-    Folded,
-}
-
-impl Arch {
-    /// Both architectures.
-    pub const ALL: [Arch; 2] = [Arch::Pipelined, Arch::Folded];
-
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Arch::Pipelined => "pipelined",
-            Arch::Folded => "folded",
-        }
-    }
-
-    /// Cycles from an input's transfer to its output's transfer when nothing stalls.
-    ///
-    /// # Examples
-    /// ```
-    /// use specfx::cycle::Arch;
-    /// use specfx::pipeline::Config;
-    /// let cfg = Config::baseline();
-    /// assert_eq!(Arch::Pipelined.latency(&cfg), 8);
-    /// assert_eq!(Arch::Folded.latency(&cfg), 7);
-    /// ```
-    pub fn latency(self, cfg: &crate::pipeline::Config) -> u64 {
-        let l = &cfg.latency;
-        let k = u64::from(cfg.k);
-        match self {
-            Arch::Pipelined => u64::from(l.sub + l.add) + (k + 2) * u64::from(l.mul),
-            Arch::Folded => (k + 2) * u64::from(l.mul) + 1,
-        }
-    }
-
-    /// Cycles between the starts of two inputs when nothing stalls.
-    pub fn initiation_interval(self, cfg: &crate::pipeline::Config) -> u64 {
-        match self {
-            Arch::Pipelined => 1,
-            Arch::Folded => (u64::from(cfg.k) + 2) * u64::from(cfg.latency.mul),
-        }
-    }
-}
-
-crate::names::named_enum!(Arch, "architecture", "pipelined or folded");
+/// The two microarchitectures (defined beside [`crate::pipeline::Config`], whose `arch` key
+/// records the one a configuration was costed with).
+pub use crate::pipeline::Arch;
 
 /// One input of a stream: its sequence number, the index of its n in the datapath's n set,
 /// its raw input code, and its output under the functional model.

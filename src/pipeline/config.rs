@@ -197,6 +197,60 @@ pub struct LatencySpec {
     pub add: u32,
 }
 
+/// The two microarchitectures of the cycle model and the reference RTL (`docs/cycle.md`).
+/// A configuration may record one (its `arch` key, [`Config::arch`]); every command that
+/// costs, simulates or emits a datapath takes [`Config::resolve_arch`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Arch {
+    /// One new input per cycle; every operation its own stage with its register latency.
+    Pipelined,
+    /// One shared multiplier for all k + 2 products, driven by an FSM.
+    Folded,
+}
+
+impl Arch {
+    /// Both architectures.
+    pub const ALL: [Arch; 2] = [Arch::Pipelined, Arch::Folded];
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Arch::Pipelined => "pipelined",
+            Arch::Folded => "folded",
+        }
+    }
+
+    /// Cycles from an input's transfer to its output's transfer when nothing stalls.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::cycle::Arch;
+    /// use specfx::pipeline::Config;
+    /// let cfg = Config::baseline();
+    /// assert_eq!(Arch::Pipelined.latency(&cfg), 8);
+    /// assert_eq!(Arch::Folded.latency(&cfg), 7);
+    /// ```
+    pub fn latency(self, cfg: &Config) -> u64 {
+        let l = &cfg.latency;
+        let k = u64::from(cfg.k);
+        match self {
+            Arch::Pipelined => u64::from(l.sub + l.add) + (k + 2) * u64::from(l.mul),
+            Arch::Folded => (k + 2) * u64::from(l.mul) + 1,
+        }
+    }
+
+    /// Cycles between the starts of two inputs when nothing stalls.
+    pub fn initiation_interval(self, cfg: &Config) -> u64 {
+        match self {
+            Arch::Pipelined => 1,
+            Arch::Folded => (u64::from(cfg.k) + 2) * u64::from(cfg.latency.mul),
+        }
+    }
+}
+
+crate::names::named_enum!(Arch, "architecture", "pipelined or folded");
+
 /// A complete datapath configuration. See `docs/arithmetic.md` for the arithmetic it implies.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -232,6 +286,16 @@ pub struct Config {
     pub minimax: MinimaxSpec,
     /// Register latencies for the cycle-level model and the RTL.
     pub latency: LatencySpec,
+    /// The microarchitecture the configuration was made for (`optimize` records the one its
+    /// answer was costed with): the default of every command that reads the configuration,
+    /// which a command's `--arch` overrides ([`Config::resolve_arch`]). Left out: none
+    /// recorded, pipelined.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "arch_key"
+    )]
+    pub arch: Option<Arch>,
 }
 
 fn fmt(s: &str) -> Format {
@@ -353,6 +417,22 @@ impl Config {
         !self.depth.is_fixed() && self.n.values().iter().any(|&n| self.depth_of(n) < self.k)
     }
 
+    /// The microarchitecture a command uses: its `--arch` flag when given, else the one the
+    /// configuration records (its `arch` key), else pipelined. Every command that reads a
+    /// configuration and costs, simulates or emits it resolves its architecture here.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::pipeline::{Arch, Config};
+    /// let folded = Config::from_toml("arch = \"folded\"").unwrap();
+    /// assert_eq!(folded.resolve_arch(None), Arch::Folded);
+    /// assert_eq!(folded.resolve_arch(Some(Arch::Pipelined)), Arch::Pipelined);
+    /// assert_eq!(Config::baseline().resolve_arch(None), Arch::Pipelined);
+    /// ```
+    pub fn resolve_arch(&self, flag: Option<Arch>) -> Arch {
+        flag.or(self.arch).unwrap_or(Arch::Pipelined)
+    }
+
     /// The built-in `baseline` configuration (see `docs/arithmetic.md`).
     ///
     /// # Examples
@@ -402,6 +482,7 @@ impl Config {
                 mul: 1,
                 add: 1,
             },
+            arch: None,
         }
     }
 
@@ -535,6 +616,19 @@ pub(crate) struct ConfigFile {
     out: Option<StagePatch>,
     minimax: Option<MinimaxPatch>,
     latency: Option<LatencyPatch>,
+    #[serde(default, deserialize_with = "arch_key")]
+    arch: Option<Arch>,
+}
+
+/// The `arch` key: `"pipelined"` or `"folded"` (any case), refused with both names otherwise.
+fn arch_key<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Arch>, D::Error> {
+    let value = toml::Value::deserialize(d)?;
+    match value.as_str().map(str::parse::<Arch>) {
+        Some(Ok(arch)) => Ok(Some(arch)),
+        _ => Err(serde::de::Error::custom(format!(
+            "arch: expected \"pipelined\" or \"folded\" (the microarchitecture), got {value}"
+        ))),
+    }
 }
 
 impl ConfigFile {
@@ -613,6 +707,7 @@ impl ConfigFile {
                 rounding: mm.rounding.unwrap_or(base.minimax.rounding),
             },
             latency,
+            arch: self.arch.or(base.arch),
         })
     }
 }
@@ -667,6 +762,36 @@ mod tests {
             e,
             "square: expected one [square] table for all stages or k = 3 [[square]] tables, got 2"
         );
+    }
+
+    #[test]
+    fn arch_is_recorded_read_back_and_checked() {
+        let mut c = Config::baseline();
+        assert!(!c.to_toml().contains("arch"), "no arch recorded, no key");
+        c.arch = Some(Arch::Folded);
+        let text = c.to_toml();
+        assert!(text.contains("arch = \"folded\""), "{text}");
+        assert_eq!(Config::from_toml(&text).unwrap(), c);
+        let c = Config::from_toml("arch = \"Pipelined\"").unwrap();
+        assert_eq!(c.arch, Some(Arch::Pipelined));
+        for (text, got) in [("arch = \"fold\"", "\"fold\""), ("arch = 1", "1")] {
+            let e = Config::from_toml(text).unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!(
+                    "line 1: arch: expected \"pipelined\" or \"folded\" (the microarchitecture), got {got}"
+                )
+            );
+        }
+        // The flag wins, then the key, then pipelined.
+        let folded = Config::from_toml("arch = \"folded\"").unwrap();
+        assert_eq!(folded.resolve_arch(Some(Arch::Pipelined)), Arch::Pipelined);
+        assert_eq!(folded.resolve_arch(None), Arch::Folded);
+        assert_eq!(
+            Config::baseline().resolve_arch(Some(Arch::Folded)),
+            Arch::Folded
+        );
+        assert_eq!(Config::baseline().resolve_arch(None), Arch::Pipelined);
     }
 
     #[test]

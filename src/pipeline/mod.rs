@@ -23,8 +23,8 @@ pub mod fast;
 pub mod walk;
 
 pub use config::{
-    CoefSpec, Config, Depth, DepthStep, FormatSpec, LatencySpec, MinimaxSpec, StageSpec, Variant,
-    DEPTH_BITS,
+    Arch, CoefSpec, Config, Depth, DepthStep, FormatSpec, LatencySpec, MinimaxSpec, StageSpec,
+    Variant, DEPTH_BITS,
 };
 pub use datapath::{
     first_code_where, Datapath, NConstants, OutputScratch, ProbeColumns, Probes, StageInfo,

@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod arch;
 mod calibrate_shards;
 mod children;
 mod cli;

@@ -107,6 +107,7 @@ prop_compose! {
                 rounding: Rounding::Rnd,
             },
             latency: LatencySpec { sub: lat.0, mul: lat.1, add: lat.2 },
+            arch: None,
         }
     }
 }
