@@ -250,6 +250,13 @@ pub struct Assignment {
 }
 
 impl Assignment {
+    /// Whether the shards come from a scheduler's task or are several: each then needs a
+    /// directory of its own (a `{shard}` placeholder), and the log says which this process
+    /// took.
+    pub fn several_or_scheduled(&self) -> bool {
+        self.task.is_some() || self.shards.len() > 1
+    }
+
     /// One line for the log: which task this is and which shards it takes.
     pub fn describe(&self) -> String {
         let shards = self
@@ -370,6 +377,58 @@ pub fn assign(
             })
         }
     }
+}
+
+/// The shards this process runs under `spec` (see [`assign`]) and the directory of each: the
+/// path `template` of the option `flag` (`--out`, `--data`) with `{shard}` replaced by the
+/// shard's index (see [`shard_path`]). Every directory is known before the first shard runs,
+/// so a missing placeholder is refused before any work.
+///
+/// # Examples
+/// ```
+/// use specfx::analysis::cluster::{assign_dirs, ShardSpec};
+/// use std::path::{Path, PathBuf};
+/// let env = |var: &str| (var == "SLURM_ARRAY_TASK_ID").then(|| "1".to_string());
+/// let spec = ShardSpec::Auto { count: Some(4) };
+/// let (a, dirs) = assign_dirs(spec, 2, &env, Path::new("o/s{shard}"), "--out").unwrap();
+/// assert_eq!(a.shards, vec![1, 3]);
+/// assert_eq!(dirs, vec![PathBuf::from("o/s1"), PathBuf::from("o/s3")]);
+/// let e = assign_dirs(spec, 2, &env, Path::new("cal"), "--data").unwrap_err();
+/// assert!(e.to_string().starts_with("--data: expected a {shard} placeholder"));
+/// ```
+pub fn assign_dirs(
+    spec: ShardSpec,
+    per_task: u64,
+    env: &dyn Fn(&str) -> Option<String>,
+    template: &std::path::Path,
+    flag: &str,
+) -> Result<(Assignment, Vec<std::path::PathBuf>), Error> {
+    let assignment = assign(spec, per_task, env)?;
+    let required = assignment.several_or_scheduled();
+    let dirs = assignment
+        .shards
+        .iter()
+        .map(|&i| match template.to_str() {
+            Some(t) => shard_path(t, i, assignment.count, required)
+                .map(std::path::PathBuf::from)
+                .map_err(|e| match e {
+                    Error::Cluster { problem, .. } => Error::Cluster {
+                        option: flag.to_string(),
+                        problem,
+                    },
+                    e => e,
+                }),
+            None if required => Err(Error::Cluster {
+                option: flag.to_string(),
+                problem: format!(
+                    "expected a UTF-8 path holding {SHARD_PLACEHOLDER}, got {}",
+                    crate::error::OneLine(&template.display().to_string())
+                ),
+            }),
+            None => Ok(template.to_path_buf()),
+        })
+        .collect::<Result<_, Error>>()?;
+    Ok((assignment, dirs))
 }
 
 /// The placeholder of a shard's index in an output path.

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 
 use super::output::{print_json, print_with};
 use super::Outcome;
-use specfx::analysis::cluster::{assign, parse_shard_spec, shard_path, ShardSpec};
+use specfx::analysis::cluster::{assign_dirs, parse_shard_spec, ShardSpec};
 use specfx::hdl::calibrate::{
     calibration, fit, merge_records, read_records, sample, Calibration, Record, TargetFit,
 };
@@ -327,25 +327,8 @@ pub fn run(args: &CalibrateArgs) -> Result<Outcome> {
         bail!("--shard: a shard synthesises its part of the sample; --fit-only fits whole records (after `specfx calibrate merge`)");
     }
     let env = |var: &str| std::env::var(var).ok();
-    let assignment = assign(spec, args.shards_per_task, &env)?;
-    let required = assignment.task.is_some() || assignment.shards.len() > 1;
-    let template = args
-        .data
-        .to_str()
-        .ok_or_else(|| anyhow::anyhow!("--data {}: expected a UTF-8 path", args.data.display()))?;
-    let dirs: Vec<PathBuf> = assignment
-        .shards
-        .iter()
-        .map(|&i| {
-            Ok(PathBuf::from(shard_path(
-                template,
-                i,
-                assignment.count,
-                required,
-            )?))
-        })
-        .collect::<Result<_>>()?;
-    if matches!(spec, ShardSpec::Auto { .. }) || assignment.shards.len() > 1 {
+    let (assignment, dirs) = assign_dirs(spec, args.shards_per_task, &env, &args.data, "--data")?;
+    if assignment.several_or_scheduled() {
         log::info!("calibrate: {}", assignment.describe());
     }
     for (&i, dir) in assignment.shards.iter().zip(&dirs) {

@@ -11,8 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::Outcome;
 use specfx::analysis::cluster::{
-    assign, parse_shard_spec, shard_path, Emit, Plan, PointCost, ShardSpec, MAX_SHARDS_PER_TASK,
-    MAX_TASKS, SHARD_PLACEHOLDER,
+    assign_dirs, parse_shard_spec, Emit, Plan, PointCost, ShardSpec, MAX_SHARDS_PER_TASK, MAX_TASKS,
 };
 use specfx::analysis::sweep::{
     check_shard_complete, check_shards, mark_pareto, same_space, Evaluator, GivenShard, LogUse,
@@ -329,30 +328,8 @@ pub fn run(args: &SweepArgs) -> Result<Outcome> {
         .shard
         .unwrap_or(ShardSpec::Given { index: 0, count: 1 });
     let env = |var: &str| std::env::var(var).ok();
-    let assignment = assign(spec, args.shards_per_task, &env)?;
-    // Every directory is known before the first point: a missing placeholder is refused first.
-    let required = assignment.task.is_some() || assignment.shards.len() > 1;
-    let dirs: Vec<PathBuf> = assignment
-        .shards
-        .iter()
-        .map(|&i| {
-            let template = match args.out.to_str() {
-                Some(t) => t,
-                None if required => bail!(
-                    "--out {}: expected a UTF-8 path holding {SHARD_PLACEHOLDER}",
-                    args.out.display()
-                ),
-                None => return Ok(args.out.clone()),
-            };
-            Ok(PathBuf::from(shard_path(
-                template,
-                i,
-                assignment.count,
-                required,
-            )?))
-        })
-        .collect::<Result<_>>()?;
-    if matches!(spec, ShardSpec::Auto { .. }) || assignment.shards.len() > 1 {
+    let (assignment, dirs) = assign_dirs(spec, args.shards_per_task, &env, &args.out, "--out")?;
+    if assignment.several_or_scheduled() {
         log::info!("sweep: {}", assignment.describe());
     }
     let target = space.target;

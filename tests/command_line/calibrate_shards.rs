@@ -157,4 +157,21 @@ fn calibration_shards_merge_into_the_one_file_and_conflicts_are_refused() {
         );
     }
     assert_eq!(std::fs::read(out.join("ice40.jsonl")).unwrap(), before);
+    // A scheduler's task without {shard} in --data: refused under the flag's own name.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_specfx"))
+        .args([
+            "calibrate",
+            "--targets",
+            "ice40",
+            "--count",
+            "6",
+            "--shard",
+            "auto/3",
+        ])
+        .args(["--data", &s(&root.join("cal"))])
+        .env("SPECFX_TASK_ID", "0")
+        .output()
+        .unwrap();
+    refused(&o, "--data: expected a {shard} placeholder");
+    assert!(!root.join("cal").exists());
 }
