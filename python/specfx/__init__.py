@@ -12,10 +12,14 @@ The same engine as the ``specfx`` command line, for cocotb scoreboards and noteb
 Raw codes are integers (two's complement for signed formats, every format up to 64 bits).
 An input outside the model's domain (an n not in the configuration's set, a code outside the
 input format) raises ``ValueError`` with the command line's message, as does a configuration
-the command line refuses.
+the command line refuses; so do a negative or too large integer, a float or a bool where an
+integer code, exponent or seed is expected (never truncated), and a read-only ``out=``. A
+result too large for the memory raises ``MemoryError``. Nothing raises Rust's
+``PanicException``.
 """
 
 import json
+import operator
 from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
@@ -45,6 +49,21 @@ def _codes(x: Any, what: str, dtype: Any) -> np.ndarray:
             bad = lo if lo < info.min else hi
             raise ValueError(f"{what} = {bad} does not fit in {np.dtype(dtype).name}")
     return a.astype(dtype, copy=False)
+
+
+def _int(x: Any, what: str, dtype: Any) -> int:
+    """``x``, one integer (a Python or numpy integer, or a 0-d integer array), as an ``int``
+    that fits in ``dtype``: a float (``16.5``), a bool or a value that does not fit raises
+    ``ValueError`` naming ``what`` (never truncated, never ``OverflowError``)."""
+    if isinstance(x, np.ndarray) and x.ndim == 0:
+        x = x[()]
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)):
+        raise ValueError(f"{what}: expected an integer, got {type(x).__name__}")
+    v = operator.index(x)
+    info = np.iinfo(dtype)
+    if not info.min <= v <= info.max:
+        raise ValueError(f"{what} = {v} does not fit in {np.dtype(dtype).name}")
+    return v
 
 
 class Datapath:
@@ -116,9 +135,10 @@ class Datapath:
         fraction bits; ``threshold`` is None unless the paper cutoff applies) and their values
         before quantization (``*_value``); ``depth`` is j(n), the squarings n uses (k for a
         fixed depth; the RTL's ``in_depth``)."""
-        s, sf, o, of, th, coef, sv, ov, cv, depth = self._m.constants(int(n))
+        n = _int(n, "n", np.uint32)
+        s, sf, o, of, th, coef, sv, ov, cv, depth = self._m.constants(n)
         return {
-            "n": int(n),
+            "n": n,
             "slope": s,
             "slope_frac": sf,
             "offset": o,
@@ -154,11 +174,11 @@ class Datapath:
         or one ``n``), computed on every core with the GIL released. ``out``, a C-contiguous
         int64 array of that shape, receives the codes instead of a new array (reusing it saves
         the allocation, as numpy's ``out=``); when an input is outside the model's domain the
-        ``ValueError`` comes after some of it may have been written, as with numpy's ``out=``."""
+        ``ValueError`` comes after some of it may have been written, as with numpy's ``out=``.
+        A read-only ``out`` raises ``ValueError``; ``out`` may be an input (``eval(c, 64,
+        out=c)``, ``c`` int64): the result is the same as into a fresh array."""
         if out is None and np.ndim(c) == 0 and np.ndim(n) == 0:
-            _codes(c, "c", np.int64)
-            _codes(n, "n", np.uint32)
-            return self._m.eval(int(c), int(n))
+            return self._m.eval(_int(c, "c", np.int64), _int(n, "n", np.uint32))
         cs, ns, n_all, shape = self._pairs(c, n)
         if out is None:
             return self._m.eval_array(cs, ns, n_all).reshape(shape)
@@ -172,7 +192,15 @@ class Datapath:
                 f"out: expected a C-contiguous int64 array of shape {shape}, got "
                 f"{getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}"
             )
-        self._m.eval_into(cs, ns, n_all, out.reshape(-1))
+        flat = out.reshape(-1)
+        # out may be an input (or overlap one): the inputs are read from a copy, so that the
+        # result is the one a fresh out would get (the native half copies too when it sees the
+        # overlap; this also covers views it cannot relate).
+        if np.may_share_memory(flat, cs):
+            cs = cs.copy()
+        if ns is not None and np.may_share_memory(flat, ns):
+            ns = ns.copy()
+        self._m.eval_into(cs, ns, n_all, flat)
         return out
 
     def probes(self, c: IntOrArray, n: IntOrArray) -> Dict[str, Any]:
@@ -200,7 +228,7 @@ class Datapath:
         ends of the code range, 1.0 and above, every cutoff switch +-1 code), codes with a
         non-zero output, and the inputs on and next to every stage's rounding boundary,
         interleaved with ``seed``. Returns ``(n, c)``, two arrays."""
-        return self._m.directed(int(seed))
+        return self._m.directed(_int(seed, "seed", np.uint64))
 
     def check(self) -> Dict[str, Any]:
         """The exhaustive check of every input code up to 1.0 and every n: the same figures as
@@ -222,7 +250,16 @@ class Machine:
         """What the ports show during this cycle, given the input offered (``(c, n)`` when
         in_valid is high, else None) and out_ready: ``(in_ready, out)``, ``out`` being
         ``(input number, raw code)`` when out_valid is high, else None; then the clock edge
-        (the input transfers when in_ready is high)."""
+        (the input transfers when in_ready is high). A bad input (not a pair of integers, an n
+        outside the set, a code outside the input format) raises ``ValueError`` and the machine
+        does not move."""
+        if input is not None:
+            if not isinstance(input, (tuple, list)) or len(input) != 2:
+                got = type(input).__name__
+                if isinstance(input, (tuple, list)):
+                    got = f"a {got} of {len(input)}"
+                raise ValueError(f"input: expected None or a pair (c, n), got {got}")
+            input = (_int(input[0], "c", np.int64), _int(input[1], "n", np.uint32))
         return self._m.cycle(input, bool(out_ready))
 
     def registers(self) -> List[tuple]:

@@ -4,7 +4,8 @@
 directories of configurations at the edges (one-bit stages, a 64-bit signed output, a signed
 input, 63-bit inputs, every rounding and overflow mode), outputs, probes and constants;
 `check()` gives what `specfx check --json` prints; bad input raises ValueError with the command
-line's message; batch work releases the GIL.
+line's message; batch work releases the GIL; nothing crosses the boundary as a panic (a
+read-only out=, an out= that is an input, integers out of range or floats, memory exhaustion).
 
 Run by tests/hardware/python.rs with the virtual environment ./scripts/test makes (the wheel
 installed): SPECFX names the specfx binary, SPECFX_CONFIGS the tests/configs directory.
@@ -13,6 +14,7 @@ installed): SPECFX names the specfx binary, SPECFX_CONFIGS the tests/configs dir
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -151,6 +153,132 @@ class Errors(unittest.TestCase):
             dp.probes(np.array([1, 2, 3]), np.array([16, 17]))
         with self.assertRaises(ValueError):
             dp.constants(15)
+
+
+# Run in a child Python: its address space limited (RLIMIT_AS) to what it uses plus 256 MiB
+# once its inputs exist, every result too large must raise MemoryError (the process aborted on
+# an allocation failure before), and the interpreter carries on.
+MEMORY_SCRIPT = """
+import resource
+import numpy as np, specfx
+dp = specfx.Datapath()
+dp.eval(np.arange(100), 64)  # the worker threads started before the limit
+c = np.zeros(2**27, np.int64)  # 1 GiB of address space, never touched
+n = np.full(2**27, 64, np.uint32)
+with open("/proc/self/status") as f:
+    vm = next(int(l.split()[1]) * 1024 for l in f if l.startswith("VmSize:"))
+resource.setrlimit(resource.RLIMIT_AS, (vm + (256 << 20), resource.RLIM_INFINITY))
+calls = [
+    lambda: dp.eval(c, 64),
+    lambda: dp.eval(c, n),
+    lambda: dp.probes(c[: 2**24], 64),
+    lambda: dp.eval(c, 64, out=c),
+    lambda: dp._m.eval_into(c, None, 64, c),
+]
+for i, call in enumerate(calls):
+    try:
+        call()
+        print(i, "no error")
+    except MemoryError:
+        print(i, "MemoryError")
+print("after", dp.eval(np.array([0, 32768]), 64).tolist() == [0, dp.constants(64)["coef"]])
+"""
+
+
+class Boundary(unittest.TestCase):
+    """What crosses the boundary badly gets an exception an ``except Exception`` catches
+    (never PyO3's PanicException), or, for an out= that is an input, the right answer."""
+
+    def test_a_read_only_out_raises_value_error(self):
+        dp = specfx.Datapath()
+        c = np.arange(4, dtype=np.int64)
+        frozen = np.zeros(4, dtype=np.int64)
+        frozen.flags.writeable = False
+        for out in [frozen, np.frombuffer(bytes(32), np.int64)]:
+            with self.assertRaises(ValueError) as e:
+                dp.eval(c, 64, out=out)
+            self.assertEqual(str(e.exception), "out: output array is read-only")
+            with self.assertRaises(ValueError) as e:
+                dp._m.eval_into(c, None, 64, out)
+            self.assertEqual(str(e.exception), "out: output array is read-only")
+        np.testing.assert_array_equal(frozen, 0)
+
+    def test_an_out_that_is_an_input_is_computed_in_place(self):
+        dp = specfx.Datapath()
+        one, coef = dp.one_code, dp.constants(64)["coef"]
+        # With n = 64 and k = 4 the base (64/16)(c - 1) + 1 is at most 0 below c = 0.75
+        # (code 24576): the output is 0 there; at c = 1.0 the lobe is 1: the output is coef.
+        codes = np.concatenate([np.arange(0, 24576, 97), [24576], np.arange(24577, one, 5), [one]])
+        fresh = dp.eval(codes, 64)
+        np.testing.assert_array_equal(fresh[codes <= 24576], 0)
+        self.assertEqual(fresh[-1], coef)
+        c = codes.copy()
+        self.assertIs(dp.eval(c, 64, out=c), c)
+        np.testing.assert_array_equal(c, fresh)
+        # A view of the input as out, and the native half given the very same array.
+        c = codes.copy()
+        dp.eval(c, 64, out=c.view())
+        np.testing.assert_array_equal(c, fresh)
+        c = codes.copy()
+        dp._m.eval_into(c, None, 64, c)
+        np.testing.assert_array_equal(c, fresh)
+        # n read from out's own bytes (a uint32 view of its first half).
+        ns = np.resize(np.array([16, 64, 1024], dtype=np.uint32), codes.size)
+        want = dp.eval(codes, ns)
+        self.assertEqual(want[-1], dp.constants(int(ns[-1]))["coef"])
+        for native in [False, True]:
+            out = np.zeros(codes.size, dtype=np.int64)
+            n_view = out.view(np.uint32)[: codes.size]
+            n_view[:] = ns
+            if native:
+                dp._m.eval_into(codes, n_view, 0, out)
+            else:
+                dp.eval(codes, n_view, out=out)
+            np.testing.assert_array_equal(out, want)
+
+    def test_integers_are_checked_never_truncated_or_overflowed(self):
+        dp = specfx.Datapath()
+        m = specfx.Machine(dp)
+        cases = [
+            (lambda: dp.constants(-16), "n = -16 does not fit in uint32"),
+            (lambda: dp.constants(2**70), f"n = {2**70} does not fit in uint32"),
+            (lambda: dp.constants(16.5), "n: expected an integer, got float"),
+            (lambda: dp.constants(16.0), "n: expected an integer, got float"),
+            (lambda: dp.constants("16"), "n: expected an integer, got str"),
+            (lambda: dp.constants(True), "n: expected an integer, got bool"),
+            (lambda: dp.constants(7), "n = 7 is not in the configuration's exponent set 16..=1024"),
+            (lambda: dp.directed(-1), "seed = -1 does not fit in uint64"),
+            (lambda: dp.directed(1.5), "seed: expected an integer, got float"),
+            (lambda: dp.eval(16.5, 64), "c: expected an integer, got float"),
+            (lambda: dp.eval(0, 2**40), f"n = {2**40} does not fit in uint32"),
+            (lambda: dp.eval(2**63, 64), f"c = {2**63} does not fit in int64"),
+            (lambda: m.cycle((100, -16), True), "n = -16 does not fit in uint32"),
+            (lambda: m.cycle((100.5, 16), True), "c: expected an integer, got float"),
+            (lambda: m.cycle((100, 16.5), True), "n: expected an integer, got float"),
+            (lambda: m.cycle((1, 2, 3), True), "input: expected None or a pair (c, n), got a tuple of 3"),
+            (lambda: m.cycle(5, True), "input: expected None or a pair (c, n), got int"),
+            (lambda: m.cycle((100, 7), True), "n = 7 is not in the configuration's exponent set 16..=1024"),
+            (lambda: m.cycle((70000, 16), True), "c = 70000 is not a code of the input format u1.15 (expected 0..=65535)"),
+        ]
+        for call, message in cases:
+            with self.assertRaises(ValueError) as e:
+                call()
+            self.assertEqual(str(e.exception), message)
+        # numpy integers and 0-d arrays are integers.
+        self.assertEqual(dp.constants(np.uint16(64)), dp.constants(64))
+        self.assertEqual(dp.constants(np.array(64))["n"], 64)
+        # The failed cycles left the machine as it was: it runs like one that never saw them.
+        twin = specfx.Machine(dp)
+        for i in range(24):
+            offered = (dp.one_code - 40 * i, 16 + i) if i % 3 else None
+            self.assertEqual(m.cycle(offered, i % 4 != 3), twin.cycle(offered, i % 4 != 3), i)
+        self.assertEqual(m.registers(), twin.registers())
+
+    def test_memory_exhaustion_raises_memory_error(self):
+        o = subprocess.run([sys.executable, "-c", MEMORY_SCRIPT], capture_output=True, text=True)
+        self.assertEqual(o.returncode, 0, o.stderr)
+        want = [f"{i} MemoryError" for i in range(5)] + ["after True"]
+        self.assertEqual(o.stdout.splitlines(), want, o.stderr)
 
 
 class Check(unittest.TestCase):

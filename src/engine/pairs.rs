@@ -112,6 +112,25 @@ fn check_pairs(dp: &Datapath, index: &NIndex, cs: &[i64], ns: Ns) -> Result<(), 
     Ok(())
 }
 
+/// Checks every pair against the datapath's domain, in parallel, with the error the
+/// evaluations name (the first code outside the input format, else the lengths or the first n
+/// outside the set): for a face that checks a large batch whole before evaluating it piece by
+/// piece.
+///
+/// # Examples
+/// ```
+/// use specfx::engine::pairs::{check_domain, Ns};
+/// let dp = specfx::input::load_datapath("baseline", None).unwrap();
+/// assert!(check_domain(&dp, &[0, 32768], Ns::One(16)).is_ok());
+/// assert_eq!(
+///     check_domain(&dp, &[0, 1], Ns::Each(&[16, 3])).unwrap_err().to_string(),
+///     "n[1] = 3 is not in the configuration's exponent set 16..=1024"
+/// );
+/// ```
+pub fn check_domain(dp: &Datapath, cs: &[i64], ns: Ns) -> Result<(), Error> {
+    check_pairs(dp, &NIndex::new(dp), cs, ns)
+}
+
 /// The output code of every pair into `out` (as long as `cs`): the same codes as
 /// [`Datapath::eval`], computed by the batch kernels. Nothing is written unless every pair is
 /// in the datapath's domain.
