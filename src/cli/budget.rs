@@ -126,9 +126,14 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
         args.force,
         &super::output::inputs(&args.config, None),
     )?;
+    // Cost ceilings are counted on the configuration's own architecture (its `arch` key).
+    let judged = args.budget.clone().map(|mut b| {
+        b.arch = dp.config().resolve_arch(None);
+        b
+    });
     let report = budget(
         &dp,
-        args.budget.as_ref(),
+        judged.as_ref(),
         gappa_n.as_deref(),
         out_dir.path(),
     )?;

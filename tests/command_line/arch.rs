@@ -162,3 +162,28 @@ fn a_bad_arch_key_is_refused_by_name() {
     );
     let _ = std::fs::remove_file(&cfg);
 }
+
+/// `budget` counts a cost ceiling on the configuration's architecture: k = 3 pipelined has
+/// k + 2 = 5 multipliers, each at least one DSP block, so `dsps <= 4` fails; the same datapath
+/// recorded folded shares one multiplier and passes.
+#[test]
+fn budget_counts_cost_ceilings_on_the_recorded_arch() {
+    for (arch_line, code) in [("", 1), ("arch = \"folded\"\n", 0)] {
+        let cfg = temp_path(&format!("budget{code}.toml"));
+        std::fs::write(&cfg, format!("{arch_line}k = 3\nn = \"16..=64\"\n")).unwrap();
+        let out = temp_path(&format!("budget-out{code}"));
+        let o = specfx(&[
+            "budget",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--budget",
+            "dsps <= 4",
+            "--no-gappa",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(code), "{arch_line:?}");
+        let _ = std::fs::remove_file(&cfg);
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
