@@ -123,7 +123,8 @@ int specfx_eval_probes(const struct specfx_model *model,
 
 // The output codes of `len` input codes `c[i]` into `out[i]`, with exponent `n[i]`, or
 // `n_all` for every code when `n` is null; in parallel on every core. Nothing is written
-// unless every pair is in the model's domain.
+// unless every pair is in the model's domain. `out` may be `c` (or overlap `c` or `n`): the
+// outputs are then computed in place, from a copy of the inputs.
 int specfx_eval_batch(const struct specfx_model *model,
                       const int64_t *c,
                       const uint32_t *n,

@@ -396,9 +396,30 @@ pub extern "C" fn specfx_eval_probes(
     })
 }
 
+/// Whether `a_len` places of `A` at `a` and `b_len` places of `B` at `b` share a byte.
+fn overlaps<A, B>(a: *const A, a_len: usize, b: *const B, b_len: usize) -> bool {
+    let (a0, b0) = (a as usize, b as usize);
+    let a1 = a0.saturating_add(a_len.saturating_mul(std::mem::size_of::<A>()));
+    let b1 = b0.saturating_add(b_len.saturating_mul(std::mem::size_of::<B>()));
+    a0 < b1 && b0 < a1
+}
+
+/// A copy of `len` places at `p` (non-null), or the error when it cannot be allocated.
+fn copy_of<T: Copy>(p: *const T, len: usize, what: &str) -> Result<Vec<T>, String> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|_| {
+        format!("{what}: cannot allocate a copy of {len} elements (it overlaps out)")
+    })?;
+    // SAFETY: non-null, len places (the caller's contract); no mutable reference to them
+    // exists yet.
+    v.extend_from_slice(unsafe { std::slice::from_raw_parts(p, len) });
+    Ok(v)
+}
+
 /// The output codes of `len` input codes `c[i]` into `out[i]`, with exponent `n[i]`, or
 /// `n_all` for every code when `n` is null; in parallel on every core. Nothing is written
-/// unless every pair is in the model's domain.
+/// unless every pair is in the model's domain. `out` may be `c` (or overlap `c` or `n`): the
+/// outputs are then computed in place, from a copy of the inputs.
 #[unsafe(no_mangle)]
 pub extern "C" fn specfx_eval_batch(
     model: *const specfx_model,
@@ -413,22 +434,47 @@ pub extern "C" fn specfx_eval_batch(
         if len > 0 && (c.is_null() || out.is_null()) {
             return Err("c, out: a null pointer, expected len places".into());
         }
-        let (cs, out): (&[i64], &mut [i64]) = if len == 0 {
-            (&[], &mut [])
+        let most = isize::MAX as usize / std::mem::size_of::<i64>();
+        if len > most {
+            return Err(format!("len = {len}: expected at most {most}"));
+        }
+        if len == 0 {
+            let ns = if n.is_null() {
+                Ns::One(n_all)
+            } else {
+                Ns::Each(&[])
+            };
+            pairs::eval_outputs(dp, &[], ns, &mut []).map_err(|e| e.to_string())?;
+            return Ok(SPECFX_OK);
+        }
+        // Inputs that share memory with out are copied before out is borrowed: the result is
+        // the one a separate out gets (a slice and a mutable one over the same memory would
+        // be undefined behaviour).
+        let c_copy = if overlaps(c, len, out, len) {
+            Some(copy_of(c, len, "c")?)
         } else {
-            // SAFETY: non-null, and the caller gives len places in each (documented).
-            unsafe {
-                (
-                    std::slice::from_raw_parts(c, len),
-                    std::slice::from_raw_parts_mut(out, len),
-                )
-            }
+            None
         };
-        let ns = if n.is_null() {
-            Ns::One(n_all)
+        let n_copy = if !n.is_null() && overlaps(n, len, out, len) {
+            Some(copy_of(n, len, "n")?)
         } else {
+            None
+        };
+        // SAFETY: non-null, and the caller gives len places in each (documented); out overlaps
+        // no slice read below (overlapping inputs were copied).
+        let (cs, out) = unsafe {
+            (
+                c_copy
+                    .as_deref()
+                    .unwrap_or_else(|| std::slice::from_raw_parts(c, len)),
+                std::slice::from_raw_parts_mut(out, len),
+            )
+        };
+        let ns = match (&n_copy, n.is_null()) {
+            (Some(ns), _) => Ns::Each(ns),
+            (None, true) => Ns::One(n_all),
             // SAFETY: as c.
-            Ns::Each(unsafe { std::slice::from_raw_parts(n, len) })
+            (None, false) => Ns::Each(unsafe { std::slice::from_raw_parts(n, len) }),
         };
         pairs::eval_outputs(dp, cs, ns, out).map_err(|e| e.to_string())?;
         Ok(SPECFX_OK)

@@ -2,7 +2,8 @@
 //! never a crash: a configuration refused with the command line's own message, null pointers,
 //! an n outside the set, a code outside the input format, a stage or index out of range,
 //! invalid UTF-8; and the error is per thread. A failed call writes through none of its out
-//! pointers, and a failed cycle leaves a cycle model exactly as it was.
+//! pointers, and a failed cycle leaves a cycle model exactly as it was; a batch whose output
+//! overlaps its input is computed in place.
 
 use std::ffi::{c_char, CStr, CString};
 use std::ptr::{null, null_mut};
@@ -298,5 +299,69 @@ fn a_failed_call_writes_through_none_of_its_pointers() {
         SPECFX_ERROR
     );
     assert_eq!(n, -5);
+    specfx_free(m);
+}
+
+/// Two batches of outputs are equal, or the first place they differ.
+fn assert_same(got: &[i64], want: &[i64], what: &str) {
+    assert_eq!(got.len(), want.len(), "{what}");
+    if let Some(i) = got.iter().zip(want).position(|(g, w)| g != w) {
+        panic!("{what}: out[{i}] = {}, expected {}", got[i], want[i]);
+    }
+}
+
+#[test]
+fn a_batch_into_its_own_input_is_computed_in_place() {
+    let m = open("baseline");
+    let mut coef = 0i64;
+    assert_eq!(
+        specfx_dpi_constant(m.cast(), 64, SPECFX_COEF, &mut coef),
+        SPECFX_OK
+    );
+    // Consecutive runs (the kernels' range path) and scattered codes (one by one and the
+    // batch path), every code at most 1.0 (32768).
+    let consecutive: Vec<i64> = (0..=32768).collect();
+    let scattered: Vec<i64> = (0..5000i64).map(|i| i * 7919 % 32769).collect();
+    for codes in [consecutive, scattered] {
+        let len = codes.len();
+        let mut fresh = vec![-1i64; len];
+        let rc = specfx_eval_batch(m, codes.as_ptr(), null(), 64, len, fresh.as_mut_ptr());
+        assert_eq!(rc, SPECFX_OK);
+        // With n = 64 and k = 4 the base (64/16)(c - 1) + 1 is at most 0 up to c = 0.75
+        // (code 24576): the output is 0; at c = 1.0 the lobe is 1: the output is coef.
+        for (&c, &o) in codes.iter().zip(&fresh) {
+            if c <= 24576 {
+                assert_eq!(o, 0, "c = {c}");
+            }
+            if c == 32768 {
+                assert_eq!(o, coef);
+            }
+        }
+        // out = c.
+        let mut inout = codes.clone();
+        let p = inout.as_mut_ptr();
+        assert_eq!(specfx_eval_batch(m, p, null(), 64, len, p), SPECFX_OK);
+        assert_same(&inout, &fresh, "out = c");
+        // out one place past c (overlapping all but one).
+        let mut shifted = vec![0i64; len + 1];
+        shifted[..len].copy_from_slice(&codes);
+        let p = shifted.as_mut_ptr();
+        // SAFETY: within the vector of len + 1.
+        let out = unsafe { p.add(1) };
+        assert_eq!(specfx_eval_batch(m, p, null(), 64, len, out), SPECFX_OK);
+        assert_same(&shifted[1..], &fresh, "out = c + 1");
+        // n stored in out's own bytes (its first half as u32).
+        let ns: Vec<u32> = (0..len).map(|i| [16, 64, 1024][i % 3]).collect();
+        let mut want = vec![0i64; len];
+        let rc = specfx_eval_batch(m, codes.as_ptr(), ns.as_ptr(), 0, len, want.as_mut_ptr());
+        assert_eq!(rc, SPECFX_OK);
+        let mut out = vec![0i64; len];
+        let n_in_out = out.as_mut_ptr().cast::<u32>();
+        // SAFETY: len u32 fit in the first half of len i64.
+        unsafe { std::slice::from_raw_parts_mut(n_in_out, len) }.copy_from_slice(&ns);
+        let rc = specfx_eval_batch(m, codes.as_ptr(), n_in_out, 0, len, out.as_mut_ptr());
+        assert_eq!(rc, SPECFX_OK);
+        assert_same(&out, &want, "n in out's bytes");
+    }
     specfx_free(m);
 }
