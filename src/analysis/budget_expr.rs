@@ -90,6 +90,28 @@ impl Metric {
         matches!(self, Metric::Correct | Metric::EffectiveBits)
     }
 
+    /// How a limit of the metric is written: its unit, or why it takes a bare number. A bound
+    /// on a metric with a unit must name it (`shape_total <= 1` is refused, never read as an
+    /// absolute 1.0).
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::analysis::budget_expr::Metric;
+    /// assert_eq!(Metric::Out.units(), "ulp (output LSBs), e.g. 'out <= 1 ulp'");
+    /// ```
+    pub fn units(self) -> &'static str {
+        match self {
+            Metric::ShapeTotal => "lsbN (2^-N, N in 1..=64), e.g. 'shape_total <= 1 lsb8'",
+            Metric::ShapeQuant => "lsbN (2^-N, N in 1..=64), e.g. 'shape_quant <= 0.5 lsb8'",
+            Metric::Out => "ulp (output LSBs), e.g. 'out <= 1 ulp'",
+            Metric::OutTotal => "ulp (output LSBs), e.g. 'out_total <= 4 ulp'",
+            Metric::Correct => "% or a fraction, e.g. 'correct >= 99%' or 'correct >= 0.99'",
+            Metric::OutRel => "% or a fraction, e.g. 'out_rel <= 1%' or 'out_rel <= 0.01'",
+            Metric::EffectiveBits => "a number of bits, no unit, e.g. 'effective_bits >= 8'",
+            _ => "a whole number of cells, no unit, e.g. 'luts <= 800 on ice40'",
+        }
+    }
+
     /// Whether the metric measures the normalised output against exact normalised cos^n.
     pub fn is_normalised(self) -> bool {
         matches!(
@@ -126,7 +148,17 @@ impl FromStr for Budget {
     /// `correct >= 99%` (or `0.99`), the normalised output against exact normalised cos^n
     /// `out_total <= 4 ulp`, `out_rel <= 1%`, `effective_bits >= 8`, and cost ceilings `luts <= 800 on ice40`, `dsps <= 8 on
     /// ice40`, `ffs <= 400 on xilinx` (analytic; target ice40 when `on` is left out),
-    /// several joined by `,` or `and`. `lsbN` is 2^-N.
+    /// several joined by `,` or `and`. `lsbN` is 2^-N. A metric with a unit needs it
+    /// ([`Metric::units`]): `shape_total <= 1` and `out <= 1` are refused.
+    ///
+    /// # Examples
+    /// ```
+    /// use specfx::analysis::budget_expr::Budget;
+    /// let b: Budget = "shape_total <= 1 lsb8".parse().unwrap();
+    /// assert_eq!(b.bounds[0].limit, 1.0 / 256.0);
+    /// let e = "shape_total <= 1".parse::<Budget>().unwrap_err().to_string();
+    /// assert!(e.starts_with("budget: 'shape_total <= 1' is a bare number: shape_total takes lsbN"), "{e}");
+    /// ```
     fn from_str(s: &str) -> Result<Self, Error> {
         let bad = |part: &str, why: &str| {
             Error::Config {
@@ -190,14 +222,30 @@ impl FromStr for Budget {
             let unit_at = rhs
                 .find("lsb")
                 .or_else(|| rhs.find("ulp"))
-                .or_else(|| rhs.find('%'));
+                .or_else(|| rhs.find('%'))
+                .or_else(|| rhs.find(char::is_whitespace));
             let (number, unit) = match unit_at {
                 Some(i) => (rhs[..i].trim(), rhs[i..].trim()),
                 None => (rhs, ""),
             };
             let value: f64 = number.parse().map_err(|_| bad(part, "no number"))?;
+            if !value.is_finite() || value < 0.0 {
+                return Err(bad(part, "the limit must be a finite number >= 0"));
+            }
+            let name = lhs.trim();
+            let bare_ok = matches!(
+                metric,
+                Metric::Correct | Metric::OutRel | Metric::EffectiveBits
+            ) || metric.is_cost();
+            // A unit error says which units the metric takes, not the general examples.
+            let bad_unit = |why: String| Error::Config {
+                key: "budget".into(),
+                problem: format!("'{part}' {why}: {name} takes {}", metric.units()),
+            };
+            if unit.is_empty() && !bare_ok {
+                return Err(bad_unit("is a bare number".into()));
+            }
             let limit = match (metric, unit) {
-                (Metric::ShapeTotal | Metric::ShapeQuant, "") => value,
                 (Metric::ShapeTotal | Metric::ShapeQuant, u) if u.starts_with("lsb") => {
                     let bits: i32 = u[3..]
                         .parse()
@@ -206,21 +254,15 @@ impl FromStr for Budget {
                         .ok_or_else(|| bad(part, "lsbN needs a number N in 1..=64"))?;
                     value * (-f64::from(bits)).exp2()
                 }
-                (Metric::Out | Metric::OutTotal, "ulp" | "") => value,
+                (Metric::Out | Metric::OutTotal, "ulp") => value,
                 (Metric::Correct | Metric::OutRel, "%") => value / 100.0,
                 (Metric::Correct | Metric::OutRel, "") => value,
                 (Metric::EffectiveBits, "") => value,
                 (m, "") if m.is_cost() => value,
                 _ => {
-                    return Err(bad(
-                        part,
-                        &format!("unit '{unit}' does not fit this metric"),
-                    ));
+                    return Err(bad_unit(format!("has the unit '{unit}'")));
                 }
             };
-            if !value.is_finite() || value < 0.0 {
-                return Err(bad(part, "the limit must be a finite number >= 0"));
-            }
             if metric.is_cost() && value.fract() != 0.0 {
                 return Err(bad(part, "a count of cells is a whole number"));
             }
@@ -310,7 +352,7 @@ impl Budget {
     /// ```
     /// use specfx::analysis::budget_expr::Budget;
     /// let a: Budget = "shape_total <= 1 lsb8, correct >= 99%".parse().unwrap();
-    /// let b: Budget = "correct >= 0.99 and shape_total<=0.00390625".parse().unwrap();
+    /// let b: Budget = "correct >= 0.99 and shape_total<=0.5 lsb7".parse().unwrap();
     /// assert_eq!(a.canonical(), ["correct >= 0.99", "shape_total <= 0.00390625"]);
     /// assert_eq!(a.canonical(), b.canonical());
     /// ```
@@ -445,7 +487,64 @@ pub struct Verdict {
 
 #[cfg(test)]
 mod tests {
-    use super::bound_parts;
+    use super::{bound_parts, Budget, Metric};
+
+    /// A metric with a unit needs it: a bare number is refused with the units it takes, never
+    /// read as an absolute value (`shape_total <= 1` was 1.0, 256 lsb8). Metrics without a
+    /// unit (shares as fractions, effective bits, cell counts) take a bare number.
+    #[test]
+    fn a_bare_number_is_refused_where_the_metric_has_a_unit() {
+        for (text, metric, units) in [
+            (
+                "shape_total <= 1",
+                "shape_total",
+                "lsbN (2^-N, N in 1..=64)",
+            ),
+            (
+                "shape_quant <= 0.5",
+                "shape_quant",
+                "lsbN (2^-N, N in 1..=64)",
+            ),
+            ("out <= 1", "out", "ulp (output LSBs)"),
+            ("out_total <= 4", "out_total", "ulp (output LSBs)"),
+        ] {
+            let e = text.parse::<Budget>().unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!(
+                    "budget: '{text}' is a bare number: {metric} takes {units}, e.g. '"
+                )),
+                "{e}"
+            );
+        }
+        let e = "shape_total <= 1 parsecs"
+            .parse::<Budget>()
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(
+                "budget: 'shape_total <= 1 parsecs' has the unit 'parsecs': shape_total takes lsbN"
+            ),
+            "{e}"
+        );
+        // Hand values: 1 lsb8 = 2^-8, 0.5 lsb7 = 2^-8, 3 ulp = 3, 99% = 0.99.
+        let b: Budget = "shape_total <= 1 lsb8, shape_quant <= 0.5 lsb7, out <= 3 ulp, out_total <= 2ulp, correct >= 99%, out_rel <= 0.01, effective_bits >= 8, luts <= 800"
+            .parse()
+            .unwrap();
+        let limits: Vec<(Metric, f64)> = b.bounds.iter().map(|b| (b.metric, b.limit)).collect();
+        assert_eq!(
+            limits,
+            [
+                (Metric::ShapeTotal, 0.00390625),
+                (Metric::ShapeQuant, 0.00390625),
+                (Metric::Out, 3.0),
+                (Metric::OutTotal, 2.0),
+                (Metric::Correct, 0.99),
+                (Metric::OutRel, 0.01),
+                (Metric::EffectiveBits, 8.0),
+                (Metric::Luts(crate::hdl::cost::Target::Ice40), 800.0),
+            ]
+        );
+    }
 
     #[test]
     fn bounds_are_split_at_commas_and_the_word_and() {

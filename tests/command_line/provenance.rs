@@ -135,9 +135,9 @@ fn one_configuration_written_two_ways_has_one_hash() {
         ]));
         out
     };
-    // The same (generous) budget written two ways, too: 64 lsb8 is 64 * 2^-8.
+    // The same (generous) budget written two ways, too: 64 lsb8 is 64 * 2^-8 = 0.5 * 2^-1.
     let da = budget(&a, "shape_total <= 64 lsb8, out <= 1000000 ulp", "da");
-    let db = budget(&b, "out<=1e6 and shape_total <= 0.25", "db");
+    let db = budget(&b, "out<=1e6ulp and shape_total <= 0.5 lsb1", "db");
     let dc = budget(&c, "shape_total <= 64 lsb8, out <= 1000000 ulp", "dc");
     let (text_a, hash_a) = provenance(&da, "budget");
     let (text_b, hash_b) = provenance(&db, "budget");

@@ -138,6 +138,23 @@ const CASES: &[Case] = &[
         inputs: &[],
         expect: "the limit must be a finite number >= 0",
     },
+    // A bare number where the metric has a unit: refused with the units, never read as 1.0.
+    Case {
+        args: &[
+            "optimize",
+            "--budget",
+            "shape_total <= 1",
+            "--out",
+            "{dir}/o.toml",
+        ],
+        inputs: &[],
+        expect: "'shape_total <= 1' is a bare number: shape_total takes lsbN",
+    },
+    Case {
+        args: &["budget", "--budget", "out <= 1", "--out", "{dir}/b"],
+        inputs: &[],
+        expect: "'out <= 1' is a bare number: out takes ulp",
+    },
     Case {
         args: &[
             "optimize",

@@ -121,7 +121,7 @@ fn an_impossible_budget_shows_the_closest() {
     let o = specfx(&[
         "optimize",
         "--budget",
-        "shape_total <= 1e-6",
+        "shape_total <= 1 lsb20",
         "--n",
         "64",
         "--k",
