@@ -20,6 +20,7 @@ pub mod config;
 pub mod datapath;
 pub mod f64_walk;
 pub mod fast;
+pub mod ports;
 pub mod walk;
 
 pub use config::{

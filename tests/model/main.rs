@@ -19,4 +19,5 @@ mod minimax;
 mod oracle;
 mod pairs;
 mod paper;
+mod ports;
 mod properties;
