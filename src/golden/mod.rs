@@ -18,6 +18,7 @@ use sha2::{Digest, Sha256};
 use crate::csv_dialect::CsvWriter;
 use crate::fixed::{Format, Rounding};
 use crate::pipeline::fast::EventCounts;
+use crate::pipeline::ports::PerN;
 use crate::pipeline::{Config, Datapath, NConstants, ProbeColumns};
 
 pub use cases::{CaseSelection, Directed, Order, Selection};
@@ -27,11 +28,7 @@ pub use cases::{CaseSelection, Directed, Order, Selection};
 enum Source {
     C,
     N,
-    Coef,
-    Slope,
-    Offset,
-    Threshold,
-    Depth,
+    PerN(PerN),
     Stage(usize),
 }
 
@@ -78,47 +75,24 @@ pub fn n_format(config: &Config) -> Format {
 
 /// The ports of a datapath's vector files, in the order they are written.
 ///
-/// Inputs first: `in_c`, `in_n`, then the per-n constants a datapath reads from its ROM
-/// (`in_slope`, `in_offset`, `in_threshold`, `in_coef`, `in_depth`; every configuration has
-/// all five, so one testbench serves them all: `in_depth` is k for a fixed depth), then one
-/// probe per stage before the coefficient, then `expected_out`.
+/// Inputs first: `in_c`, `in_n`, then the per-n constants a datapath reads from its ROM, one
+/// port each ([`PerN`], in the order of `specfx_top`'s ports; every configuration has all of
+/// them, so one testbench serves them all: `in_depth` is k for a fixed depth), then one probe
+/// per stage before the coefficient, then `expected_out`.
 pub fn ports(dp: &Datapath) -> Vec<Port> {
     let cfg = dp.config();
-    let (slope_format, offset_format) = cfg.constant_formats();
     let mut v = vec![
         Port::new("in_c", cfg.c.format, Source::C, "input cosine c (raw code)"),
         Port::new("in_n", n_format(cfg), Source::N, "specular exponent n"),
-        Port::new(
-            "in_slope",
-            slope_format,
-            Source::Slope,
-            "slope: n with k fraction bits (plain) or A(n) (minimax)",
-        ),
-        Port::new(
-            "in_offset",
-            offset_format,
-            Source::Offset,
-            "offset: 1 (plain) or A(n) + B(n) (minimax)",
-        ),
-        Port::new(
-            "in_threshold",
-            cfg.c.format,
-            Source::Threshold,
-            "paper cutoff: inputs below this code give 0 (0 for the other cutoffs)",
-        ),
-        Port::new(
-            "in_coef",
-            cfg.coef.format,
-            Source::Coef,
-            "coef(n), the per-n coefficient constant",
-        ),
-        Port::new(
-            "in_depth",
-            Format::unsigned(crate::pipeline::DEPTH_BITS as i32, 0).expect("3 bits"),
-            Source::Depth,
-            "j(n): the squarings n uses (stages past it pass their input through; k for a fixed depth)",
-        ),
     ];
+    for p in PerN::ALL {
+        v.push(Port::new(
+            p.port(),
+            p.format(dp),
+            Source::PerN(p),
+            p.description(),
+        ));
+    }
     let coef_idx = dp.stage_coef();
     for (stage_idx, s) in dp.stages().iter().enumerate() {
         if stage_idx == coef_idx || stage_idx == dp.stage_out() {
@@ -331,11 +305,7 @@ pub fn write_vectors(
                 let raw = match port.source {
                     Source::C => c,
                     Source::N => i64::from(n),
-                    Source::Coef => nc.coef_raw,
-                    Source::Slope => nc.slope_raw,
-                    Source::Offset => nc.offset_raw,
-                    Source::Threshold => nc.threshold.unwrap_or(0),
-                    Source::Depth => i64::from(nc.depth),
+                    Source::PerN(p) => p.raw(nc),
                     Source::Stage(stage_idx) => row[stage_idx],
                 };
                 cell.clear();
