@@ -14,6 +14,11 @@
 //! claims the entry (a `<key>.claim` file naming its process) while it runs the tool, and the
 //! others wait for the entry it keeps ([`get_or_claim`]). A claim whose process is gone is
 //! taken over; a tool that fails keeps nothing, and the next in line runs it.
+//!
+//! Waiting is bounded: a claim that is not a regular file (a directory, say) or that cannot be
+//! removed when stale, and a live claimant that has not kept its entry after [`WAIT_LIMIT`],
+//! make the caller run the tool itself without the cache, with a warning naming the claim
+//! file to remove. A figure is then the same, only not shared.
 
 use std::path::{Path, PathBuf};
 
@@ -117,20 +122,40 @@ pub fn release_all() {
 /// How often a process waiting for another's entry looks again.
 const WAIT_POLL: std::time::Duration = std::time::Duration::from_millis(50);
 
+/// The longest a caller waits for another live process's entry (the slowest syntheses take
+/// minutes) before it runs the tool itself, without the cache: 30 minutes.
+pub const WAIT_LIMIT: std::time::Duration = std::time::Duration::from_secs(30 * 60);
+
 /// The entry `kind`/`key` ([`get`]'s files) when it is there, or when another live process
 /// that claimed it keeps it meanwhile (waiting for it); else a [`Claim`] for this caller to
 /// run the tool and [`put`] the entry (without a cache, a claim that holds nothing).
 pub fn get_or_claim(kind: &str, key: &str, names: &[&str]) -> Result<Vec<Option<Vec<u8>>>, Claim> {
     match entry(kind, key) {
-        Some(dest) => get_or_claim_at(&dest, names),
+        Some(dest) => get_or_claim_at(&dest, names, WAIT_LIMIT),
         None => Err(Claim { file: None }),
     }
 }
 
-/// [`get_or_claim`] for the entry directory `dest`.
-fn get_or_claim_at(dest: &Path, names: &[&str]) -> Result<Vec<Option<Vec<u8>>>, Claim> {
+/// A claim this caller cannot wait on or take over: the tool runs here without the cache (a
+/// claim that holds nothing), and the warning says which file to remove.
+fn without_cache(claim_file: &Path, why: &str) -> Claim {
+    log::warn!(
+        "synthesis cache: {why}; running the tool here without the cache (remove {} if no other specfx run is using it)",
+        claim_file.display()
+    );
+    Claim { file: None }
+}
+
+/// [`get_or_claim`] for the entry directory `dest`, waiting at most `limit` for another live
+/// process's entry.
+fn get_or_claim_at(
+    dest: &Path,
+    names: &[&str],
+    limit: std::time::Duration,
+) -> Result<Vec<Option<Vec<u8>>>, Claim> {
     let claim_file = dest.with_extension("claim");
     let mut said = false;
+    let started = std::time::Instant::now();
     loop {
         if let Some(files) = get_at(dest, names) {
             return Ok(files);
@@ -162,6 +187,20 @@ fn get_or_claim_at(dest: &Path, names: &[&str]) -> Result<Vec<Option<Vec<u8>>>, 
                 });
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                // Not a file specfx writes: nothing to read, wait on or take over.
+                if let Ok(meta) = std::fs::symlink_metadata(&claim_file) {
+                    if !meta.is_file() {
+                        let kind = if meta.is_dir() {
+                            "a directory"
+                        } else {
+                            "not a regular file"
+                        };
+                        return Err(without_cache(
+                            &claim_file,
+                            &format!("the claim {} is {kind}", claim_file.display()),
+                        ));
+                    }
+                }
                 let owner = std::fs::read_to_string(&claim_file).ok();
                 // The claim names its process by number and start time, so a number the
                 // system gave to another process since is not taken for the claimant.
@@ -177,11 +216,42 @@ fn get_or_claim_at(dest: &Path, names: &[&str]) -> Result<Vec<Option<Vec<u8>>>, 
                     .and_then(|m| m.modified())
                     .is_ok_and(|t| t.elapsed().is_ok_and(|e| e.as_secs() > 10));
                 if (!unwritten && !alive) || (unwritten && old) {
-                    let _ = std::fs::remove_file(&claim_file);
-                    continue;
+                    match std::fs::remove_file(&claim_file) {
+                        Ok(()) => continue,
+                        Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
+                        Err(e) => {
+                            return Err(without_cache(
+                                &claim_file,
+                                &format!(
+                                    "the stale claim {} cannot be removed: {e}",
+                                    claim_file.display()
+                                ),
+                            ));
+                        }
+                    }
+                }
+                let who = owner
+                    .as_deref()
+                    .and_then(|t| t.split_whitespace().next())
+                    .map_or("another process".to_string(), |pid| {
+                        format!("process {pid}")
+                    });
+                if started.elapsed() >= limit {
+                    return Err(without_cache(
+                        &claim_file,
+                        &format!(
+                            "{who} claimed this synthesis ({}) and has not finished it after {} s",
+                            claim_file.display(),
+                            limit.as_secs()
+                        ),
+                    ));
                 }
                 if !said {
-                    log::info!("waiting for another specfx run of the same synthesis");
+                    log::info!(
+                        "waiting for {who}, another specfx run of the same synthesis (its claim {}), at most {} s",
+                        claim_file.display(),
+                        limit.as_secs()
+                    );
                     said = true;
                 }
                 std::thread::sleep(WAIT_POLL);
@@ -235,10 +305,10 @@ mod tests {
     fn a_second_caller_waits_for_the_entry_the_first_keeps() {
         let tmp = tempfile::tempdir().unwrap();
         let dest = tmp.path().join("yosys").join("k");
-        let claim = get_or_claim_at(&dest, &["a"]).expect_err("nothing there yet");
+        let claim = get_or_claim_at(&dest, &["a"], WAIT_LIMIT).expect_err("nothing there yet");
         assert!(dest.with_extension("claim").is_file());
         std::thread::scope(|s| {
-            let waiter = s.spawn(|| get_or_claim_at(&dest, &["a"]));
+            let waiter = s.spawn(|| get_or_claim_at(&dest, &["a"], WAIT_LIMIT));
             std::thread::sleep(5 * WAIT_POLL);
             assert!(!waiter.is_finished(), "it waits while the claim is held");
             put_at(&dest, &[("a", b"answer")]);
@@ -253,14 +323,59 @@ mod tests {
     fn a_failed_run_lets_the_next_caller_run_the_tool() {
         let tmp = tempfile::tempdir().unwrap();
         let dest = tmp.path().join("k");
-        let first = get_or_claim_at(&dest, &["a"]).expect_err("nothing there yet");
+        let first = get_or_claim_at(&dest, &["a"], WAIT_LIMIT).expect_err("nothing there yet");
         std::thread::scope(|s| {
-            let waiter = s.spawn(|| get_or_claim_at(&dest, &["a"]).is_err());
+            let waiter = s.spawn(|| get_or_claim_at(&dest, &["a"], WAIT_LIMIT).is_err());
             std::thread::sleep(5 * WAIT_POLL);
             // The tool failed: no entry, the claim goes.
             drop(first);
             assert!(waiter.join().unwrap(), "the waiter claims it in turn");
         });
+    }
+
+    /// Runs `get_or_claim_at` on another thread and returns its answer, or panics when it has
+    /// not returned within a minute: the old loop never returned on these claims.
+    fn bounded(dest: &Path, limit: std::time::Duration) -> Result<Vec<Option<Vec<u8>>>, Claim> {
+        let (tx, rx) = std::sync::mpsc::channel();
+        let dest = dest.to_path_buf();
+        std::thread::spawn(move || {
+            let _ = tx.send(get_or_claim_at(&dest, &["a"], limit));
+        });
+        rx.recv_timeout(std::time::Duration::from_secs(60))
+            .expect("get_or_claim returns: it must not spin or wait forever")
+    }
+
+    #[test]
+    fn a_claim_that_is_a_directory_runs_the_tool_without_the_cache() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dest = tmp.path().join("k");
+        let claim_dir = dest.with_extension("claim");
+        std::fs::create_dir(&claim_dir).unwrap();
+        // Older than the grace of an unwritten claim, as the spinning loop found it.
+        let old = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+        std::fs::File::open(&claim_dir)
+            .unwrap()
+            .set_modified(old)
+            .unwrap();
+        let claim = bounded(&dest, WAIT_LIMIT).expect_err("no entry");
+        assert_eq!(claim.file, None, "it holds nothing");
+        assert!(claim_dir.is_dir(), "the directory is left for the user");
+    }
+
+    #[test]
+    fn a_live_claimant_is_waited_for_at_most_the_limit() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dest = tmp.path().join("k");
+        // This very process as the claimant: alive, and it never keeps the entry.
+        let mine = owner_of(std::process::id()).unwrap();
+        std::fs::write(dest.with_extension("claim"), &mine).unwrap();
+        let claim = bounded(&dest, 3 * WAIT_POLL).expect_err("no entry");
+        assert_eq!(claim.file, None, "it holds nothing");
+        assert_eq!(
+            std::fs::read_to_string(dest.with_extension("claim")).unwrap(),
+            mine,
+            "the other's claim is left alone"
+        );
     }
 
     #[test]
@@ -269,13 +384,13 @@ mod tests {
         let dest = tmp.path().join("k");
         // No process has this number (above the kernel's pid limit).
         std::fs::write(dest.with_extension("claim"), "4194305 1").unwrap();
-        let claim = get_or_claim_at(&dest, &["a"]).expect_err("taken over");
+        let claim = get_or_claim_at(&dest, &["a"], WAIT_LIMIT).expect_err("taken over");
         drop(claim);
         // This process's number with another start time: the number was given again.
         let mine = owner_of(std::process::id()).unwrap();
         let pid = mine.split(' ').next().unwrap();
         std::fs::write(dest.with_extension("claim"), format!("{pid} 1")).unwrap();
-        let claim = get_or_claim_at(&dest, &["a"]).expect_err("taken over");
+        let claim = get_or_claim_at(&dest, &["a"], WAIT_LIMIT).expect_err("taken over");
         assert_eq!(
             std::fs::read_to_string(dest.with_extension("claim")).unwrap(),
             owner_of(std::process::id()).unwrap()
