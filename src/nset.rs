@@ -112,7 +112,21 @@ fn parse_n(s: &str, whole: &str) -> Result<u32, Error> {
 
 impl FromStr for NSet {
     type Err = Error;
+    /// Parses comma-separated items `a`, `a..b` or `a..=b`. Spaces (U+0020) are ignored
+    /// around an item and an operator; any other whitespace (a tab, a line break) is refused,
+    /// because the set is echoed as written into reports, TOML, CSV and Verilog comments,
+    /// where it would change the file.
     fn from_str(s: &str) -> Result<Self, Error> {
+        if let Some(c) = s.chars().find(|&c| c.is_whitespace() && c != ' ') {
+            return Err(Error::OutOfRange {
+                what: "an n set",
+                expected: format!(
+                    "items a, a..b or a..=b separated by ',', with spaces only between them (got {:?}, which is whitespace but not a space)",
+                    c
+                ),
+                got: format!("'{s}'"),
+            });
+        }
         // Ranges are kept as written and merged before they are expanded, so that the work
         // and memory follow the text and the distinct values, not the sum of the ranges'
         // lengths (thousands of `1..65535` are still 65535 values).
@@ -203,11 +217,32 @@ mod tests {
 
     #[test]
     fn user_text_in_errors_stays_on_one_line() {
-        let e = "16..17\n,x\r".parse::<NSet>().unwrap_err().to_string();
+        let e = "16..17, x\u{1b}".parse::<NSet>().unwrap_err().to_string();
         assert_eq!(
             e,
-            r"an exponent n must be a whole number in 1..=65535, digits only (in n set '16..17\n,x\r'), got 'x'"
+            r"an exponent n must be a whole number in 1..=65535, digits only (in n set '16..17, x\u{1b}'), got 'x\u{1b}'"
         );
+    }
+
+    /// docs/arithmetic.md 4.3 allows spaces only: a tab or a line break would reach every file
+    /// that echoes the set as written.
+    #[test]
+    fn whitespace_other_than_spaces_is_refused() {
+        for (text, c) in [
+            ("16,\t32", r"'\t'"),
+            ("16..17\n,20", r"'\n'"),
+            ("16\r", r"'\r'"),
+        ] {
+            let e = text.parse::<NSet>().unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!(
+                    "an n set must be items a, a..b or a..=b separated by ',', with spaces only between them (got {c}, which is whitespace but not a space), got '"
+                )),
+                "{e}"
+            );
+            assert!(!e.contains(['\t', '\n', '\r']), "{e}");
+        }
+        assert_eq!(" 16 , 32 ".parse::<NSet>().unwrap().values(), &[16, 32]);
     }
 
     #[test]

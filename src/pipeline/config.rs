@@ -143,7 +143,11 @@ impl Depth {
     }
 }
 
-const DEPTH_EXPECTED: &str = "expected \"fixed\", \"best\" or a list of { from = N, j = J } tables";
+/// What a `depth` value may be, for its errors.
+const DEPTH_EXPECTED: &str = "expected \"fixed\", \"best\" or a list of steps { from = N, j = J }";
+
+/// What a step of a `depth` list is, for its errors.
+const STEP_IS: &str = "a step is { from = N, j = J }: from exponent N on, J squarings";
 
 impl Serialize for Depth {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
@@ -156,33 +160,58 @@ impl Serialize for Depth {
 }
 
 impl<'de> Deserialize<'de> for Depth {
+    /// Reads the value whole, then says what is wrong with it in the key's own terms: which
+    /// step, which of its keys, and what a step is.
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct Visitor;
-        impl<'de> serde::de::Visitor<'de> for Visitor {
-            type Value = Depth;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str(DEPTH_EXPECTED)
-            }
-            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Depth, E> {
-                match v {
-                    "fixed" => Ok(Depth::Fixed),
-                    "best" => Ok(Depth::Best),
-                    other => Err(E::custom(format!("depth: {DEPTH_EXPECTED}, got {other:?}"))),
-                }
-            }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(
-                self,
-                mut seq: A,
-            ) -> Result<Depth, A::Error> {
-                let mut steps = Vec::new();
-                while let Some(step) = seq.next_element::<DepthStep>()? {
-                    steps.push(step);
-                }
-                Ok(Depth::Steps(steps))
-            }
-        }
-        d.deserialize_any(Visitor)
+        let value = toml::Value::deserialize(d)?;
+        depth_from_value(&value).map_err(serde::de::Error::custom)
     }
+}
+
+/// A `depth` value as TOML (or JSON, in a manifest) gives it.
+fn depth_from_value(value: &toml::Value) -> Result<Depth, String> {
+    match value {
+        toml::Value::String(s) if s == "fixed" => Ok(Depth::Fixed),
+        toml::Value::String(s) if s == "best" => Ok(Depth::Best),
+        toml::Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .map(|(i, item)| step_from_value(i + 1, item))
+            .collect::<Result<_, _>>()
+            .map(Depth::Steps),
+        other => Err(format!(
+            "depth: {DEPTH_EXPECTED}, got {} {other}",
+            other.type_str()
+        )),
+    }
+}
+
+/// Step `number` (from 1) of a `depth` list.
+fn step_from_value(number: usize, item: &toml::Value) -> Result<DepthStep, String> {
+    let fail = |what: String| format!("depth: step {number}: {what} ({STEP_IS})");
+    let toml::Value::Table(table) = item else {
+        return Err(fail(format!(
+            "expected a table {{ from = N, j = J }}, got {} {item}",
+            item.type_str()
+        )));
+    };
+    if let Some(key) = table.keys().find(|k| *k != "from" && *k != "j") {
+        return Err(fail(format!(
+            "unknown key `{key}`, expected `from` and `j`"
+        )));
+    }
+    let field = |key: &str, expected: &str| -> Result<u32, String> {
+        let v = table
+            .get(key)
+            .ok_or_else(|| fail(format!("missing `{key}`")))?;
+        v.as_integer()
+            .and_then(|i| u32::try_from(i).ok())
+            .ok_or_else(|| fail(format!("{key} = {v}: expected {expected}")))
+    };
+    Ok(DepthStep {
+        from: field("from", "the step's first exponent, a whole number >= 0")?,
+        j: field("j", "a number of squarings, a whole number in 1..=k")?,
+    })
 }
 
 /// Register latencies of the operations in the cycle-level model (`docs/cycle.md`).

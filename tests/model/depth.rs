@@ -132,15 +132,43 @@ fn rules_that_leave_an_exponent_without_a_depth_are_refused() {
         refused("depth = \"best\"\nn = \"16..=5000\"\n"),
         "depth: \"best\" ranks the depths by the minimax table's floors, which end at n = 4096; the set reaches n = 5000"
     );
+    // Parse errors say what depth and a step are, once each ("expected expected" and
+    // "expected u32" before).
     let parse = |text: &str| Config::from_toml(text).unwrap_err().to_string();
-    assert!(
-        parse("depth = \"deep\"\n").contains(
-            "depth: expected \"fixed\", \"best\" or a list of { from = N, j = J } tables, got \"deep\""
+    let step = "(a step is { from = N, j = J }: from exponent N on, J squarings)";
+    for (text, message) in [
+        (
+            "depth = \"deep\"\n",
+            "line 1: depth: expected \"fixed\", \"best\" or a list of steps { from = N, j = J }, got string \"deep\"".to_string(),
         ),
-        "{}",
-        parse("depth = \"deep\"\n")
-    );
-    assert!(parse("depth = [{ from = 16, depth = 4 }]\n").contains("unknown field `depth`"));
+        (
+            "depth = 4\n",
+            "line 1: depth: expected \"fixed\", \"best\" or a list of steps { from = N, j = J }, got integer 4".to_string(),
+        ),
+        (
+            "depth = [{ from = -5, j = 3 }]\n",
+            format!("line 1: depth: step 1: from = -5: expected the step's first exponent, a whole number >= 0 {step}"),
+        ),
+        (
+            "depth = [{ from = 1, j = 3 }, { from = 16, j = -1 }]\n",
+            format!("line 1: depth: step 2: j = -1: expected a number of squarings, a whole number in 1..=k {step}"),
+        ),
+        (
+            "depth = [{ from = 16 }]\n",
+            format!("line 1: depth: step 1: missing `j` {step}"),
+        ),
+        (
+            "depth = [3]\n",
+            format!("line 1: depth: step 1: expected a table {{ from = N, j = J }}, got integer 3 {step}"),
+        ),
+        (
+            "depth = [{ from = 16, depth = 4 }]\n",
+            format!("line 1: depth: step 1: unknown key `depth`, expected `from` and `j` {step}"),
+        ),
+    ] {
+        assert_eq!(parse(text), message, "{text}");
+        assert!(!parse(text).contains("expected expected"), "{text}");
+    }
 }
 
 #[test]
