@@ -9,10 +9,14 @@ the head of the queue. Every cycle, `specfx.Machine` (the cycle model, docs/cycl
 what in_ready and out_valid must be and which input's output must be on the port, so every
 output is also checked on its cycle.
 
+An X or Z on in_ready or out_valid in any cycle, or on out_data while out_valid is high, is a
+failure (a missing reset shows so in Icarus Verilog; it is never read as 0).
+
 Every cycle it also compares every register of the core (`specfx_top.g_pipelined.u_core` or
 `g_folded.u_core`) holding valid data with the cycle model's (`Machine.registers`, the RTL's
-names): when the run fails, the first register that differed (e.g. `g_square[1].y_q`, the
-second squaring) names the stage that went wrong, in a `stage:` line. Under Verilator the
+names): the first register that differs (e.g. `g_square[1].y_q`, the second squaring) is a
+failure, reported once in a `stage:` line that names the stage that went wrong, also when every
+output agrees (a register the outputs do not show yet, or a difference a later stage hides). Under Verilator the
 registers are visible as run.py builds it (`--public-flat-rw`), and are found by their full
 names (cocotb_compat.signal_at); the log says how many of the model's registers were found.
 
@@ -21,7 +25,14 @@ Environment (hdl_ref/cocotb/run.py --live sets it):
                    parameters: `specfx hdl params --config C --arch A --format json`)
   SPECFX_ARCH      pipelined or folded (the DUT's ARCH)
   SPECFX_SEED, SPECFX_NVEC, SPECFX_BUBBLE, SPECFX_STALL   the stimulus: seed, random vectors
-                   after the directed ones, probabilities of a bubble and of a stall
+                   after the directed ones, probabilities of a bubble and of a stalled cycle in
+                   the random cycles of the handshake pattern
+
+The handshake pattern (docs/cycle.md, "The handshake pattern", as `specfx hdl stimulus` draws
+it): a block of directed episodes (an output stalled from its first cycle for longer than an
+initiation interval while inputs come back to back at the interval, a stall that ends on the
+cycle a new input is offered, a one-cycle stall, a stall in a stream), each after a drain, then
+4096 random cycles (bubbles drawn per cycle, stalls in bursts), repeated.
   SPECFX_RESET_DATA  optional, 1 when the DUT has RESET_DATA = 1: out_data must be 0 in cycle 0
   SPECFX_SUMMARY   optional: a JSON file to write the verdict to
 """
@@ -96,6 +107,69 @@ class Stimulus:
         return c, n
 
 
+def timing(dp, arch):
+    """The cycle model's latency and initiation interval: an input offered on every cycle
+    into an empty machine, always ready; the latency is the cycle its first output shows, the
+    interval the cycle its second input is accepted."""
+    machine = specfx.Machine(dp, arch)
+    item = (dp.one_code, dp.n[0])
+    latency = interval = None
+    for cycle in range(10_000):
+        ready, out = machine.cycle(item, True)
+        if ready and cycle > 0 and interval is None:
+            interval = cycle
+        if out is not None and latency is None:
+            latency = cycle
+        if latency is not None and interval is not None:
+            return latency, interval
+    raise AssertionError("setup: the cycle model gave no output")
+
+
+class Handshake:
+    """The handshake pattern: (offer, out_ready) per cycle (`specfx::cycle::stimulus::Handshake`)."""
+
+    RANDOM_CYCLES = 4096
+
+    def __init__(self, latency, ii, bubble, stall, rng):
+        self.rng, self.bubble = rng, bubble
+        burst = ii + 1
+        self.start = stall / (stall + burst * (1 - stall)) if stall > 0 else 0.0
+        self.burst_max = 2 * burst - 1
+        self.burst_left = 0
+        self.cycle = 0
+        s = ii + 1
+        episodes = [
+            ({0, ii, 2 * ii, 3 * ii}, latency, s),
+            ({0, latency + s}, latency, s),
+            ({0, 1}, latency, 1),
+            (set(range(2 * ii + 1)), latency + 1, s),
+        ]
+        self.block = []
+        for offers, stall_at, stall_len in episodes:
+            self.block += [(False, True)] * (latency + ii + 2)
+            end = max(max(offers), stall_at + stall_len - 1)
+            self.block += [
+                (t in offers, not stall_at <= t < stall_at + stall_len) for t in range(end + 1)
+            ]
+
+    def next(self):
+        phase = self.cycle % (len(self.block) + self.RANDOM_CYCLES)
+        self.cycle += 1
+        if phase < len(self.block):
+            self.burst_left = 0
+            return self.block[phase]
+        offer = self.rng.random() >= self.bubble
+        if self.burst_left > 0:
+            self.burst_left -= 1
+            ready = False
+        elif self.rng.random() < self.start:
+            self.burst_left = self.rng.randint(1, self.burst_max) - 1
+            ready = False
+        else:
+            ready = True
+        return offer, ready
+
+
 def drive(dut, widths, item):
     c, n, constants = item
     dut.in_c.value = c & ((1 << widths["in_c"]) - 1)
@@ -127,7 +201,8 @@ async def specfx_live_scoreboard(dut):
     out_width = len(dut.out_data)
     mask = (1 << out_width) - 1
     machine = specfx.Machine(dp, arch)
-    rng = random.Random(seed + 1)
+    latency, interval = timing(dp, arch)
+    handshake = Handshake(latency, interval, bubble, stall, random.Random(seed + 1))
     log.info("%d vectors (%d directed), %s, seed %d", stim.total, len(stim.directed), arch, seed)
 
     start_clock(dut.clk, CLOCK_PERIOD_NS)
@@ -166,8 +241,8 @@ async def specfx_live_scoreboard(dut):
             c, n = stim.next()
             pending = (c, n, stim.ports(n))
             drive(dut, widths, pending)
-        in_valid = pending is not None and rng.random() >= bubble
-        out_ready = rng.random() >= stall
+        offer, out_ready = handshake.next()
+        in_valid = pending is not None and offer
         dut.in_valid.value = int(in_valid)
         dut.out_ready.value = int(out_ready)
         await ReadOnly()
@@ -182,10 +257,20 @@ async def specfx_live_scoreboard(dut):
                         f"stage: the first register that differs from the model is {name} "
                         f"(cycle {cycle}: got {got}, the model {want & ((1 << width) - 1):x})"
                     )
+                    # Always shown (not counted among the first problems shown).
+                    failed += 1
+                    problems.append(first_register)
+                    log.error("%s", first_register)
                     break
-        in_ready = str(dut.in_ready.value) == "1"
-        out_valid = str(dut.out_valid.value) == "1"
+        handshake_bits = {"in_ready": str(dut.in_ready.value), "out_valid": str(dut.out_valid.value)}
+        for name, bit in handshake_bits.items():
+            if bit not in ("0", "1"):
+                fail(f"protocol: cycle {cycle}: {name}={bit}, an X or Z")
+        in_ready = handshake_bits["in_ready"] == "1"
+        out_valid = handshake_bits["out_valid"] == "1"
         data = dut.out_data.value
+        if out_valid and not data.is_resolvable:
+            fail(f"protocol: cycle {cycle}: out_data={data} while out_valid is high, an X or Z")
         m_ready, m_out = machine.cycle(pending[:2] if in_valid else None, out_ready)
         if in_ready != m_ready:
             fail(f"protocol: cycle {cycle}: in_ready={int(in_ready)}, the cycle model says {int(m_ready)}")
@@ -225,8 +310,8 @@ async def specfx_live_scoreboard(dut):
         await RisingEdge(dut.clk)
         cycle += 1
 
-    if failed:
-        line = first_register or "stage: every register of the core agreed with the model"
+    if failed and first_register is None:
+        line = "stage: every register of the core agreed with the model"
         problems.append(line)
         log.error("%s", line)
     verdict = f"{passed} passed, {failed} failed"

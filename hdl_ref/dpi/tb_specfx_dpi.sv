@@ -7,12 +7,20 @@
 //                  vector directory); the same configuration as the parameters
 //   +seed=S        the seed of the stimulus (default 1)
 //   +nvec=N        random vectors to drive after the directed ones (default 10000)
-//   +bubble=P      percent of cycles the source does not offer its pending vector (default 25)
-//   +stall=P       percent of cycles out_ready is low (default 25)
+//   +bubble=P      percent of random cycles the source does not offer its pending vector
+//                  (default 25)
+//   +stall=P       percent of random cycles out_ready is low, in bursts (default 25)
 //   +exhaustive    every code of the input format up to 1.0 for every n of the configuration
 //                  (n changing on every vector), instead of random vectors (the codes above 1.0
 //                  all clamp to 1.0: the directed vectors hold them); no bubbles or stalls
-//                  unless given
+//                  besides the directed episodes unless given
+//
+// The handshake pattern (docs/cycle.md, "The handshake pattern", as specfx hdl stimulus draws
+// it): a block of directed episodes (an output stalled from its first cycle for longer than an
+// initiation interval while inputs come back to back at the interval, a stall that ends on the
+// cycle a new input is offered, a one-cycle stall, a stall in a stream), each after a drain,
+// then 4096 random cycles (bubbles drawn per cycle, stalls in bursts of 1..2B-1 cycles,
+// B = the initiation interval + 1), repeated.
 //
 // The directed vectors come first: the cases `specfx vectors` always writes (every n's corner
 // cases, codes with a non-zero output, inputs on and next to every stage's rounding boundary),
@@ -184,6 +192,74 @@ module tb_specfx_dpi #(
         end
     end
 
+    // ---- The handshake pattern: (offer, out_ready) per cycle. ----
+    localparam integer LATENCY = (ARCH == 0) ? LAT_SUB + LAT_ADD + (K + 2) * LAT_MUL
+                                             : (K + 2) * LAT_MUL + 1;
+    localparam integer II = (ARCH == 0) ? 1 : (K + 2) * LAT_MUL;
+    localparam integer BURST = II + 1;  // the mean length of a stall burst
+    localparam integer RANDOM_CYCLES = 4096;
+    bit block_offer[$];
+    bit block_ready[$];
+    longint hs_cycle = 0;
+    longint burst_left = 0;
+
+    // One episode after its drain: offers at `offers`, out_ready low for stall_len cycles
+    // from stall_at.
+    task automatic add_episode(input int offers[], input int stall_at, input int stall_len);
+        int last = stall_at + stall_len - 1;
+        bit offered;
+        foreach (offers[i]) if (offers[i] > last) last = offers[i];
+        for (int t = 0; t < LATENCY + II + 2; t++) begin
+            block_offer.push_back(1'b0);
+            block_ready.push_back(1'b1);
+        end
+        for (int t = 0; t <= last; t++) begin
+            offered = 1'b0;
+            foreach (offers[i]) if (offers[i] == t) offered = 1'b1;
+            block_offer.push_back(offered);
+            block_ready.push_back(!(t >= stall_at && t < stall_at + stall_len));
+        end
+    endtask
+
+    initial begin
+        int offers[];
+        offers = new[4];
+        foreach (offers[i]) offers[i] = i * II;
+        add_episode(offers, LATENCY, II + 1);
+        offers = new[2];
+        offers[0] = 0;
+        offers[1] = LATENCY + II + 1;
+        add_episode(offers, LATENCY, II + 1);
+        offers[1] = 1;
+        add_episode(offers, LATENCY, 1);
+        offers = new[2 * II + 1];
+        foreach (offers[i]) offers[i] = i;
+        add_episode(offers, LATENCY + 1, II + 1);
+    end
+
+    // The next cycle's offer and out_ready: the block, then the random cycles.
+    task automatic handshake_next(output bit offer, output bit ready);
+        longint phase = hs_cycle % (block_offer.size() + RANDOM_CYCLES);
+        hs_cycle = hs_cycle + 1;
+        if (phase < block_offer.size()) begin
+            burst_left = 0;
+            offer = block_offer[phase];
+            ready = block_ready[phase];
+        end else begin
+            offer = percent() >= bubble;
+            if (burst_left > 0) begin
+                burst_left = burst_left - 1;
+                ready = 1'b0;
+            end else if (stall > 0
+                         && longint'(rnd() % longint'(stall + BURST * (100 - stall))) < stall) begin
+                burst_left = longint'(rnd() % longint'(2 * BURST - 1));
+                ready = 1'b0;
+            end else begin
+                ready = 1'b1;
+            end
+        end
+    endtask
+
     // ---- The DUT's inputs: the offered vector, held until it transfers (rule 2). ----
     reg in_valid = 1'b0;
     reg out_ready = 1'b0;
@@ -292,6 +368,7 @@ module tb_specfx_dpi #(
     endtask
 
     int m_in_ready, m_out_valid;
+    bit offer, ready;
     longint m_out_data, m_out_tag, want;
     string how;
     always @(posedge clk) begin
@@ -350,13 +427,14 @@ module tb_specfx_dpi #(
                 next_vector();
                 pending = 1;
             end
-            if (pending && percent() >= bubble) begin
+            handshake_next(offer, ready);
+            if (pending && offer) begin
                 in_valid <= 1'b1;
             end else begin
                 if (pending) n_bubbles = n_bubbles + 1;
                 in_valid <= 1'b0;
             end
-            out_ready <= percent() >= stall;
+            out_ready <= ready;
             if (total == 0) finish();
             if (cycle > 1000 + total * PER_VECTOR * 4) begin
                 $display("timeout at cycle %0d: %0d of %0d outputs arrived", cycle, n_out, total);

@@ -21,7 +21,8 @@
 // vector passes when both match. The run stops when every output has arrived, or at a
 // timeout (the missing outputs count as failed). A change of out_data or a drop of out_valid
 // while out_valid is high and out_ready low (docs/cycle.md, rule 5) counts as one more
-// failure, and so does, with RESET_DATA = 1, an out_data other than 0 in cycle 0. Prints the
+// failure, and so do, with RESET_DATA = 1, an out_data other than 0 in cycle 0, and in any
+// cycle an X or Z on in_ready or out_valid, or on out_data while out_valid is high. Prints the
 // first 10 mismatches, then exactly one line `N passed, N failed`; then ends with $finish when
 // every vector passed, and with $fatal (a non-zero exit status: vvp exits with 1, a Verilator
 // model aborts) when a check failed or nothing was checked.
@@ -232,6 +233,20 @@ module tb_specfx #(
                 n_failed = n_failed + 1;
                 if (n_shown < MAX_SHOWN)
                     $display("protocol: out_data=%h after reset with RESET_DATA=1, want 0", out_data);
+                n_shown = n_shown + 1;
+            end
+            if ((^{in_ready, out_valid}) === 1'bx) begin
+                n_failed = n_failed + 1;
+                if (n_shown < MAX_SHOWN)
+                    $display("protocol: cycle %0d: in_ready=%b out_valid=%b, an X or Z", cycle,
+                             in_ready, out_valid);
+                n_shown = n_shown + 1;
+            end
+            if (out_valid === 1'b1 && (^out_data) === 1'bx) begin
+                n_failed = n_failed + 1;
+                if (n_shown < MAX_SHOWN)
+                    $display("protocol: cycle %0d: out_data=%h while out_valid is high, an X or Z",
+                             cycle, out_data);
                 n_shown = n_shown + 1;
             end
             if (held && (!out_valid || out_data !== held_data)) begin

@@ -54,7 +54,7 @@ pub struct SimArgs {
     /// hierarchy, names and widths (docs/cycle.md, "Traces").
     #[arg(long)]
     vcd: Option<PathBuf>,
-    /// Cycles in the VCD trace (at most 131072: each traced cycle is kept in memory).
+    /// Cycles in the VCD trace (at most 262144: each traced cycle is kept in memory).
     #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u64).range(1..=specfx::cycle::vcd::MAX_TRACE_CYCLES))]
     vcd_cycles: u64,
     /// Replace an existing output file that is not an earlier result of this command.

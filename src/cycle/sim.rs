@@ -9,12 +9,16 @@ use crate::cycle::{Arch, Folded, Item, Machine, Pipelined, RegisterView};
 use crate::pipeline::Datapath;
 
 /// Per-cycle `valid` offers and `out_ready` bits, drawn from ChaCha8 with a seed: for each
-/// cycle, first the bubble draw, then the stall draw (`docs/cycle.md`).
+/// cycle, first the bubble draw, then the stall draw; or the co-simulation's handshake
+/// pattern (`docs/cycle.md`, [`Stimulus::with_handshake`]).
 #[derive(Debug, Clone)]
 pub struct Stimulus {
     rng: ChaCha8Rng,
     bubble: f64,
     stall: f64,
+    /// The co-simulation's pattern (stall bursts and directed episodes) instead of
+    /// independent draws, when given.
+    handshake: Option<super::stimulus::Handshake>,
 }
 
 impl Stimulus {
@@ -24,18 +28,31 @@ impl Stimulus {
             rng: ChaCha8Rng::seed_from_u64(seed),
             bubble,
             stall,
+            handshake: None,
+        }
+    }
+
+    /// A pattern source drawing the co-simulation's handshake pattern from ChaCha8 with a
+    /// seed (`super::stimulus::Handshake`: directed episodes, stall bursts).
+    pub fn with_handshake(seed: u64, handshake: super::stimulus::Handshake) -> Stimulus {
+        Stimulus {
+            handshake: Some(handshake),
+            ..Stimulus::new(seed, 0.0, 0.0)
         }
     }
 
     /// Whether every cycle offers an input and is ready for an output (no bubbles, no
     /// stalls): [`Stimulus::next_cycle`] then draws nothing.
     pub fn always_ready(&self) -> bool {
-        self.bubble == 0.0 && self.stall == 0.0
+        self.handshake.is_none() && self.bubble == 0.0 && self.stall == 0.0
     }
 
     /// The next cycle's (valid offer, out_ready).
     #[inline]
     pub fn next_cycle(&mut self) -> (bool, bool) {
+        if let Some(h) = &mut self.handshake {
+            return h.next(&mut self.rng);
+        }
         if self.bubble == 0.0 && self.stall == 0.0 {
             // Both draws would be >= 0: skipping them changes no cycle, since nothing else
             // reads this generator.

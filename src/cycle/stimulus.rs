@@ -1,9 +1,12 @@
 //! The co-simulation stimulus: the cycle model run on a vector directory's inputs in file
 //! order under seeded bubbles and stalls, rendered as the testbench's files
 //! (`stim_valid.hex`, `stim_ready.hex`, `expected_cycle.hex`, `stim.json`) and, on request,
-//! the model's VCD trace of that run.
+//! the model's VCD trace of that run; and [`Handshake`], the pattern of `in_valid` offers and
+//! `out_ready` every testbench drives (docs/cycle.md, "The handshake pattern").
 
 use std::fmt::Write as _;
+
+use rand::Rng;
 
 use super::sim::{simulate, Stimulus, Stop};
 use super::vcd::write_vcd;
@@ -44,6 +47,128 @@ pub struct CosimStimulus {
     pub latency: (u64, u64),
 }
 
+/// The handshake pattern of the co-simulation (docs/cycle.md, "The handshake pattern"): a
+/// block of directed episodes, then [`Handshake::RANDOM_CYCLES`] random cycles, repeated. The
+/// episodes start from an empty machine (each after a drain: no offer, ready, for
+/// `latency + ii + 2` cycles) and have the handshakes a folded machine can meet, with
+/// `s = ii + 1`:
+///
+/// 1. inputs offered at 0, ii, 2 ii, 3 ii (back to back at the initiation interval), the first
+///    output stalled from its first cycle (`latency`) for `s` cycles;
+/// 2. inputs at 0 and `latency + s`, the first output stalled for `s` cycles from its first:
+///    the stall ends on the cycle a new input is offered;
+/// 3. inputs at 0 and 1, the first output stalled on its first cycle only;
+/// 4. an input offered on every cycle 0..=2 ii, a stall of `s` cycles from `latency + 1`.
+///
+/// In the random cycles, each offers with probability `1 - bubble` (independent draws), and
+/// `out_ready` falls in bursts: in a cycle outside a burst a burst starts with probability
+/// `stall / (stall + B (1 - stall))`, `B = ii + 1`, and lasts a length drawn uniformly from
+/// `1..=2B - 1` (mean `B`), so that a fraction `stall` of the cycles is stalled and bursts as
+/// long as two initiation intervals occur; a burst in progress ends when a block begins. Draws
+/// per random cycle: the offer, then (outside a burst) the start, then (when it starts) the
+/// length.
+///
+/// # Examples
+/// ```
+/// use specfx::cycle::stimulus::Handshake;
+/// // Pipelined, latency 3: episode 3 after its drain of 3 + 1 + 2 cycles.
+/// let block = Handshake::block(3, 1);
+/// let drain = vec![(false, true); 6];
+/// let third: Vec<(bool, bool)> = vec![(true, true), (true, true), (false, true), (false, false)];
+/// let at = block.len() - (drain.len() + 6) - (drain.len() + third.len());
+/// assert_eq!(&block[at..at + 6], &drain[..]);
+/// assert_eq!(&block[at + 6..at + 10], &third[..]);
+/// ```
+#[derive(Debug, Clone)]
+pub struct Handshake {
+    block: Vec<(bool, bool)>,
+    bubble: f64,
+    burst_start: f64,
+    burst_max: u64,
+    burst_left: u64,
+    cycle: u64,
+}
+
+impl Handshake {
+    /// Random cycles between two blocks of directed episodes.
+    pub const RANDOM_CYCLES: u64 = 4096;
+
+    /// The pattern of a machine of this latency and initiation interval, with these
+    /// probabilities of a bubble and of a stalled cycle (in [0, 1)).
+    pub fn new(latency: u64, ii: u64, bubble: f64, stall: f64) -> Handshake {
+        let b = (ii + 1) as f64;
+        Handshake {
+            block: Handshake::block(latency, ii),
+            bubble,
+            burst_start: if stall > 0.0 {
+                stall / (stall + b * (1.0 - stall))
+            } else {
+                0.0
+            },
+            burst_max: 2 * (ii + 1) - 1,
+            burst_left: 0,
+            cycle: 0,
+        }
+    }
+
+    /// The block of directed episodes, each after its drain: `(offer, out_ready)` per cycle.
+    pub fn block(latency: u64, ii: u64) -> Vec<(bool, bool)> {
+        let s = ii + 1;
+        let drain = latency + ii + 2;
+        let episodes: [(Vec<u64>, u64, u64); 4] = [
+            (vec![0, ii, 2 * ii, 3 * ii], latency, s),
+            (vec![0, latency + s], latency, s),
+            (vec![0, 1], latency, 1),
+            ((0..=2 * ii).collect(), latency + 1, s),
+        ];
+        let mut block = Vec::new();
+        for (inputs, stall_at, stall_len) in episodes {
+            block.extend((0..drain).map(|_| (false, true)));
+            let end = inputs
+                .iter()
+                .copied()
+                .max()
+                .unwrap_or(0)
+                .max(stall_at + stall_len - 1);
+            block.extend((0..=end).map(|t| {
+                (
+                    inputs.contains(&t),
+                    !(stall_at..stall_at + stall_len).contains(&t),
+                )
+            }));
+        }
+        block
+    }
+
+    /// The number of cycles of the directed blocks among `cycles` cycles of a run.
+    pub fn block_cycles(&self, cycles: u64) -> u64 {
+        let len = self.block.len() as u64;
+        (cycles / (len + Self::RANDOM_CYCLES) + 1) * len
+    }
+
+    /// The next cycle's `(offer, out_ready)`.
+    pub fn next(&mut self, rng: &mut impl Rng) -> (bool, bool) {
+        let len = self.block.len() as u64;
+        let phase = self.cycle % (len + Self::RANDOM_CYCLES);
+        self.cycle += 1;
+        if phase < len {
+            self.burst_left = 0;
+            return self.block[phase as usize];
+        }
+        let offer = rng.r#gen::<f64>() >= self.bubble;
+        let ready = if self.burst_left > 0 {
+            self.burst_left -= 1;
+            false
+        } else if rng.r#gen::<f64>() < self.burst_start {
+            self.burst_left = rng.gen_range(1..=self.burst_max) - 1;
+            false
+        } else {
+            true
+        };
+        (offer, ready)
+    }
+}
+
 /// One bit a line.
 fn bits_file(bits: &[bool]) -> String {
     bits.iter()
@@ -79,13 +204,22 @@ pub fn cosim_stimulus(
             )
         })
         .collect();
-    let mut stim = Stimulus::new(seed, bubble, stall);
+    let latency = arch.latency(dp.config());
+    let handshake = Handshake::new(
+        latency,
+        arch.initiation_interval(dp.config()),
+        bubble,
+        stall,
+    );
     // Each vector needs about one offer (1 / (1 - bubble) cycles) and, folded, an initiation
-    // interval of accepted outputs (ii / (1 - stall)); twenty times that, plus the latency,
-    // drains any run but one of vanishing probability. Longer stimuli are refused up front.
+    // interval of accepted outputs (ii / (1 - stall)), besides the directed episodes; twenty
+    // times that, plus the latency, drains any run but one of vanishing probability. Longer
+    // stimuli are refused up front.
     let ii = arch.initiation_interval(dp.config()) as f64;
     let per_vector = 1.0 / (1.0 - bubble) + ii / (1.0 - stall);
-    let expected = (items.len() as f64 * per_vector).ceil();
+    let random = (items.len() as f64 * per_vector).ceil();
+    let expected = random + handshake.block_cycles(random as u64) as f64;
+    let mut stim = Stimulus::with_handshake(seed, handshake);
     // With a trace, every cycle is kept in memory: a tighter limit.
     let (max, what) = if vcd {
         (super::vcd::MAX_TRACE_CYCLES, "with --vcd, the trace")
@@ -177,4 +311,88 @@ pub fn cosim_stimulus(
         n_cycles: s.n_cycles,
         latency: (s.latency_min, s.latency_max),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Handshake;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    /// The first episode of a folded machine of latency 7 and initiation interval 6, by hand:
+    /// a drain of 7 + 6 + 2 = 15 cycles, then offers at 0, 6, 12, 18 and out_ready low from 7
+    /// to 13 (s = 7 cycles from the first output's first cycle).
+    #[test]
+    fn the_first_episode_of_a_folded_machine() {
+        let block = Handshake::block(7, 6);
+        assert!(block[..15].iter().all(|&b| b == (false, true)));
+        let episode = &block[15..15 + 19];
+        for (t, &(offer, ready)) in episode.iter().enumerate() {
+            assert_eq!(offer, [0, 6, 12, 18].contains(&t), "offer at {t}");
+            assert_eq!(ready, !(7..=13).contains(&t), "ready at {t}");
+        }
+        // Then the second episode's drain.
+        assert!(block[34..34 + 15].iter().all(|&b| b == (false, true)));
+    }
+
+    /// In the random cycles a fraction `stall` of the cycles is stalled, in bursts of 1 to
+    /// 2 (ii + 1) - 1 cycles whose mean is ii + 1; offers have probability 1 - bubble.
+    #[test]
+    fn random_cycles_stall_in_bursts_of_the_asked_fraction() {
+        let (latency, ii, bubble, stall) = (7, 6, 0.25, 0.2);
+        let mut h = Handshake::new(latency, ii, bubble, stall);
+        let skip = Handshake::block(latency, ii).len();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..skip {
+            h.next(&mut rng);
+        }
+        let n = Handshake::RANDOM_CYCLES as usize;
+        let (mut stalled, mut offered, mut run) = (0, 0, 0);
+        let mut bursts = Vec::new();
+        // Many periods' random cycles (each period's block skipped).
+        for _ in 0..100 {
+            for _ in 0..n {
+                let (offer, ready) = h.next(&mut rng);
+                offered += usize::from(offer);
+                if ready {
+                    if run > 0 {
+                        bursts.push(run);
+                    }
+                    run = 0;
+                } else {
+                    stalled += 1;
+                    run += 1;
+                }
+            }
+            for _ in 0..skip {
+                h.next(&mut rng);
+            }
+        }
+        let total = (100 * n) as f64;
+        assert!((stalled as f64 / total - stall).abs() < 0.01, "{stalled}");
+        assert!(
+            (offered as f64 / total - (1.0 - bubble)).abs() < 0.01,
+            "{offered}"
+        );
+        // Adjacent bursts merge into longer runs, so runs reach past 2 (ii + 1) - 1 = 13 only
+        // by merging; runs at least an initiation interval long are common.
+        let long = bursts.iter().filter(|&&b| b > ii).count();
+        assert!(long * 10 > bursts.len(), "{long} of {}", bursts.len());
+        assert_eq!(bursts.iter().min(), Some(&1));
+    }
+
+    /// Without bubbles or stalls, the random cycles offer and accept on every cycle and draw
+    /// only the offers; the blocks come back every RANDOM_CYCLES cycles.
+    #[test]
+    fn without_probabilities_only_the_blocks_stall() {
+        let mut h = Handshake::new(8, 1, 0.0, 0.0);
+        let block = Handshake::block(8, 1);
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let period = block.len() + Handshake::RANDOM_CYCLES as usize;
+        for cycle in 0..2 * period {
+            let phase = cycle % period;
+            let want = block.get(phase).copied().unwrap_or((true, true));
+            assert_eq!(h.next(&mut rng), want, "cycle {cycle}");
+        }
+    }
 }

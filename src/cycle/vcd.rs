@@ -164,9 +164,11 @@ fn value(dp: &Datapath, t: &CycleTrace, source: Source, width: u32) -> Option<Wo
     Some(Word::new(raw, width))
 }
 
-/// The longest trace specfx writes, in cycles (2^17): every register of every traced cycle is
-/// kept in memory, several kilobytes a cycle, until the trace is written.
-pub const MAX_TRACE_CYCLES: u64 = 1 << 17;
+/// The longest trace specfx writes, in cycles (2^18, room for the default co-simulation of
+/// the baseline in either architecture: the folded one is expected to need about 137,000
+/// cycles): every register of every traced cycle is kept in memory, several kilobytes a
+/// cycle, until the trace is written.
+pub const MAX_TRACE_CYCLES: u64 = 1 << 18;
 
 /// The first bytes of every trace [`write_vcd`] writes (a simulator's dump begins with
 /// `$date` or a comment): how a command recognises its own earlier trace before replacing it.

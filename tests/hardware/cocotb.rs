@@ -435,3 +435,126 @@ fn the_cocotb_testbenches_pass_and_fail_under_verilator() {
     );
     std::fs::remove_dir_all(&broken).unwrap();
 }
+
+/// A copy of `hdl_ref/rtl` (and the vector testbench) with one exact piece of `file` (under
+/// `rtl/`) replaced.
+fn rtl_with(name: &str, file: &str, from: &str, to: &str) -> PathBuf {
+    let dir = temp_dir(name);
+    std::fs::create_dir_all(dir.join("tb")).unwrap();
+    std::fs::copy(
+        root().join("hdl_ref/tb/tb_specfx.v"),
+        dir.join("tb/tb_specfx.v"),
+    )
+    .unwrap();
+    std::fs::create_dir_all(dir.join("rtl")).unwrap();
+    for entry in std::fs::read_dir(root().join("hdl_ref/rtl")).unwrap() {
+        let path = entry.unwrap().path();
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        if path.ends_with(file) {
+            assert_eq!(
+                text.matches(from).count(),
+                1,
+                "{from:?} is not in {file} once"
+            );
+            text = text.replace(from, to);
+        }
+        std::fs::write(dir.join("rtl").join(path.file_name().unwrap()), text).unwrap();
+    }
+    dir
+}
+
+/// A folded core whose `out_valid` has no reset starts with `out_valid` X in Icarus Verilog:
+/// the live scoreboard fails it (it used to read the X as 0 and pass every vector), and so
+/// does the vector testbench (`specfx cosim`).
+#[test]
+fn an_x_on_out_valid_fails_the_live_scoreboard_and_the_vector_testbench() {
+    let dir = rtl_with(
+        "no-reset",
+        "specfx_folded.v",
+        "            count     <= {CNT_W{1'b0}};\n            out_valid <= 1'b0;\n",
+        "            count     <= {CNT_W{1'b0}};\n",
+    );
+    let hdl = dir.to_str().unwrap();
+    let o = run_live(
+        "baseline",
+        &[
+            "--n",
+            "16,17",
+            "--arch",
+            "folded",
+            "--nvec",
+            "100",
+            "--hdl-ref",
+            hdl,
+        ],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .any(|l| l.starts_with("protocol: cycle ")
+                && l.contains(" out_valid=")
+                && l.ends_with("an X or Z")),
+        "{}",
+        text(&o)
+    );
+    let o = specfx(&[
+        "cosim",
+        "--sim",
+        "icarus",
+        "--arch",
+        "folded",
+        "--n",
+        "16,17",
+        "--cases",
+        "corner",
+        "--hdl-ref",
+        hdl,
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .any(|l| l.starts_with("protocol: cycle ") && l.ends_with("an X or Z")),
+        "{}",
+        text(&o)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A register that differs from the model where no port shows it fails the live scoreboard:
+/// a pipelined core whose first register keeps the input unclamped (`c_cl_1` above 1.0; only
+/// the paper cutoff reads it) passes every vector at the ports (`specfx cosim` passes it) and
+/// the live scoreboard's register comparison fails it, naming the register.
+#[test]
+fn a_register_only_difference_fails_the_live_scoreboard() {
+    let dir = rtl_with(
+        "register-only",
+        "specfx_pipelined.v",
+        ".d({in_depth, in_coef, in_threshold, in_offset, in_slope, c_cl_0, d_0}),",
+        ".d({in_depth, in_coef, in_threshold, in_offset, in_slope, in_c, d_0}),",
+    );
+    let hdl = dir.to_str().unwrap();
+    let o = specfx(&[
+        "cosim",
+        "--sim",
+        "icarus",
+        "--n",
+        "16,17",
+        "--cases",
+        "corner",
+        "--hdl-ref",
+        hdl,
+    ]);
+    assert!(o.status.success(), "the ports show it now: {}", text(&o));
+    let o = run_live(
+        "baseline",
+        &["--n", "16,17", "--nvec", "100", "--hdl-ref", hdl],
+    );
+    let stage = stage_line(&o);
+    assert!(
+        stage.contains("the first register that differs from the model is c_cl_1"),
+        "{stage}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
