@@ -13,6 +13,7 @@ use serde::Serialize;
 
 use crate::fixed::Format;
 use crate::hdl::cost::Target;
+use crate::pipeline::ports::PerN;
 use crate::pipeline::{Datapath, Variant};
 use crate::reference::lobe::Cutoff;
 
@@ -76,39 +77,23 @@ pub fn constant_rom(dp: &Datapath, target: Target) -> ConstantRom {
     } else {
         index_bits(entries)
     };
-    let (slope, offset) = cfg.constant_formats();
-    let mut fields = Vec::new();
     let minimax = cfg.variant == Variant::Minimax;
     // Per-n depth: the plain slope n / 2^j(n) is no longer n itself, and j(n) is a field.
     let bypass = dp.bypass_from() < cfg.k as usize;
-    if minimax || !addressed_by_n || bypass {
-        fields.push(RomField {
-            name: "slope",
-            bits: slope.width(),
-        });
-    }
-    if minimax {
-        fields.push(RomField {
-            name: "offset",
-            bits: offset.width(),
-        });
-    }
-    if cfg.cutoff == Cutoff::Paper {
-        fields.push(RomField {
-            name: "threshold",
-            bits: cfg.c.format.width(),
-        });
-    }
-    fields.push(RomField {
-        name: "coef",
-        bits: cfg.coef.format.width(),
-    });
-    if bypass {
-        fields.push(RomField {
-            name: "depth",
-            bits: crate::hdl::DEPTH_BITS,
-        });
-    }
+    let fields: Vec<RomField> = PerN::ALL
+        .into_iter()
+        .filter(|p| match p {
+            PerN::Slope => minimax || !addressed_by_n || bypass,
+            PerN::Offset => minimax,
+            PerN::Threshold => cfg.cutoff == Cutoff::Paper,
+            PerN::Coef => true,
+            PerN::Depth => bypass,
+        })
+        .map(|p| RomField {
+            name: p.field(),
+            bits: p.format(dp).width(),
+        })
+        .collect();
     let width: u64 = fields.iter().map(|f| u64::from(f.bits)).sum();
     let inputs = match target {
         Target::Xilinx => 6,
@@ -143,18 +128,13 @@ fn hex(raw: i64, f: Format) -> String {
 pub fn rom_verilog(dp: &Datapath) -> String {
     let cfg = dp.config();
     let rom = constant_rom(dp, Target::Generic);
-    let (slope_f, offset_f) = cfg.constant_formats();
-    let stored = |name: &str| rom.fields.iter().any(|f| f.name == name);
-    let mut ports = vec![
-        ("slope", slope_f),
-        ("offset", offset_f),
-        ("threshold", cfg.c.format),
-        ("coef", cfg.coef.format),
-    ];
-    if stored("depth") {
-        let bits = crate::hdl::DEPTH_BITS as i32;
-        ports.push(("depth", Format::unsigned(bits, 0).expect("a few bits")));
-    }
+    let stored = |p: PerN| rom.fields.iter().any(|f| f.name == p.field());
+    // Every per-n port of specfx_dut, but the depth where no n bypasses a stage.
+    let ports: Vec<(PerN, Format)> = PerN::ALL
+        .into_iter()
+        .filter(|&p| p != PerN::Depth || stored(p))
+        .map(|p| (p, p.format(dp)))
+        .collect();
     let mut v = String::new();
     v.push_str(&format!(
         "// specfx_rom: the per-n constants of datapath `{}` ({} entries, addressed by {}).\n// Written by specfx; do not edit.\n`timescale 1ns / 1ps\n`default_nettype none\n\nmodule specfx_rom (\n    input  wire [{}:0] addr",
@@ -163,44 +143,37 @@ pub fn rom_verilog(dp: &Datapath) -> String {
         if rom.addressed_by_n { "n" } else { "the index of n in the ascending set" },
         rom.address_bits - 1
     ));
-    for &(name, f) in &ports {
-        let kind = if stored(name) { "reg " } else { "wire" };
+    for &(p, f) in &ports {
+        let kind = if stored(p) { "reg " } else { "wire" };
         v.push_str(&format!(
-            ",\n    output {kind} [{}:0] {name}",
-            f.width() - 1
+            ",\n    output {kind} [{}:0] {}",
+            f.width() - 1,
+            p.field()
         ));
     }
     v.push_str("\n);\n");
     let first = dp.constants_for(cfg.n.min()).expect("n set is not empty");
-    for &(name, f) in &ports {
-        if stored(name) {
+    for &(p, f) in &ports {
+        if stored(p) {
             continue;
         }
-        let value = match name {
+        let value = match p {
             // Plain, addressed by n: the slope's raw code (n with k fraction bits) is n.
-            "slope" => "addr".to_string(),
-            "offset" => hex(first.offset_raw, f),
+            PerN::Slope => "addr".to_string(),
+            PerN::Offset => hex(first.offset_raw, f),
             _ => hex(0, f),
         };
-        v.push_str(&format!("    assign {name} = {value};\n"));
+        v.push_str(&format!("    assign {} = {value};\n", p.field()));
     }
     v.push_str("    always @* begin\n        case (addr)\n");
     for (i, &n) in cfg.n.values().iter().enumerate() {
         let nc = dp.constants_for(n).expect("n in the set");
         let addr = if rom.addressed_by_n { n as usize } else { i };
         let mut body = Vec::new();
-        for &(name, f) in &ports {
-            if !stored(name) {
-                continue;
+        for &(p, f) in &ports {
+            if stored(p) {
+                body.push(format!("{} = {};", p.field(), hex(p.raw(nc), f)));
             }
-            let raw = match name {
-                "slope" => nc.slope_raw,
-                "offset" => nc.offset_raw,
-                "threshold" => nc.threshold.unwrap_or(0),
-                "depth" => i64::from(nc.depth),
-                _ => nc.coef_raw,
-            };
-            body.push(format!("{name} = {};", hex(raw, f)));
         }
         v.push_str(&format!(
             "            {}'d{addr}: begin {} end // n = {n}\n",
@@ -210,8 +183,8 @@ pub fn rom_verilog(dp: &Datapath) -> String {
     }
     let defaults: Vec<String> = ports
         .iter()
-        .filter(|(name, _)| stored(name))
-        .map(|(name, f)| format!("{name} = {};", hex(0, *f)))
+        .filter(|(p, _)| stored(*p))
+        .map(|(p, f)| format!("{} = {};", p.field(), hex(0, *f)))
         .collect();
     v.push_str(&format!(
         "            default: begin {} end\n        endcase\n    end\nendmodule\n\n`default_nettype wire\n",
