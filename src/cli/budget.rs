@@ -131,12 +131,7 @@ pub fn run(args: &BudgetArgs) -> Result<Outcome> {
         b.arch = dp.config().resolve_arch(None);
         b
     });
-    let report = budget(
-        &dp,
-        judged.as_ref(),
-        gappa_n.as_deref(),
-        out_dir.path(),
-    )?;
+    let report = budget(&dp, judged.as_ref(), gappa_n.as_deref(), out_dir.path())?;
     out_dir.commit()?;
     if args.json {
         print_json(&report)?;

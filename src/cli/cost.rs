@@ -77,7 +77,25 @@ pub fn run(args: &CostArgs) -> Result<Outcome> {
         }
         dir
     };
-    let mut r = tools::yosys::cost_report(&dp, arch, args.target, &dir, args.analytic_only)?;
+    // yosys takes seconds to minutes per run: a line per step (and a bar on a terminal).
+    let n_steps = if args.analytic_only {
+        0
+    } else {
+        tools::yosys::COST_REPORT_STEPS + u64::from(args.timing)
+    };
+    let mut steps = (n_steps > 0).then(|| super::progress::Steps::new("specfx cost", n_steps));
+    let mut r = tools::yosys::cost_report_steps(
+        &dp,
+        arch,
+        args.target,
+        &dir,
+        args.analytic_only,
+        &mut |msg| {
+            if let Some(s) = steps.as_mut() {
+                s.start(msg);
+            }
+        },
+    )?;
     if args.target == Target::Ice40 {
         let (dsps, luts, ffs) = match &r.yosys {
             Some(y) => (y.dsps, y.luts, y.ffs),
@@ -87,7 +105,17 @@ pub fn run(args: &CostArgs) -> Result<Outcome> {
         r.over_limit = specfx::hdl::pnr::device_check(dsps, luts, ffs, device);
     }
     if args.timing {
+        if let Some(s) = steps.as_mut() {
+            s.start(&format!(
+                "placing and routing {} ({arch}) on the {} with yosys and nextpnr",
+                dp.config().name,
+                device.full_name()
+            ));
+        }
         r.timing = Some(tools::nextpnr::place_and_route(&dp, arch, device, &dir)?);
+    }
+    if let Some(s) = steps {
+        s.finish();
     }
     if args.json {
         print_json(&r)?;

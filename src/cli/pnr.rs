@@ -42,7 +42,15 @@ pub fn run(args: &TimingArgs) -> Result<Outcome> {
     let arch = dp.config().resolve_arch(args.arch);
     let dir = hdl_ref(args.hdl_ref.as_deref())?;
     tools::yosys::check()?;
+    // Synthesis, placement and routing take seconds to minutes: say so (a bar on a terminal).
+    let mut steps = super::progress::Steps::new("specfx timing", 1);
+    steps.start(&format!(
+        "placing and routing {} ({arch}) on the {} with yosys and nextpnr",
+        dp.config().name,
+        args.device.full_name()
+    ));
     let t = tools::nextpnr::place_and_route(&dp, arch, args.device, &dir)?;
+    steps.finish();
     if args.json {
         print_json(&t)?;
     } else {

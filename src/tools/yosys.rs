@@ -162,10 +162,35 @@ pub fn cost_report(
     hdl_ref: &Path,
     analytic_only: bool,
 ) -> Result<CostReport, Error> {
+    cost_report_steps(dp, arch, target, hdl_ref, analytic_only, &mut |_| {})
+}
+
+/// How many runs of yosys [`cost_report_steps`] starts: the datapath's and its ROM's (none
+/// when `analytic_only`).
+pub const COST_REPORT_STEPS: u64 = 2;
+
+/// [`cost_report`], calling `step` with what it starts before each synthesis (each may take
+/// minutes; a cached one is instant), for the caller's progress.
+pub fn cost_report_steps(
+    dp: &Datapath,
+    arch: Arch,
+    target: Target,
+    hdl_ref: &Path,
+    analytic_only: bool,
+    step: &mut dyn FnMut(&str),
+) -> Result<CostReport, Error> {
     let synthesis = if analytic_only {
         None
     } else {
+        let name = &dp.config().name;
+        let target_name = target.name();
+        step(&format!(
+            "synthesising {name} ({arch}) with yosys on {target_name}"
+        ));
         let datapath = synthesise(dp, arch, target, hdl_ref)?;
+        step(&format!(
+            "synthesising the constant ROM of {name} with yosys on {target_name}"
+        ));
         let rom = synthesise_rom(dp, target)?;
         Some((datapath, rom.cost))
     };

@@ -242,3 +242,44 @@ fn a_repeated_synthesis_comes_from_the_cache_and_only_for_the_same_inputs() {
     assert!(entries("yosys").len() >= 3, "{:?}", entries("yosys"));
     assert_eq!(entries("nextpnr").len(), 2);
 }
+
+/// `cost` runs yosys twice (the datapath, its constant ROM), for seconds to minutes: off a
+/// terminal it says what it starts and how far it is, as every long command does (a line
+/// per step, a line per tenth); `--quiet` and `--analytic-only` print nothing on stderr.
+#[test]
+fn cost_reports_its_progress_off_a_terminal() {
+    let dir = std::env::temp_dir().join(format!("specfx-hw-progress-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = dir.join("small.toml");
+    std::fs::write(&cfg, "k = 1\nn = \"16..=20\"\n").unwrap();
+    let run = |extra: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_specfx"))
+            .args(["cost", "--config", cfg.to_str().unwrap()])
+            .args(extra)
+            .env("SPECFX_CACHE", dir.join("cache"))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stderr).unwrap()
+    };
+    let stderr = run(&[]);
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 4, "{stderr}");
+    assert_eq!(
+        lines[0],
+        "specfx cost: synthesising small (pipelined) with yosys on ice40"
+    );
+    assert!(lines[1].starts_with("cost: 50% (1/2 steps)"), "{stderr}");
+    assert_eq!(
+        lines[2],
+        "specfx cost: synthesising the constant ROM of small with yosys on ice40"
+    );
+    assert!(
+        lines[3].starts_with("cost: 100% (2/2 steps), took "),
+        "{stderr}"
+    );
+    assert_eq!(run(&["--quiet"]), "");
+    assert_eq!(run(&["--analytic-only"]), "");
+    let _ = std::fs::remove_dir_all(&dir);
+}
