@@ -186,3 +186,70 @@ fn depth_rules_round_trip_and_fixed_is_left_out() {
         assert_eq!(Config::from_toml(&c.to_toml()).unwrap(), c);
     }
 }
+
+/// `docs/arithmetic.md` section 3.3 as written: its Python reference code, with the plain
+/// variant's per-n constants computed by the very expression the section gives for
+/// `slope_raw` (read from the document), equals `Datapath::eval` on every probe, at exponents
+/// that square twice (two stages bypassed) and four times. The section once gave
+/// `slope_raw = n`, the fixed depth's constant, which this finds.
+#[test]
+fn the_documented_reference_code_follows_the_per_n_depth() {
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/arithmetic.md"))
+        .expect("the document is in the repository");
+    let section = &doc[doc.find("### 3.3 Reference code").expect("section 3.3")..];
+    let section = &section[..section.find("\n## 4.").expect("section 4 follows")];
+    let code_start = section.find("```python\n").expect("a Python block") + "```python\n".len();
+    let code_len = section[code_start..].find("```").expect("the block ends");
+    let code = &section[code_start..code_start + code_len];
+    let after = &section[code_start + code_len..];
+    let plain = &after[after.find("`plain` variant").expect("the plain constants")..];
+    let rule_start = plain.find("`slope_raw = ").expect("slope_raw's rule") + "`slope_raw = ".len();
+    let rule = &plain[rule_start..rule_start + plain[rule_start..].find('`').unwrap()];
+
+    let dp = Datapath::new(config(
+        "k = 4\nn = \"16,40,63,64,100\"\ndepth = [{ from = 16, j = 2 }, { from = 64, j = 4 }]\n",
+    ))
+    .unwrap();
+    let codes = [0i64, 1000, 20000, 30000, 32000, 32767, 32768];
+    let mut cases = String::new();
+    let mut expected = String::new();
+    for nc in dp.constants() {
+        for &c in &codes {
+            cases.push_str(&format!(
+                "({}, {}, {}, {}),\n",
+                nc.n, nc.depth, nc.coef_raw, c
+            ));
+            let p = dp.eval(c, nc);
+            let values: Vec<String> = p.values[..9].iter().map(i64::to_string).collect();
+            expected.push_str(&values.join(" "));
+            expected.push('\n');
+        }
+    }
+    let driver = format!(
+        r#"{code}
+from types import SimpleNamespace as NS
+spec = lambda fmt: (fmt, "RND", "SAT")
+cfg = NS(c=(False, 1, 15), d=(True, 1, 15), t=spec((True, 2, 16)), b=spec((False, 1, 16)),
+         square=[spec((False, 1, 16))] * 4, out=spec((False, 8, 16)), coef_format=(False, 8, 16),
+         cutoff="clamp")
+k = 4
+for n, j, coef_raw, c in [{cases}]:
+    K = NS(depth=j, slope_raw=({rule}), slope_frac=k, offset_raw=1, offset_frac=0,
+           threshold=None, coef_raw=coef_raw)
+    values, events, cut, clamped = evaluate(cfg, K, c)
+    print(" ".join(str(v) for v in values))
+"#
+    );
+    let out = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(&driver)
+        .output()
+        .expect("python3 runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let got = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(got, expected, "the document's slope_raw rule: {rule}");
+}
