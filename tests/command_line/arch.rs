@@ -187,3 +187,24 @@ fn budget_counts_cost_ceilings_on_the_recorded_arch() {
         let _ = std::fs::remove_dir_all(&out);
     }
 }
+
+/// A design space whose base records an architecture: its points take it (and record it),
+/// unless `arch` is an axis; a base without one gives pipelined points that record none.
+#[test]
+fn sweep_points_take_the_base_arch() {
+    use specfx::analysis::sweep::Space;
+    use specfx::pipeline::Arch;
+    let s = Space::from_toml("[base]\narch = \"folded\"\n[vary]\nk = [3, 4]\n").unwrap();
+    let (cfg, arch) = s.point(1).unwrap();
+    assert_eq!(
+        (cfg.k, arch, cfg.arch),
+        (4, Arch::Folded, Some(Arch::Folded))
+    );
+    let s =
+        Space::from_toml("[base]\narch = \"folded\"\n[vary]\narch = [\"pipelined\"]\n").unwrap();
+    let (cfg, arch) = s.point(0).unwrap();
+    assert_eq!((arch, cfg.arch), (Arch::Pipelined, Some(Arch::Pipelined)));
+    let s = Space::from_toml("[vary]\nk = [3]\n").unwrap();
+    let (cfg, arch) = s.point(0).unwrap();
+    assert_eq!((arch, cfg.arch), (Arch::Pipelined, None));
+}
