@@ -22,7 +22,8 @@ left) && stim_valid[t], out_ready = stim_ready[t] (both 1 past the end of the fi
 input ports show the next vector also while in_valid is low (zeros after the last).
 Checks: on each output transfer, out_data against expected_out[i] and the cycle against
 expected_cycle[i]; out_valid and out_data held while out_valid is high and out_ready low
-(rule 5); with RESET_DATA = 1, out_data == 0 in cycle 0; no output after the last one (rule
+(rule 5); with RESET_DATA = 1, out_data == 0 in cycle 0; no X or Z on in_ready or out_valid
+in any cycle, nor on out_data while out_valid is high; no output after the last one (rule
 4, for a few cycles); every output arrives (a timeout counts the missing ones as failed).
 Every word is compared as its raw bits, masked to the port's width (signed formats are two's
 complement; any width up to 64 bits and beyond). The first problems are logged as
@@ -288,11 +289,21 @@ async def specfx_matches_vectors(dut):
         dut.out_ready.value = int(out_ready)
 
         await ReadOnly()
-        in_ready = str(dut.in_ready.value) == "1"
+        in_ready_bit = str(dut.in_ready.value)
+        in_ready = in_ready_bit == "1"
         out_valid_bit = str(dut.out_valid.value)
         out_data = dut.out_data.value
         out_valid = out_valid_bit == "1"
         data_bits = str(out_data)
+        # An X or Z is never read as 0 (tb_specfx.v's check).
+        for name, bit in (("in_ready", in_ready_bit), ("out_valid", out_valid_bit)):
+            if bit not in ("0", "1"):
+                chk.fail(f"protocol: cycle {cycle}: {name}={bit}, an X or Z")
+        if out_valid and not out_data.is_resolvable:
+            chk.fail(
+                f"protocol: cycle {cycle}: out_data={logic_text(out_data, out_width)} while "
+                "out_valid is high, an X or Z"
+            )
 
         if reset_data and cycle == 0 and data_bits != "0" * out_width:
             chk.fail(

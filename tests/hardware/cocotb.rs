@@ -498,6 +498,17 @@ fn an_x_on_out_valid_fails_the_live_scoreboard_and_the_vector_testbench() {
         "{}",
         text(&o)
     );
+    let (vec_dir, _) = vectors("no-reset-vectors", &["--n", "16,17", "--cases", "corner"]);
+    let o = run_py(&vec_dir, &["--arch", "folded", "--hdl-ref", hdl]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .any(|l| l.starts_with("protocol: cycle ") && l.ends_with("an X or Z")),
+        "{}",
+        text(&o)
+    );
+    std::fs::remove_dir_all(&vec_dir).unwrap();
     let o = specfx(&[
         "cosim",
         "--sim",
