@@ -280,7 +280,7 @@ mod tests {
         let e = "out <=\t1 ulp\u{1b}[2J 'é'".parse::<Budget>().unwrap_err();
         assert_eq!(
             e.to_string(),
-            r"budget: unit 'ulp\u{1b}[2J 'é'' does not fit this metric in 'out <= 1 ulp\u{1b}[2J 'é''; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'"
+            r"budget: 'out <= 1 ulp\u{1b}[2J 'é'' has the unit 'ulp\u{1b}[2J 'é'': out takes ulp (output LSBs), e.g. 'out <= 1 ulp'"
         );
         let e = "s1.2\t".parse::<Format>().unwrap_err().to_string();
         assert!(e.ends_with(r"got 's1.2\t'"), "{e}");
