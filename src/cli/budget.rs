@@ -29,7 +29,9 @@ pub struct BudgetArgs {
     /// Exponents, replacing the configuration's set.
     #[arg(long)]
     n: Option<NSet>,
-    /// The budget to judge against, e.g. "shape_total <= 1 lsb8, out <= 1 ulp".
+    /// The budget to judge against, e.g. "shape_total <= 1 lsb8, out <= 1 ulp" (a metric with
+    /// a unit needs it: a bare number is refused). Cost ceilings are counted on the
+    /// configuration's `arch` key (pipelined without one).
     #[arg(long)]
     budget: Option<Budget>,
     /// Output directory.

@@ -28,7 +28,8 @@ use specfx::provenance::{canonical_nset, Inputs, Provenance};
 #[derive(Debug, Args)]
 pub struct OptimizeArgs {
     /// The budget, e.g. "shape_total <= 1 lsb8", "shape_quant <= 0.5 lsb8", "out <= 1 ulp",
-    /// "correct >= 99%", several joined by commas.
+    /// "correct >= 99%", several joined by commas. A metric with a unit needs it (lsbN, ulp):
+    /// a bare number is refused (docs/budget.md).
     #[arg(long, default_value = "shape_total <= 1 lsb8")]
     budget: Budget,
     /// The base configuration (formats' integer bits, coefficient, cutoff ... are kept).
