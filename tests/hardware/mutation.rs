@@ -446,8 +446,9 @@ fn mutated(tag: &str, name: &str) -> PathBuf {
 /// (issue 48) fails only when an output stalls for an initiation interval from its first
 /// cycle while the next input is computed: independent stalls of probability 0.2 did that
 /// about once in 15,000 vectors. The handshake pattern's directed episodes catch it on their
-/// own (no random bubble or stall), in the vector testbench and the cocotb live scoreboard,
-/// and so does the default `specfx cosim` (its stall bursts too); the DPI scoreboard in
+/// own (no random bubble or stall), in the vector testbench, the cocotb live scoreboard and
+/// the DPI scoreboard's exhaustive run (which drives no random stall), and so does the
+/// default `specfx cosim` (its stall bursts too); the DPI scoreboard's random runs in
 /// `every_mutant_is_caught_by_the_dpi_scoreboard`.
 #[test]
 fn the_handshake_pattern_catches_a_folded_fsm_that_steps_while_stalled() {
@@ -490,6 +491,25 @@ fn the_handshake_pattern_catches_a_folded_fsm_that_steps_while_stalled() {
         Some(1),
         "cocotb live: {}",
         String::from_utf8_lossy(&o.stdout)
+    );
+    let _lib = common::capi_dir();
+    let o = common::specfx(&[
+        "cosim",
+        "--dpi",
+        "--arch",
+        "folded",
+        "--n",
+        "16",
+        "--cases",
+        "exhaustive",
+        "--hdl-ref",
+        hdl,
+    ]);
+    let verdict = summary(&o);
+    assert!(
+        o.status.code() == Some(1) && verdict.is_some_and(|(_, failed)| failed > 0),
+        "cosim --dpi --cases exhaustive: {verdict:?} {}",
+        String::from_utf8_lossy(&o.stderr)
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
