@@ -182,7 +182,7 @@ pub enum Error {
     },
     /// The minimax table has no entry for this (n, k).
     #[error(
-        "no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..=7"
+        "no minimax constants cached for n = {n}, k = {k}: the table covers n = 1..={n_max}, k = 1..={k_max}"
     )]
     NoMinimaxEntry {
         /// The exponent asked for.
@@ -191,6 +191,8 @@ pub enum Error {
         k: u32,
         /// The largest n in the table.
         n_max: u32,
+        /// The largest k in the table.
+        k_max: u32,
     },
 }
 

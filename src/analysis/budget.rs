@@ -329,7 +329,7 @@ impl Acc {
             ),
             hist_shape: Histogram::covering(
                 "lobe error against cos^n (units of 2^-8)",
-                shape_max * 256.0,
+                shape_max / crate::analysis::LSB8,
             ),
             per_c_out: vec![0.0; C_BINS],
             per_c_shape: vec![0.0; C_BINS],
@@ -458,7 +458,7 @@ fn add_chunk(dp: &Datapath, sources: &Sources, acc: &mut Acc, chunk: &Chunk<'_>)
         let shape_total = fixed_lobe - target;
         acc.shape_total = acc.shape_total.max(shape_total.abs());
         acc.shape_approx = acc.shape_approx.max((ref_lobe - target).abs());
-        acc.hist_shape.add(shape_total * 256.0);
+        acc.hist_shape.add(shape_total / crate::analysis::LSB8);
         let bin = ((c * C_BINS as f64) as usize).min(C_BINS - 1);
         acc.per_c_shape[bin] = acc.per_c_shape[bin].max(shape_total.abs());
     }

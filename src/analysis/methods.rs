@@ -11,7 +11,7 @@ use crate::reference::minimax::sup_abs_error;
 /// a per-n depth up to m = 32, 64 and 128 (each n at its best m(n), `depth = "best"`), cs16 with
 /// the paper's cutoff, Schlick and the exponential limit.
 pub fn report_methods() -> Vec<Method> {
-    let mut v: Vec<Method> = (2..=7)
+    let mut v: Vec<Method> = (2..=crate::reference::lobe::K_MAX)
         .map(|k| Method::CsM {
             k,
             cutoff: Cutoff::Clamp,
@@ -21,8 +21,8 @@ pub fn report_methods() -> Vec<Method> {
         k: 4,
         cutoff: Cutoff::Paper,
     });
-    v.extend((2..=7).map(|k| Method::Minimax { k }));
-    v.extend((5..=7).map(|k| Method::MinimaxPerN { k }));
+    v.extend((2..=crate::reference::lobe::K_MAX).map(|k| Method::Minimax { k }));
+    v.extend((5..=crate::reference::lobe::K_MAX).map(|k| Method::MinimaxPerN { k }));
     v.push(Method::Schlick);
     v.push(Method::ExpLimit);
     v

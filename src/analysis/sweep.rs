@@ -335,7 +335,10 @@ fn apply(cfg: &mut Config, arch: &mut Arch, key: &str, v: &toml::Value) -> Resul
         "k" => {
             let k = u32::try_from(as_int(key, v)?).map_err(|_| fail(format!("bad k: {v}")))?;
             if !crate::reference::lobe::K_RANGE.contains(&k) {
-                return Err(fail(format!("expected k in 1..=7, got {k}")));
+                return Err(fail(format!(
+                    "expected k in {}, got {k}",
+                    crate::reference::lobe::K_RANGE_TEXT
+                )));
             }
             let first = cfg.square[0];
             cfg.square = vec![first; k as usize];

@@ -73,7 +73,7 @@ pub fn f64_methods() -> Vec<(String, Method)> {
         ("schlick".to_string(), Method::Schlick),
         ("exp_limit".to_string(), Method::ExpLimit),
     ];
-    for k in 2..=7 {
+    for k in 2..=crate::reference::lobe::K_MAX {
         for cutoff in Cutoff::ALL {
             let m = Method::CsM { k, cutoff };
             v.push((m.name(), m));
@@ -81,7 +81,7 @@ pub fn f64_methods() -> Vec<(String, Method)> {
         let m = Method::Minimax { k };
         v.push((m.name(), m));
     }
-    for k in 5..=7 {
+    for k in 5..=crate::reference::lobe::K_MAX {
         let m = Method::MinimaxPerN { k };
         v.push((m.name(), m));
     }

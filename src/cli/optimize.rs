@@ -47,7 +47,7 @@ pub struct OptimizeArgs {
     target: Target,
     /// Numbers of squarings to try (each is searched only if its f64 floor can meet the
     /// budget).
-    #[arg(long, default_value = "1..=7", value_parser = super::datapath::parse_k_set)]
+    #[arg(long, default_value = specfx::reference::lobe::K_RANGE_TEXT, value_parser = super::datapath::parse_k_set)]
     k: NSet,
     /// Variants to try: plain, minimax or both.
     #[arg(long, default_value = "plain,minimax", value_delimiter = ',',
@@ -119,7 +119,10 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         .iter()
         .find(|&&k| !specfx::reference::lobe::K_RANGE.contains(&k))
     {
-        bail!("--k: expected numbers of squarings in 1..=7, got {k}");
+        bail!(
+            "--k: expected numbers of squarings in {}, got {k}",
+            specfx::reference::lobe::K_RANGE_TEXT
+        );
     }
     let yosys = args.objective == Objective::Yosys;
     let hdl = super::hdl_ref::hdl_ref_dir(None);

@@ -10,7 +10,7 @@ use super::output::{print_json, print_with};
 use super::Outcome;
 use specfx::nset::NSet;
 use specfx::output::write_atomic;
-use specfx::reference::lobe::{m_of_k, K_RANGE};
+use specfx::reference::lobe::{m_of_k, K_RANGE, K_RANGE_TEXT};
 use specfx::reference::minimax::{self, MinimaxFit, TABLE_N_MAX};
 use specfx::reference::normalisation::{coefficient, CoefSource, Form};
 use specfx::report::csv::write_minimax_table;
@@ -19,7 +19,7 @@ fn parse_k(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
         Ok(k) if K_RANGE.contains(&k) => Ok(k),
         _ => Err(format!(
-            "expected a number of squarings k in 1..=7, got '{s}'"
+            "expected a number of squarings k in {K_RANGE_TEXT}, got '{s}'"
         )),
     }
 }
@@ -127,7 +127,7 @@ pub fn run_minimax(args: &MinimaxArgs) -> Result<Outcome> {
         return write_table(path, args.n_max, args.force);
     }
     if let Some(&k) = args.k.values().iter().find(|&&k| !K_RANGE.contains(&k)) {
-        bail!("--k: expected numbers of squarings in 1..=7, got {k}");
+        bail!("--k: expected numbers of squarings in {K_RANGE_TEXT}, got {k}");
     }
     let mut fits: Vec<MinimaxFit> = Vec::new();
     for &k in args.k.values() {

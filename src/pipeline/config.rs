@@ -667,7 +667,10 @@ impl ConfigFile {
         if !crate::reference::lobe::K_RANGE.contains(&k) {
             return Err(Error::Config {
                 key: "k".to_string(),
-                problem: format!("expected a number of squarings in 1..=7, got {k}"),
+                problem: format!(
+                    "expected a number of squarings in {}, got {k}",
+                    crate::reference::lobe::K_RANGE_TEXT
+                ),
             });
         }
         let base_square = base.square[0];

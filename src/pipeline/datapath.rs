@@ -17,7 +17,7 @@ use crate::reference::minimax;
 use crate::reference::normalisation::coefficient;
 
 /// The most stages a datapath can have: d, t, b, seven squarings, coef and out.
-pub const MAX_STAGES: usize = 12;
+pub const MAX_STAGES: usize = 3 + crate::reference::lobe::K_MAX as usize + 2;
 
 /// Index of the d = c - 1 probe.
 pub const STAGE_D: usize = 0;
@@ -165,7 +165,7 @@ pub struct Datapath {
     d_shift: u32,
     plan: BatchPlan,
     /// The squaring chain tabulated by b's code, one per depth j (index j), built on first use.
-    chain: [std::sync::OnceLock<Option<ChainTable>>; 8],
+    chain: [std::sync::OnceLock<Option<ChainTable>>; crate::reference::lobe::K_MAX as usize + 1],
     cut_is_prefix: bool,
     lobe_monotone: bool,
 }
@@ -272,7 +272,10 @@ impl Datapath {
         if !crate::reference::lobe::K_RANGE.contains(&k) {
             return Err(config_error(
                 "k",
-                format!("expected a number of squarings in 1..=7, got {k}"),
+                format!(
+                    "expected a number of squarings in {}, got {k}",
+                    crate::reference::lobe::K_RANGE_TEXT
+                ),
             ));
         }
         for (key, value) in [

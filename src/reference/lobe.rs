@@ -6,8 +6,19 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The largest number of squarings, as a literal for [`K_MAX`] and [`K_RANGE_TEXT`].
+macro_rules! k_max {
+    () => {
+        7
+    };
+}
+
+/// The largest number of squarings k (m = 2^k = 128).
+pub const K_MAX: u32 = k_max!();
 /// The number of squarings k supported by cs_m (m = 2^k).
-pub const K_RANGE: std::ops::RangeInclusive<u32> = 1..=7;
+pub const K_RANGE: std::ops::RangeInclusive<u32> = 1..=K_MAX;
+/// [`K_RANGE`] as messages and defaults write it: `1..=7`.
+pub const K_RANGE_TEXT: &str = concat!("1..=", k_max!());
 
 /// The constant of the paper's approximate cutoff angle theta = 6 / sqrt(n).
 pub const PAPER_CUTOFF_CONSTANT: f64 = 6.0;

@@ -358,6 +358,7 @@ pub fn constants(n: u32, k: u32) -> Result<MinimaxFit, Error> {
             n,
             k,
             n_max: TABLE_N_MAX,
+            k_max: crate::reference::lobe::K_MAX,
         });
     }
     let idx = (k - 1) as usize * TABLE_N_MAX as usize + (n - 1) as usize;
@@ -368,6 +369,7 @@ pub fn constants(n: u32, k: u32) -> Result<MinimaxFit, Error> {
             n,
             k,
             n_max: TABLE_N_MAX,
+            k_max: crate::reference::lobe::K_MAX,
         })
 }
 

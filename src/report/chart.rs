@@ -277,7 +277,7 @@ pub fn minus_sign(s: &str) -> String {
 /// assert_eq!(lsb8(0.0), "0 lsb8");
 /// ```
 pub fn lsb8(v: f64) -> String {
-    let x = v * 256.0;
+    let x = v / crate::analysis::LSB8;
     let text = if x == 0.0 {
         "0".to_string()
     } else if !(1e-4..1e4).contains(&x.abs()) {

@@ -97,7 +97,7 @@ pub fn write_check_table(
         writeln!(
             w,
             "  {name} {v:.3e} = {:.3} lsb8 at n={} c={:.6}",
-            v * 256.0,
+            v / crate::analysis::LSB8,
             at.n,
             at.c
         )?;

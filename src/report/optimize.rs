@@ -86,7 +86,7 @@ pub fn write_no_answer(
             "closest algorithm: {}, whose f64 floor is {:.3e} ({:.2} lsb8); what would meet the budget: a shape_total limit above that floor (quantization adds to it), or fewer exponents (--n: the floors fall when every n is at least m = 2^k)",
             f.algorithm,
             f.shape_total.unwrap(),
-            f.shape_total.unwrap() * 256.0
+            f.shape_total.unwrap() / crate::analysis::LSB8
         )?;
     }
     if let Some(c) = closest {

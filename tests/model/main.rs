@@ -16,6 +16,7 @@ mod engine;
 mod furnace;
 mod layers;
 mod minimax;
+mod one_place;
 mod oracle;
 mod pairs;
 mod paper;
