@@ -24,6 +24,9 @@ use specfx::report::optimize::{answer_header, write_answer, write_no_answer, Ans
 const OUT_HEADER: &str = "# specfx optimize:";
 use specfx::provenance::{canonical_nset, Inputs, Provenance};
 
+/// How many syntheses with yosys `optimize` runs between two lines of progress.
+const SYNTHESES_PER_LINE: u64 = 10;
+
 /// Arguments of `specfx optimize`.
 #[derive(Debug, Args)]
 pub struct OptimizeArgs {
@@ -159,8 +162,23 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         ),
         _ => format!("{} on {}", target.logic_unit(), target.name()),
     };
+    // Each synthesis takes seconds to minutes and a search runs many: a line at the first and
+    // at every tenth, since nothing else would show for minutes off a terminal.
+    let syntheses = std::sync::atomic::AtomicU64::new(0);
+    let synthesising = |target: Target| {
+        let done = syntheses.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if done == 0 {
+            log::info!(
+                "optimize: synthesising with yosys on {} (seconds to minutes each, cached ones at once; a line every {SYNTHESES_PER_LINE})",
+                target.name()
+            );
+        } else if done.is_multiple_of(SYNTHESES_PER_LINE) {
+            log::info!("optimize: {done} syntheses with yosys so far");
+        }
+    };
     let cost = |dp: &Datapath, arch: Arch| -> Result<f64, specfx::Error> {
         if yosys {
+            synthesising(target);
             specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| {
                 objective_value(&specfx::hdl::cost::CostFigures {
                     target,
@@ -210,6 +228,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
                  arch: Arch,
                  target: Target|
      -> Result<specfx::hdl::cost::CostFigures, specfx::Error> {
+        synthesising(target);
         specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| {
             specfx::hdl::cost::CostFigures {
                 target,
