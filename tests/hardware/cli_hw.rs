@@ -324,3 +324,26 @@ fn optimize_says_when_it_synthesises() {
     assert_eq!(run(&["--quiet"]), "");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `timing` (yosys and nextpnr) places and routes the architecture the configuration records,
+/// and `--arch` overrides it, as every command that reads a configuration does.
+#[test]
+fn timing_takes_the_configurations_arch() {
+    let dir = std::env::temp_dir().join(format!("specfx-hw-timing-arch-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = dir.join("folded.toml");
+    std::fs::write(&cfg, "arch = \"folded\"\nk = 3\nn = \"16..=64\"\n").unwrap();
+    let arch = |extra: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_specfx"))
+            .args(["timing", "--json", "--config", cfg.to_str().unwrap()])
+            .args(extra)
+            .env("SPECFX_CACHE", dir.join("cache"))
+            .output()
+            .unwrap();
+        json(&o)["arch"].clone()
+    };
+    assert_eq!(arch(&[]), "folded");
+    assert_eq!(arch(&["--arch", "pipelined"]), "pipelined");
+    let _ = std::fs::remove_dir_all(&dir);
+}
