@@ -97,6 +97,15 @@ fn manifests_of_every_test_configuration_follow_the_schema() {
         "--cases".into(),
         "random:10".into(),
     ]);
+    // A configuration that records its microarchitecture (the manifest's config.arch).
+    let folded = dir.path().join("folded.toml");
+    std::fs::write(&folded, "arch = \"folded\"\nk = 3\nn = \"16..=20\"\n").unwrap();
+    runs.push(vec![
+        "--config".into(),
+        folded.to_string_lossy().into_owned(),
+        "--cases".into(),
+        "corner".into(),
+    ]);
     let mut configs: Vec<String> =
         std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/configs"))
             .unwrap()
