@@ -130,18 +130,9 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     // The --vcd directory is made with the model's trace, once the stimulus is known to fit.
     let model_vcd = args.vcd.as_ref().map(|d| d.join("model.vcd"));
     let stim = write_stimulus(&opened, args.run, wd, model_vcd.as_deref())?;
-    for port in [
-        "in_c",
-        "in_n",
-        "in_slope",
-        "in_offset",
-        "in_threshold",
-        "in_coef",
-        "in_depth",
-        "expected_out",
-    ] {
-        let from = vectors.join(format!("{port}.hex"));
-        std::fs::copy(&from, wd.join(format!("{port}.hex")))
+    for port in specfx::golden::testbench_ports(&dp) {
+        let from = vectors.join(port.file_name());
+        std::fs::copy(&from, wd.join(port.file_name()))
             .with_context(|| format!("cannot copy {}", from.display()))?;
     }
     let mut params = vec![

@@ -24,6 +24,7 @@ use vcd::{IdCode, ReferenceIndex, ScopeType, TimescaleUnit, Value, VarType};
 use crate::cycle::rtl::{core_scope, Widths};
 use crate::cycle::sim::CycleTrace;
 use crate::cycle::{Arch, Word};
+use crate::pipeline::ports::{Carries, TOP_PORTS};
 use crate::pipeline::Datapath;
 
 /// Clock period in the trace, in time units (ns), as the testbench's `always #5 clk = ~clk`.
@@ -47,21 +48,10 @@ pub fn cycle_start(cycle: u64) -> u64 {
 /// Where a traced signal's value comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Source {
-    Clk,
-    Rst,
+    /// A port of the top (the one port table, `pipeline::ports`).
+    Port(Carries),
     Cycle,
     InN,
-    InValid,
-    InReady,
-    InC,
-    InSlope,
-    InOffset,
-    InThreshold,
-    InCoef,
-    InDepth,
-    OutValid,
-    OutReady,
-    OutData,
     /// `registers[i]` of the cycle.
     Register(usize),
 }
@@ -74,22 +64,11 @@ struct Signal {
     source: Source,
 }
 
-fn port_list(w: &Widths) -> Vec<(&'static str, u32, Source)> {
-    vec![
-        ("clk", 1, Source::Clk),
-        ("rst", 1, Source::Rst),
-        ("in_valid", 1, Source::InValid),
-        ("in_ready", 1, Source::InReady),
-        ("in_c", w.c, Source::InC),
-        ("in_slope", w.slope, Source::InSlope),
-        ("in_offset", w.offset, Source::InOffset),
-        ("in_threshold", w.c, Source::InThreshold),
-        ("in_coef", w.coef, Source::InCoef),
-        ("in_depth", crate::pipeline::DEPTH_BITS, Source::InDepth),
-        ("out_valid", 1, Source::OutValid),
-        ("out_ready", 1, Source::OutReady),
-        ("out_data", w.out, Source::OutData),
-    ]
+fn port_list(dp: &Datapath) -> Vec<(&'static str, u32, Source)> {
+    TOP_PORTS
+        .iter()
+        .map(|p| (p.name, p.width(dp), Source::Port(p.carries)))
+        .collect()
 }
 
 /// Every signal of the trace, in declaration order.
@@ -113,7 +92,7 @@ fn signals(dp: &Datapath, arch: Arch, first: Option<&CycleTrace>) -> Vec<Signal>
     };
     let core = format!("dut.{}", core_scope(arch));
     for scope in ["", "dut", &core] {
-        for (name, width, source) in port_list(&w) {
+        for (name, width, source) in port_list(dp) {
             push(scope, name, width, source);
         }
         if scope.is_empty() {
@@ -122,7 +101,7 @@ fn signals(dp: &Datapath, arch: Arch, first: Option<&CycleTrace>) -> Vec<Signal>
         }
     }
     if arch == Arch::Pipelined {
-        push(&core, "advance", 1, Source::InReady);
+        push(&core, "advance", 1, Source::Port(Carries::InReady));
     }
     for (i, r) in first.map_or(&[][..], |t| &t.registers).iter().enumerate() {
         let (scope, name) = match r.name.rsplit_once('.') {
@@ -145,20 +124,16 @@ fn bits(word: &Word) -> Vec<Value> {
 fn value(dp: &Datapath, t: &CycleTrace, source: Source, width: u32) -> Option<Word> {
     let nc = t.input.map(|(n_idx, _)| &dp.constants()[n_idx]);
     let raw = match source {
-        Source::Clk | Source::Rst => 0,
+        Source::Port(Carries::Clock | Carries::Reset) => 0,
         Source::Cycle => t.cycle as i64,
         Source::InN => nc.map_or(0, |nc| i64::from(nc.n)),
-        Source::InValid => i64::from(t.in_valid),
-        Source::InReady => i64::from(t.in_ready),
-        Source::InC => t.input.map_or(0, |(_, c)| c),
-        Source::InSlope => nc.map_or(0, |nc| nc.slope_raw),
-        Source::InOffset => nc.map_or(0, |nc| nc.offset_raw),
-        Source::InThreshold => nc.map_or(0, |nc| nc.threshold.unwrap_or(0)),
-        Source::InCoef => nc.map_or(0, |nc| nc.coef_raw),
-        Source::InDepth => nc.map_or(0, |nc| i64::from(nc.depth)),
-        Source::OutValid => i64::from(t.out_valid),
-        Source::OutReady => i64::from(t.out_ready),
-        Source::OutData => t.out_data?,
+        Source::Port(Carries::InValid) => i64::from(t.in_valid),
+        Source::Port(Carries::InReady) => i64::from(t.in_ready),
+        Source::Port(Carries::C) => t.input.map_or(0, |(_, c)| c),
+        Source::Port(Carries::PerN(p)) => nc.map_or(0, |nc| p.raw(nc)),
+        Source::Port(Carries::OutValid) => i64::from(t.out_valid),
+        Source::Port(Carries::OutReady) => i64::from(t.out_ready),
+        Source::Port(Carries::OutData) => t.out_data?,
         Source::Register(i) => return t.registers[i].value.clone(),
     };
     Some(Word::new(raw, width))
@@ -207,7 +182,7 @@ pub fn write_vcd(
     let clk = IdCode::FIRST;
     let mut next_id = clk.next();
     let mut id_of = |source: Source| -> (IdCode, bool) {
-        if source == Source::Clk {
+        if source == Source::Port(Carries::Clock) {
             return (clk, false);
         }
         if let Some(&(_, id)) = ids.iter().find(|(s, _)| *s == source) {
@@ -246,7 +221,7 @@ pub fn write_vcd(
         let (id, new) = id_of(s.source);
         let var_type = match s.source {
             Source::Cycle => VarType::Integer,
-            Source::Clk | Source::Rst if s.scope.is_empty() => VarType::Reg,
+            Source::Port(Carries::Clock | Carries::Reset) if s.scope.is_empty() => VarType::Reg,
             _ => VarType::Wire,
         };
         let index = (s.width > 1).then(|| ReferenceIndex::Range(s.width as i32 - 1, 0));
@@ -274,7 +249,7 @@ pub fn write_vcd(
     let mut last: Vec<Vec<Value>> = Vec::with_capacity(changes.len());
     for &(id, width, source) in &changes {
         let v = match source {
-            Source::Rst => vec![Value::V1],
+            Source::Port(Carries::Reset) => vec![Value::V1],
             Source::Cycle => bits(&Word::new(0, 32)),
             _ => vec![Value::X; width as usize],
         };

@@ -114,6 +114,14 @@ pub fn ports(dp: &Datapath) -> Vec<Port> {
     v
 }
 
+/// The vector files a testbench reads: the input ports and `expected_out`, not the probes.
+pub fn testbench_ports(dp: &Datapath) -> Vec<Port> {
+    ports(dp)
+        .into_iter()
+        .filter(|p| !matches!(p.source, Source::Stage(i) if i != dp.stage_out()))
+        .collect()
+}
+
 /// One column of `vectors.csv`: a port of [`ports`], in the same order.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct CsvColumn {

@@ -212,21 +212,19 @@ impl HarnessBits {
 /// assert_eq!(bits.outputs, 2 + 24);
 /// ```
 pub fn harness_bits(dp: &Datapath) -> HarnessBits {
-    let cfg = dp.config();
-    let (slope, offset) = cfg.constant_formats();
-    let w = |f: crate::fixed::Format| u64::from(f.width());
+    use crate::pipeline::ports::{Carries, Direction, PerN, TOP_PORTS};
+    // Every port but the clock; in_depth only where some n bypasses a squaring stage.
+    let bits = |direction: Direction| -> u64 {
+        TOP_PORTS
+            .iter()
+            .filter(|p| p.direction == direction && p.carries != Carries::Clock)
+            .filter(|p| p.carries != Carries::PerN(PerN::Depth) || dp.config().has_bypass())
+            .map(|p| u64::from(p.width(dp)))
+            .sum()
+    };
     HarnessBits {
-        inputs: 3
-            + 2 * w(cfg.c.format)
-            + w(slope)
-            + w(offset)
-            + w(cfg.coef.format)
-            + if cfg.has_bypass() {
-                u64::from(crate::pipeline::DEPTH_BITS)
-            } else {
-                0
-            },
-        outputs: 2 + w(cfg.out.format),
+        inputs: bits(Direction::Input),
+        outputs: bits(Direction::Output),
     }
 }
 

@@ -61,7 +61,7 @@ impl PerN {
     }
 
     /// The input port of `specfx_top` that carries it (`in_slope`, `in_depth`).
-    pub fn port(self) -> &'static str {
+    pub const fn port(self) -> &'static str {
         match self {
             PerN::Slope => "in_slope",
             PerN::Offset => "in_offset",
@@ -179,32 +179,32 @@ pub const TOP_PORTS: [TopPort; 13] = [
     port("in_ready", Direction::Output, Carries::InReady, "1"),
     port("in_c", Direction::Input, Carries::C, "C_W"),
     port(
-        "in_slope",
+        PerN::Slope.port(),
         Direction::Input,
         Carries::PerN(PerN::Slope),
         "SLOPE_W",
     ),
     port(
-        "in_offset",
+        PerN::Offset.port(),
         Direction::Input,
         Carries::PerN(PerN::Offset),
         "OFFSET_W",
     ),
     port(
-        "in_threshold",
+        PerN::Threshold.port(),
         Direction::Input,
         Carries::PerN(PerN::Threshold),
         "C_W",
     ),
     port(
-        "in_coef",
+        PerN::Coef.port(),
         Direction::Input,
         Carries::PerN(PerN::Coef),
         "COEF_W",
     ),
     // DEPTH_BITS.
     port(
-        "in_depth",
+        PerN::Depth.port(),
         Direction::Input,
         Carries::PerN(PerN::Depth),
         "3",
