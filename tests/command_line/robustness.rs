@@ -1048,14 +1048,14 @@ const CASES: &[Case] = &[
     Case {
         args: &["sim", "--vcd", "{dir}/s.vcd", "--vcd-cycles", "1000000000"],
         inputs: &[],
-        expect: "1000000000 is not in 1..=131072",
+        expect: "1000000000 is not in 1..=262144",
     },
     Case {
         args: &[
             "cosim", "--sim", "icarus", "--cases", "corner", "--bubble", "0.99", "--vcd", "{dir}/t",
         ],
         inputs: &[],
-        expect: "with --vcd, the trace is limited to 131072 cycles",
+        expect: "with --vcd, the trace is limited to 262144 cycles",
     },
     Case {
         args: &[
