@@ -121,10 +121,12 @@ pub struct RunOpts {
     /// Seed of the bubble/stall patterns (`cosim`: also of the vectors it writes).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Probability that the source offers no input in a cycle.
+    /// Probability that the source offers no input in a random cycle.
     #[arg(long, default_value = "0.2", value_parser = parse_probability)]
     pub bubble: f64,
-    /// Probability that the sink is not ready in a cycle.
+    /// Fraction of the random cycles in which the sink is not ready: stalls come in bursts
+    /// averaging one initiation interval plus one cycle, between blocks of directed stall
+    /// episodes (the handshake pattern, docs/cycle.md).
     #[arg(long, default_value = "0.2", value_parser = parse_probability)]
     pub stall: f64,
 }
