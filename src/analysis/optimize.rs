@@ -19,11 +19,13 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::analysis::budget_expr::{Bound, Budget, Metric, Synthesise, Verdict};
-use crate::analysis::check::{check_outputs, check_outputs_cached, CosCache};
+use crate::analysis::check::{
+    check_outputs, check_outputs_cached, CheckReport, CosCache, OutputFigures,
+};
 use crate::cycle::Arch;
 use crate::error::Error;
 use crate::fixed::{Format, Overflow, Rounding};
-use crate::hdl::cost::{analytic_cost, Target};
+use crate::hdl::cost::{analytic_cost, objective_value, CostFigures, Target};
 use crate::hdl::pnr::{device_check, Device};
 use crate::pipeline::walk::Stage;
 use crate::pipeline::StageSpec;
@@ -1227,4 +1229,253 @@ pub fn closest(r: &OptimizeAll, synth: Option<Synthesise>) -> Result<Option<Clos
         correctly_rounded: chk.stages[dp.stage_out()].correctly_rounded,
         costs: r.budget.cost_values(&dp, synth)?,
     }))
+}
+
+/// What `specfx optimize` is asked, end to end: the search's settings as a face hands them
+/// over. [`Request::run`] resolves the device and the architecture, searches every algorithm
+/// whose floor can meet the budget, and proves the answer.
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// The base configuration (its exponents already the ones to serve).
+    pub base: Config,
+    /// The budget.
+    pub budget: Budget,
+    /// The numbers of squarings to try.
+    pub k: Vec<u32>,
+    /// The variants to try.
+    pub variants: Vec<Variant>,
+    /// The squaring depths to try.
+    pub depth: DepthSearch,
+    /// Fraction bits every searched stage starts from.
+    pub start_frac: i32,
+    /// The cost minimised.
+    pub objective: Objective,
+    /// The target whose logic cells are minimised.
+    pub target: Target,
+    /// The microarchitecture asked for, if any (else the base's `arch`, else chosen).
+    pub arch: Option<Arch>,
+    /// The device every answer must fit: `Some(None)` for none, `None` for the target's own
+    /// (the iCE40 UP5K on ice40, none elsewhere).
+    pub device: Option<Option<Device>>,
+}
+
+/// An answer, proven: the exhaustive check of the cheapest configuration against the budget,
+/// in the architecture it was costed in, and what a summary sets beside it.
+#[derive(Debug)]
+pub struct Proven {
+    /// The answer's configuration, named `optimized`, recording its architecture (`arch`).
+    pub config: Config,
+    /// Its datapath.
+    pub dp: Datapath,
+    /// Its exhaustive check.
+    pub proof: CheckReport,
+    /// The microarchitecture it was costed in.
+    pub arch: Arch,
+    /// Each yosys ceiling of the budget with the answer's yosys figures on its target.
+    pub yosys: Vec<(Bound, CostFigures)>,
+    /// The paper's datapath (baseline: plain, k = 4) serving the same exponents, and its
+    /// output figures.
+    pub paper: (Datapath, OutputFigures),
+}
+
+/// What a [`Request`] found.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The search.
+    pub result: OptimizeAll,
+    /// The proven answer, when a configuration meets the budget (and fits).
+    pub proven: Option<Proven>,
+    /// Otherwise the closest configuration, when the search found one.
+    pub closest: Option<Closest>,
+}
+
+impl Request {
+    /// The microarchitecture asked for: the request's, else the base configuration's own (an
+    /// earlier answer's); `None` lets the search fold where pipelined does not fit.
+    pub fn chosen_arch(&self) -> Option<Arch> {
+        self.arch.or(self.base.arch)
+    }
+
+    /// The device every answer must fit. Refused: a device on another target than ice40 (the
+    /// devices are iCE40s), and a device without DSP blocks (the analytic iCE40 model maps
+    /// every multiplier to one, so nothing could fit it).
+    pub fn device(&self) -> Result<Option<Device>, Error> {
+        let target = self.target;
+        let device = match self.device {
+            Some(d) => d,
+            None => (target == Target::Ice40).then_some(Device::Up5k),
+        };
+        let refused = |problem: String| Error::Config {
+            key: "--device".into(),
+            problem,
+        };
+        if device.is_some() && target != Target::Ice40 {
+            return Err(refused(format!(
+                "the devices are iCE40s, costed on --target ice40 (got --target {}); give --device none to cost on {} without a device",
+                target.name(),
+                target.name()
+            )));
+        }
+        if let Some(d) = device.filter(|d| d.limits().dsps == 0) {
+            return Err(Error::Config {
+                key: format!("--device {}", d.name()),
+                problem: format!(
+                    "the {} has no DSP blocks, and the analytic iCE40 model maps every multiplier to one, so no datapath can fit it; give --device up5k, or none to lift the limit",
+                    d.full_name()
+                ),
+            });
+        }
+        Ok(device)
+    }
+
+    /// The unit the objective is counted in: `LUT-equivalents on ice40 (LUTs + 260 per DSP
+    /// block)`, `gates on generic`.
+    pub fn unit(&self) -> String {
+        let target = self.target;
+        match crate::hdl::cost::dsp_weight(target) {
+            w if w > 0.0 => format!(
+                "{}-equivalents on {} ({} + {w:.0} per DSP block)",
+                target.logic_unit().trim_end_matches('s'),
+                target.name(),
+                target.logic_unit()
+            ),
+            _ => format!("{} on {}", target.logic_unit(), target.name()),
+        }
+    }
+
+    /// What an answer records of the request: its canonical inputs (`inputs.toml`, the
+    /// comment of the configuration `specfx optimize` writes).
+    pub fn inputs(&self) -> Result<crate::provenance::Inputs, Error> {
+        let mut variants: Vec<&str> = self.variants.iter().map(|v| v.name()).collect();
+        variants.sort_unstable();
+        variants.dedup();
+        let k = crate::nset::NSet::from_values(&self.k).map_err(|e| Error::Config {
+            key: "--k".into(),
+            problem: e.to_string(),
+        })?;
+        Ok(crate::provenance::Inputs::new("optimize")
+            .config(&self.base)
+            .option("budget", self.budget.canonical())
+            .option("objective", self.objective.name())
+            .option("target", self.target.name())
+            .option("k", k.to_string())
+            .option("variants", variants)
+            .option("start_frac", self.start_frac)
+            .option("depth", self.depth.name())
+            .option(
+                "arch",
+                self.chosen_arch()
+                    .map_or("auto".to_string(), |a| a.to_string()),
+            )
+            .option("device", self.device()?.map_or("none", |d| d.name())))
+    }
+
+    /// The algorithms searched: every k, variant and depth asked for.
+    pub fn algorithms(&self) -> Vec<Algorithm> {
+        Algorithm::all(&self.base, &self.k, &self.variants, self.depth.per_n())
+    }
+
+    /// Searches and proves: the f64 floor of every algorithm (`floors` hears them before the
+    /// search), the search of those that can meet the budget (`done` hears each algorithm's
+    /// result, from the worker threads), then the answer's exhaustive check in its
+    /// architecture, its yosys figures for the budget's yosys ceilings, and the paper's
+    /// datapath beside it. `synth` runs yosys (the library starts no process): the objective
+    /// `yosys` and the yosys ceilings call it.
+    ///
+    /// # Errors
+    /// The device's refusals ([`Request::device`]), a synthesis that fails, and an answer that
+    /// does not meet the budget on its re-check (a bug).
+    pub fn run(
+        &self,
+        synth: Synthesise,
+        floors_found: &dyn Fn(&[AlgorithmFloor]),
+        done: &(dyn Fn(Algorithm, &SearchResult) + Sync),
+    ) -> Result<Outcome, Error> {
+        let device = self.device()?;
+        let fit = device.map(|device| DeviceFit {
+            device,
+            fold_when_needed: self.chosen_arch().is_none(),
+        });
+        let target = self.target;
+        let objective = self.objective;
+        let cost = |dp: &Datapath, arch: Arch| -> Result<f64, Error> {
+            match objective {
+                Objective::Yosys => synth(dp, arch, target).map(|f| objective_value(&f)),
+                Objective::Analytic => Ok(objective_value(
+                    &crate::hdl::cost::analytic_cost(dp, arch, target).figures(),
+                )),
+            }
+        };
+        let mut budget = self.budget.clone();
+        budget.arch = self.base.resolve_arch(self.arch);
+        let floors = algorithm_floors(&self.base, &budget, &self.algorithms(), self.start_frac);
+        floors_found(&floors);
+        let result = optimize_all(
+            &self.base,
+            &budget,
+            floors,
+            self.start_frac,
+            &cost,
+            Some(synth),
+            fit,
+            self.depth,
+            done,
+        )?;
+        let Some(best) = &result.best else {
+            let closest = closest(&result, Some(synth))?;
+            return Ok(Outcome {
+                result,
+                proven: None,
+                closest,
+            });
+        };
+        // The proof: the exhaustive check of the answer, against the budget, in the answer's
+        // architecture.
+        let arch = best.arch;
+        let mut budget = result.budget.clone();
+        budget.arch = arch;
+        let mut config = best.config.clone();
+        config.name = "optimized".into();
+        // The answer records the microarchitecture it was costed with: cost, timing, sim,
+        // hdl, vectors and cosim read it as their default.
+        config.arch = Some(arch);
+        let dp = Datapath::new(config.clone())?;
+        let proof = crate::analysis::check::check(&dp)?;
+        if !budget.met_by(&proof.output_figures(), &dp)
+            || !budget.cost_verdict(&dp, Some(synth))?.feasible
+            || fit.is_some_and(|f| !f.overflows(&dp, arch).is_empty())
+        {
+            return Err(Error::Output {
+                message:
+                    "the configuration found does not meet the budget on re-check: this is a bug"
+                        .into(),
+            });
+        }
+        let mut yosys = Vec::new();
+        for b in result.budget.bounds.iter().filter(|b| b.metric.is_yosys()) {
+            let (Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t)) = b.metric
+            else {
+                continue;
+            };
+            yosys.push((b.clone(), synth(&dp, arch, t)?));
+        }
+        // The answer's cost on every target, beside the paper's datapath serving the same
+        // exponents.
+        let mut paper_cfg = Config::baseline();
+        paper_cfg.n = config.n.clone();
+        let paper = Datapath::new(paper_cfg)?;
+        let paper_check = crate::analysis::check::check_outputs(&paper)?;
+        Ok(Outcome {
+            result,
+            proven: Some(Proven {
+                config,
+                dp,
+                proof,
+                arch,
+                yosys,
+                paper: (paper, paper_check),
+            }),
+            closest: None,
+        })
+    }
 }

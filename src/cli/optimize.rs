@@ -6,23 +6,21 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use super::Outcome;
-use specfx::analysis::budget_expr::{Budget, Metric};
-use specfx::analysis::check::check;
-use specfx::analysis::optimize::{
-    algorithm_floors, optimize_all, Algorithm, DepthSearch, DeviceFit, Objective, SearchResult,
-};
+use specfx::analysis::budget_expr::{Bound, Budget};
+use specfx::analysis::optimize::{Algorithm, DepthSearch, Objective, Request, SearchResult};
 use specfx::cycle::Arch;
-use specfx::hdl::cost::{analytic_cost, dsp_weight, objective_value, Target};
+use specfx::hdl::cost::{CostFigures, Target};
 use specfx::hdl::pnr::Device;
 use specfx::nset::NSet;
 use specfx::output::write_atomic;
 use specfx::pipeline::{Datapath, Variant};
+use specfx::reference::lobe::{K_RANGE, K_RANGE_TEXT};
 use specfx::report::optimize::{answer_header, write_answer, write_no_answer, Answer};
 
 /// The first bytes of the configuration `specfx optimize` writes: a file that begins with
 /// them is an earlier result, replaced without `--force`.
 const OUT_HEADER: &str = "# specfx optimize:";
-use specfx::provenance::{canonical_nset, Inputs, Provenance};
+use specfx::provenance::Provenance;
 
 /// How many syntheses with yosys `optimize` runs between two lines of progress.
 const SYNTHESES_PER_LINE: u64 = 10;
@@ -113,59 +111,28 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         Some(OUT_HEADER),
         args.force,
     )?;
-    let base = dp.config().clone();
-    // --arch, else the base configuration's own (an earlier answer's); neither: auto.
-    let chosen_arch = args.arch.or(base.arch);
-    if let Some(&k) = args
-        .k
-        .values()
-        .iter()
-        .find(|&&k| !specfx::reference::lobe::K_RANGE.contains(&k))
-    {
-        bail!(
-            "--k: expected numbers of squarings in {}, got {k}",
-            specfx::reference::lobe::K_RANGE_TEXT
-        );
+    if let Some(&k) = args.k.values().iter().find(|&&k| !K_RANGE.contains(&k)) {
+        bail!("--k: expected numbers of squarings in {K_RANGE_TEXT}, got {k}");
     }
-    let yosys = args.objective == Objective::Yosys;
+    let request = Request {
+        base: dp.config().clone(),
+        budget: args.budget.clone(),
+        k: args.k.values().to_vec(),
+        variants: args.variants.clone(),
+        depth: args.depth,
+        start_frac: args.start_frac,
+        objective: args.objective,
+        target: args.target,
+        arch: args.arch,
+        device: args.device.map(|DeviceLimit(d)| d),
+    };
+    let device = request.device()?;
+    let unit = request.unit();
     let hdl = super::hdl_ref::hdl_ref_dir(None);
-    let arch = base.resolve_arch(args.arch);
-    let target = args.target;
-    let device = match args.device {
-        Some(DeviceLimit(d)) => d,
-        None => (target == Target::Ice40).then_some(Device::Up5k),
-    };
-    if device.is_some() && target != Target::Ice40 {
-        bail!(
-            "--device: the devices are iCE40s, costed on --target ice40 (got --target {}); give --device none to cost on {} without a device",
-            target.name(),
-            target.name()
-        );
-    }
-    if let Some(d) = device.filter(|d| d.limits().dsps == 0) {
-        bail!(
-            "--device {}: the {} has no DSP blocks, and the analytic iCE40 model maps every multiplier to one, so no datapath can fit it; give --device up5k, or none to lift the limit",
-            d.name(),
-            d.full_name()
-        );
-    }
-    let fit = device.map(|device| DeviceFit {
-        device,
-        fold_when_needed: chosen_arch.is_none(),
-    });
-    let unit = match dsp_weight(target) {
-        w if w > 0.0 => format!(
-            "{}-equivalents on {} ({} + {w:.0} per DSP block)",
-            target.logic_unit().trim_end_matches('s'),
-            target.name(),
-            target.logic_unit()
-        ),
-        _ => format!("{} on {}", target.logic_unit(), target.name()),
-    };
     // Each synthesis takes seconds to minutes and a search runs many: a line at the first and
     // at every tenth, since nothing else would show for minutes off a terminal.
     let syntheses = std::sync::atomic::AtomicU64::new(0);
-    let synthesising = |target: Target| {
+    let synth = |dp: &Datapath, arch: Arch, target: Target| -> Result<CostFigures, specfx::Error> {
         let done = syntheses.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         if done == 0 {
             log::info!(
@@ -175,159 +142,81 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         } else if done.is_multiple_of(SYNTHESES_PER_LINE) {
             log::info!("optimize: {done} syntheses with yosys so far");
         }
+        specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| CostFigures {
+            target,
+            luts: s.cost.luts,
+            dsps: s.cost.dsps,
+            ffs: s.cost.ffs,
+        })
     };
-    let cost = |dp: &Datapath, arch: Arch| -> Result<f64, specfx::Error> {
-        if yosys {
-            synthesising(target);
-            specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| {
-                objective_value(&specfx::hdl::cost::CostFigures {
-                    target,
-                    luts: s.cost.luts,
-                    dsps: s.cost.dsps,
-                    ffs: s.cost.ffs,
-                })
-            })
-        } else {
-            Ok(objective_value(&analytic_cost(dp, arch, target).figures()))
-        }
-    };
-    let variants = &args.variants;
-    let algorithms = Algorithm::all(&base, args.k.values(), variants, args.depth.per_n());
     log::info!(
         "optimize: f64 floor of {} algorithms (k in {}, {}; depth {})",
-        algorithms.len(),
+        request.algorithms().len(),
         args.k,
-        variants
+        args.variants
             .iter()
             .map(|v| v.name())
             .collect::<Vec<_>>()
             .join(", "),
         args.depth.name()
     );
-    let mut budget = args.budget.clone();
-    budget.arch = arch;
-    let floors = algorithm_floors(&base, &budget, &algorithms, args.start_frac);
-    let reachable = floors.iter().filter(|f| f.reachable).count();
-    let bar = super::progress::Progress::new("optimize", "algorithms", reachable as u64);
+    let bar = std::sync::OnceLock::new();
+    let floors_found = |floors: &[specfx::analysis::optimize::AlgorithmFloor]| {
+        let reachable = floors.iter().filter(|f| f.reachable).count() as u64;
+        let _ = bar.set(super::progress::Progress::new(
+            "optimize",
+            "algorithms",
+            reachable,
+        ));
+    };
     let no_answer = match device {
         Some(d) => format!("nothing meets the budget and fits the {}", d.full_name()),
         None => "nothing meets the budget".to_string(),
     };
     let done = |a: Algorithm, r: &SearchResult| {
-        let line = format!(
-            "optimize: {a}: {}",
-            r.best.as_ref().map_or(no_answer.to_string(), |b| format!(
-                "{:.0} {unit} ({})",
-                b.cost, args.objective
-            ))
-        );
-        log::info!("{line}");
-        bar.inc(1);
+        let found = r.best.as_ref().map_or(no_answer.to_string(), |b| {
+            format!("{:.0} {unit} ({})", b.cost, args.objective)
+        });
+        log::info!("optimize: {a}: {found}");
+        if let Some(bar) = bar.get() {
+            bar.inc(1);
+        }
     };
-    let synth = |dp: &Datapath,
-                 arch: Arch,
-                 target: Target|
-     -> Result<specfx::hdl::cost::CostFigures, specfx::Error> {
-        synthesising(target);
-        specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| {
-            specfx::hdl::cost::CostFigures {
-                target,
-                luts: s.cost.luts,
-                dsps: s.cost.dsps,
-                ffs: s.cost.ffs,
-            }
-        })
-    };
-    let r = optimize_all(
-        &base,
-        &budget,
-        floors,
-        args.start_frac,
-        &cost,
-        Some(&synth),
-        fit,
-        args.depth,
-        &done,
-    )?;
-    bar.finish();
+    let found = request.run(&synth, &floors_found, &done)?;
+    if let Some(bar) = bar.into_inner() {
+        bar.finish();
+    }
+    let r = &found.result;
     super::output::outln!(
         "optimize: budget '{}', {} exhaustive checks",
         r.budget,
         r.n_evaluations
     )?;
-    let Some(best) = &r.best else {
-        let closest = specfx::analysis::optimize::closest(&r, Some(&synth))?;
+    let (Some(best), Some(proven)) = (&r.best, &found.proven) else {
         super::output::print_with(|w| {
-            write_no_answer(w, &r, closest.as_ref(), super::terminal::table_width())
+            write_no_answer(w, r, found.closest.as_ref(), super::terminal::table_width())
         })?;
         return Ok(Outcome::CheckFailed);
     };
-    // The proof: the exhaustive check of the answer, against the budget, in the answer's
-    // architecture.
-    let arch = best.arch;
-    let mut budget = r.budget.clone();
-    budget.arch = arch;
-    let mut config = best.config.clone();
-    config.name = "optimized".into();
-    // The answer records the microarchitecture it was costed with: cost, timing, sim, hdl,
-    // vectors and cosim read it as their default.
-    config.arch = Some(arch);
-    let dp = Datapath::new(config.clone())?;
-    let proof = check(&dp)?;
-    if !budget.met_by(&proof.output_figures(), &dp)
-        || !budget.cost_verdict(&dp, Some(&synth))?.feasible
-        || fit.is_some_and(|f| !f.overflows(&dp, arch).is_empty())
-    {
-        bail!("the configuration found does not meet the budget on re-check: this is a bug");
-    }
-    let mut yosys = Vec::new();
-    for b in r.budget.bounds.iter().filter(|b| b.metric.is_yosys()) {
-        let (Metric::YosysLuts(t) | Metric::YosysDsps(t) | Metric::YosysFfs(t)) = b.metric else {
-            continue;
-        };
-        yosys.push((b, synth(&dp, arch, t)?));
-    }
-    // The answer's cost on every target, beside the paper's datapath (baseline: plain, k = 4)
-    // serving the same exponents.
-    let mut paper_cfg = specfx::pipeline::Config::baseline();
-    paper_cfg.n = config.n.clone();
-    let paper = Datapath::new(paper_cfg)?;
-    let paper_check = specfx::analysis::check::check_outputs(&paper)?;
+    let yosys: Vec<(&Bound, CostFigures)> =
+        proven.yosys.iter().map(|(b, f)| (b, f.clone())).collect();
     let answer = Answer {
-        result: &r,
+        result: r,
         best,
-        dp: &dp,
-        proof: &proof,
+        dp: &proven.dp,
+        proof: &proven.proof,
         objective: args.objective,
         unit: &unit,
-        arch,
-        paper: (&paper, &paper_check),
+        arch: proven.arch,
+        paper: (&proven.paper.0, &proven.paper.1),
         yosys: &yosys,
     };
-    let mut variant_names: Vec<&str> = variants.iter().map(|v| v.name()).collect();
-    variant_names.sort_unstable();
-    variant_names.dedup();
-    let provenance = Provenance::new(
-        &Inputs::new("optimize")
-            .config(&base)
-            .option("budget", args.budget.canonical())
-            .option("objective", args.objective.name())
-            .option("target", target.name())
-            .option("k", canonical_nset(&args.k))
-            .option("variants", variant_names)
-            .option("start_frac", args.start_frac)
-            .option("depth", args.depth.name())
-            .option(
-                "arch",
-                chosen_arch.map_or("auto".to_string(), |a| a.to_string()),
-            )
-            .option("device", device.map_or("none", |d| d.name())),
-    );
+    let provenance = Provenance::new(&request.inputs()?);
     let text = format!(
         "{}{}{}",
         answer_header(OUT_HEADER, &answer),
         provenance.comment(),
-        config.to_toml()
+        proven.config.to_toml()
     );
     write_atomic(&args.out, text.as_bytes())?;
     super::output::print_with(|w| {
