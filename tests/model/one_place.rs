@@ -4,22 +4,9 @@
 //! literal `1..=7`). Every code line of `src/` (outside comments and `#[cfg(test)]` modules) is
 //! read; the one place each fact is defined is the only one allowed to spell it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// Every `.rs` file under `dir`, sorted.
-fn sources(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            out.extend(sources(&p));
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-    out.sort();
-    out
-}
+use crate::layers::sources;
 
 /// The code lines of a source file with their numbers: comments cut, and nothing from the
 /// first `#[cfg(test)]` on (a module's tests come last).
