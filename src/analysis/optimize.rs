@@ -1457,7 +1457,7 @@ impl Request {
             else {
                 continue;
             };
-            yosys.push((b.clone(), synth(&dp, arch, t)?));
+            yosys.push((*b, synth(&dp, arch, t)?));
         }
         // The answer's cost on every target, beside the paper's datapath serving the same
         // exponents.

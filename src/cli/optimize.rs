@@ -198,8 +198,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         })?;
         return Ok(Outcome::CheckFailed);
     };
-    let yosys: Vec<(&Bound, CostFigures)> =
-        proven.yosys.iter().map(|(b, f)| (b, f.clone())).collect();
+    let yosys: Vec<(&Bound, CostFigures)> = proven.yosys.iter().map(|(b, f)| (b, *f)).collect();
     let answer = Answer {
         result: r,
         best,
