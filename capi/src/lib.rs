@@ -24,6 +24,7 @@ use std::sync::Arc;
 use specfx::cycle::lockstep::Lockstep;
 use specfx::cycle::Arch;
 use specfx::engine::pairs::{self, Ns};
+use specfx::pipeline::ports::PerN;
 use specfx::pipeline::{Datapath, MAX_STAGES};
 
 /// What a function returns when it succeeded.
@@ -46,6 +47,15 @@ pub const SPECFX_COEF: c_int = 3;
 /// The per-n depth j(n), the squarings n uses (`specfx_top`'s `in_depth`; k for a fixed
 /// depth).
 pub const SPECFX_DEPTH: c_int = 4;
+// The numbers are the library's order of the per-n constants (`PerN::ALL`), which
+// `specfx_dpi_constant` indexes.
+const _: () = {
+    assert!(SPECFX_SLOPE as usize == PerN::Slope as usize);
+    assert!(SPECFX_OFFSET as usize == PerN::Offset as usize);
+    assert!(SPECFX_THRESHOLD as usize == PerN::Threshold as usize);
+    assert!(SPECFX_COEF as usize == PerN::Coef as usize);
+    assert!(SPECFX_DEPTH as usize == PerN::Depth as usize);
+};
 
 /// A validated datapath: made by `specfx_open` or `specfx_from_toml`, freed by
 /// `specfx_free`.
@@ -351,8 +361,7 @@ pub extern "C" fn specfx_eval(model: *const specfx_model, c: i64, n: u32, out: *
     guard(SPECFX_ERROR, || {
         let dp = &deref(model)?.dp;
         let out = place(out, "out")?;
-        let p = pairs::eval_one(dp, c, n).map_err(|e| e.to_string())?;
-        out.set(p.values[dp.stage_out()]);
+        out.set(dp.eval_out(c, n).map_err(|e| e.to_string())?);
         Ok(SPECFX_OK)
     })
 }
@@ -545,18 +554,15 @@ pub extern "C" fn specfx_dpi_constant(
             .dp
             .constants_checked(n_of(n)?, "n")
             .map_err(|e| e.to_string())?;
-        let v = match which {
-            SPECFX_SLOPE => nc.slope_raw,
-            SPECFX_OFFSET => nc.offset_raw,
-            SPECFX_THRESHOLD => nc.threshold.unwrap_or(0),
-            SPECFX_COEF => nc.coef_raw,
-            SPECFX_DEPTH => i64::from(nc.depth),
-            _ => {
-                return Err(format!(
+        let per_n = usize::try_from(which)
+            .ok()
+            .and_then(|i| PerN::ALL.get(i))
+            .ok_or_else(|| {
+                format!(
                     "which = {which}: expected 0 (slope), 1 (offset), 2 (threshold), 3 (coef) or 4 (depth)"
-                ))
-            }
-        };
+                )
+            })?;
+        let v = per_n.raw(nc);
         value.set(v);
         Ok(SPECFX_OK)
     })
@@ -710,18 +716,7 @@ pub extern "C" fn specfx_dpi_machine_cycle(
 /// the inputs on and next to every stage's rounding boundary), interleaved (seed 1).
 fn directed(m: &specfx_model) -> Result<&[(u32, i64)], String> {
     m.directed
-        .get_or_init(|| {
-            let sel = specfx::golden::CaseSelection {
-                corner: true,
-                exhaustive: false,
-                random: 0,
-            };
-            let mut cases = specfx::golden::cases::select(&m.dp, &sel, 1)
-                .map_err(|e| e.to_string())?
-                .cases;
-            specfx::golden::cases::order(&mut cases, specfx::golden::Order::Interleaved, 1);
-            Ok(cases)
-        })
+        .get_or_init(|| specfx::golden::cases::directed(&m.dp, 1).map_err(|e| e.to_string()))
         .as_ref()
         .map(Vec::as_slice)
         .map_err(Clone::clone)

@@ -205,10 +205,7 @@ impl Model {
 
     /// The output code of one input code and exponent.
     fn eval(&self, c: i64, n: u32) -> PyResult<i64> {
-        guarded(|| {
-            let p = pairs::eval_one(&self.dp, c, n).map_err(value_error)?;
-            Ok(p.values[self.dp.stage_out()])
-        })
+        guarded(|| self.dp.eval_out(c, n).map_err(value_error))
     }
 
     /// The output codes of `c[i]` with `n[i]` (or `n_all` for every code when `n` is None), on
@@ -351,16 +348,9 @@ impl Model {
     /// interleaved with `seed`: (n, c) arrays.
     fn directed<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<Cases<'py>> {
         guarded(|| {
-            let sel = specfx::golden::CaseSelection {
-                corner: true,
-                exhaustive: false,
-                random: 0,
-            };
-            let mut cases = py
-                .detach(|| specfx::golden::cases::select(&self.dp, &sel, seed))
-                .map_err(value_error)?
-                .cases;
-            specfx::golden::cases::order(&mut cases, specfx::golden::Order::Interleaved, seed);
+            let cases = py
+                .detach(|| specfx::golden::cases::directed(&self.dp, seed))
+                .map_err(value_error)?;
             let (n, c): (Vec<u32>, Vec<i64>) = cases.into_iter().unzip();
             Ok((n.into_pyarray(py), c.into_pyarray(py)))
         })

@@ -558,38 +558,26 @@ pub fn analyse(dp: &Datapath, budget: Option<&Budget>) -> Result<BudgetReport, E
         });
     }
     let count = (codes.codes.len() * per_n.len()).max(1) as f64;
-    let sources_stats: Vec<SourceStats> = srcs
-        .iter()
-        .zip(&acc.sources)
-        .map(|(&src, m)| {
-            let (format, rounding) = source_spec(dp, src);
-            stats(
-                src.name(),
-                format.to_string(),
-                rounding,
-                m,
-                count,
-                out_lsb,
-                c_lsb,
-            )
-        })
-        .collect();
-    let incremental: Vec<SourceStats> = srcs
-        .iter()
-        .zip(&acc.incremental)
-        .map(|(&src, m)| {
-            let (format, rounding) = source_spec(dp, src);
-            stats(
-                src.name(),
-                format.to_string(),
-                rounding,
-                m,
-                count,
-                out_lsb,
-                c_lsb,
-            )
-        })
-        .collect();
+    // Each source's statistics, from one of the accumulators' columns of moments.
+    let per_source = |moments: &[Moments]| -> Vec<SourceStats> {
+        srcs.iter()
+            .zip(moments)
+            .map(|(&src, m)| {
+                let (format, rounding) = source_spec(dp, src);
+                stats(
+                    src.name(),
+                    format.to_string(),
+                    rounding,
+                    m,
+                    count,
+                    out_lsb,
+                    c_lsb,
+                )
+            })
+            .collect()
+    };
+    let sources_stats = per_source(&acc.sources);
+    let incremental = per_source(&acc.incremental);
     let total = stats(
         "all".into(),
         String::new(),

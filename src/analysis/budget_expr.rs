@@ -160,136 +160,167 @@ impl FromStr for Budget {
     /// assert!(e.starts_with("budget: 'shape_total <= 1' is a bare number: shape_total takes lsbN"), "{e}");
     /// ```
     fn from_str(s: &str) -> Result<Self, Error> {
-        let bad = |part: &str, why: &str| {
-            Error::Config {
-            key: "budget".into(),
-            problem: format!(
-                "{why} in '{part}'; expected e.g. 'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'"
-            ),
-        }
-        };
-        let mut bounds = Vec::new();
-        let parts = bound_parts(s).map_err(|why| bad(s.trim(), &why))?;
-        for part in &parts {
-            let part = part.as_str();
-            let (lhs, op, rhs) = if let Some((l, r)) = part.split_once("<=") {
-                (l, "<=", r)
-            } else if let Some((l, r)) = part.split_once(">=") {
-                (l, ">=", r)
-            } else {
-                return Err(bad(part, "no <= or >="));
-            };
-            if rhs.contains("<=") || rhs.contains(">=") {
-                return Err(bad(part, "two bounds need ',' or 'and' between them"));
-            }
-            let on = rhs.split_once(" on ");
-            let (rhs, target) = match on {
-                Some((r, t)) => (
-                    r,
-                    t.trim()
-                        .parse::<Target>()
-                        .map_err(|e| bad(part, &e.to_string()))?,
-                ),
-                None => (rhs, Target::Ice40),
-            };
-            let metric = match lhs.trim() {
-                "luts" => Metric::Luts(target),
-                "dsps" => Metric::Dsps(target),
-                "ffs" => Metric::Ffs(target),
-                "yosys_luts" => Metric::YosysLuts(target),
-                "yosys_dsps" => Metric::YosysDsps(target),
-                "yosys_ffs" => Metric::YosysFfs(target),
-                "shape_total" => Metric::ShapeTotal,
-                "shape_quant" => Metric::ShapeQuant,
-                "out" => Metric::Out,
-                "correct" => Metric::Correct,
-                "out_total" => Metric::OutTotal,
-                "out_rel" => Metric::OutRel,
-                "effective_bits" => Metric::EffectiveBits,
-                other => return Err(bad(part, &format!("unknown metric '{other}'"))),
-            };
-            if on.is_some() && !metric.is_cost() {
-                return Err(bad(
-                    part,
-                    "only luts, dsps, ffs and their yosys_ forms take 'on TARGET'",
-                ));
-            }
-            let want_op = if metric.is_floor() { ">=" } else { "<=" };
-            if op != want_op {
-                return Err(bad(part, &format!("{} takes {want_op}", lhs.trim())));
-            }
-            let rhs = rhs.trim();
-            let unit_at = rhs
-                .find("lsb")
-                .or_else(|| rhs.find("ulp"))
-                .or_else(|| rhs.find('%'))
-                .or_else(|| rhs.find(char::is_whitespace));
-            let (number, unit) = match unit_at {
-                Some(i) => (rhs[..i].trim(), rhs[i..].trim()),
-                None => (rhs, ""),
-            };
-            let value: f64 = number.parse().map_err(|_| bad(part, "no number"))?;
-            if !value.is_finite() || value < 0.0 {
-                return Err(bad(part, "the limit must be a finite number >= 0"));
-            }
-            let name = lhs.trim();
-            let bare_ok = matches!(
-                metric,
-                Metric::Correct | Metric::OutRel | Metric::EffectiveBits
-            ) || metric.is_cost();
-            // A unit error says which units the metric takes, not the general examples.
-            let bad_unit = |why: String| Error::Config {
-                key: "budget".into(),
-                problem: format!("'{part}' {why}: {name} takes {}", metric.units()),
-            };
-            if unit.is_empty() && !bare_ok {
-                return Err(bad_unit("is a bare number".into()));
-            }
-            let limit = match (metric, unit) {
-                (Metric::ShapeTotal | Metric::ShapeQuant, u) if u.starts_with("lsb") => {
-                    let bits: i32 = u[3..]
-                        .parse()
-                        .ok()
-                        .filter(|b| (1..=64).contains(b))
-                        .ok_or_else(|| bad(part, "lsbN needs a number N in 1..=64"))?;
-                    value * (-f64::from(bits)).exp2()
-                }
-                (Metric::Out | Metric::OutTotal, "ulp") => value,
-                (Metric::Correct | Metric::OutRel, "%") => value / 100.0,
-                (Metric::Correct | Metric::OutRel, "") => value,
-                (Metric::EffectiveBits, "") => value,
-                (m, "") if m.is_cost() => value,
-                _ => {
-                    return Err(bad_unit(format!("has the unit '{unit}'")));
-                }
-            };
-            if metric.is_cost() && value.fract() != 0.0 {
-                return Err(bad(part, "a count of cells is a whole number"));
-            }
-            if metric == Metric::Correct && limit > 1.0 {
-                return Err(bad(part, "a share of inputs is at most 100%"));
-            }
-            if metric == Metric::EffectiveBits && limit > 64.0 {
-                return Err(bad(part, "effective bits are at most 64"));
-            }
-            bounds.push(Bound { metric, limit });
-        }
+        let (text, bounds) = parse_bounds(
+            s,
+            &["<=", ">="],
+            "'shape_total <= 1 lsb8', 'out <= 1 ulp', 'correct >= 99%', 'dsps <= 8 on ice40'",
+            parse_bound,
+        )?;
         Ok(Budget {
-            // One canonical spelling: no newline or other separator survives into a report.
-            text: parts.join(" and "),
+            text,
             bounds,
             arch: Arch::Pipelined,
         })
     }
 }
 
+/// One bound of a [`Budget`]: `lhs op rhs` of the expression's `part`, `bad` the error of a
+/// malformed one.
+fn parse_bound(b: &RawBound<'_>, bad: &dyn Fn(&str) -> Error) -> Result<Bound, Error> {
+    let RawBound { part, lhs, op, rhs } = *b;
+    let on = rhs.split_once(" on ");
+    let (rhs, target) = match on {
+        Some((r, t)) => (
+            r,
+            t.trim()
+                .parse::<Target>()
+                .map_err(|e| bad(&e.to_string()))?,
+        ),
+        None => (rhs, Target::Ice40),
+    };
+    let metric = match lhs.trim() {
+        "luts" => Metric::Luts(target),
+        "dsps" => Metric::Dsps(target),
+        "ffs" => Metric::Ffs(target),
+        "yosys_luts" => Metric::YosysLuts(target),
+        "yosys_dsps" => Metric::YosysDsps(target),
+        "yosys_ffs" => Metric::YosysFfs(target),
+        "shape_total" => Metric::ShapeTotal,
+        "shape_quant" => Metric::ShapeQuant,
+        "out" => Metric::Out,
+        "correct" => Metric::Correct,
+        "out_total" => Metric::OutTotal,
+        "out_rel" => Metric::OutRel,
+        "effective_bits" => Metric::EffectiveBits,
+        other => return Err(bad(&format!("unknown metric '{other}'"))),
+    };
+    if on.is_some() && !metric.is_cost() {
+        return Err(bad(
+            "only luts, dsps, ffs and their yosys_ forms take 'on TARGET'",
+        ));
+    }
+    let want_op = if metric.is_floor() { ">=" } else { "<=" };
+    if op != want_op {
+        return Err(bad(&format!("{} takes {want_op}", lhs.trim())));
+    }
+    let rhs = rhs.trim();
+    let unit_at = rhs
+        .find("lsb")
+        .or_else(|| rhs.find("ulp"))
+        .or_else(|| rhs.find('%'))
+        .or_else(|| rhs.find(char::is_whitespace));
+    let (number, unit) = match unit_at {
+        Some(i) => (rhs[..i].trim(), rhs[i..].trim()),
+        None => (rhs, ""),
+    };
+    let value: f64 = number.parse().map_err(|_| bad("no number"))?;
+    if !value.is_finite() || value < 0.0 {
+        return Err(bad("the limit must be a finite number >= 0"));
+    }
+    let name = lhs.trim();
+    let bare_ok = matches!(
+        metric,
+        Metric::Correct | Metric::OutRel | Metric::EffectiveBits
+    ) || metric.is_cost();
+    // A unit error says which units the metric takes, not the general examples.
+    let bad_unit = |why: String| Error::Config {
+        key: "budget".into(),
+        problem: format!("'{part}' {why}: {name} takes {}", metric.units()),
+    };
+    if unit.is_empty() && !bare_ok {
+        return Err(bad_unit("is a bare number".into()));
+    }
+    let limit = match (metric, unit) {
+        (Metric::ShapeTotal | Metric::ShapeQuant, u) if u.starts_with("lsb") => {
+            let bits: i32 = u[3..]
+                .parse()
+                .ok()
+                .filter(|b| (1..=64).contains(b))
+                .ok_or_else(|| bad("lsbN needs a number N in 1..=64"))?;
+            value * (-f64::from(bits)).exp2()
+        }
+        (Metric::Out | Metric::OutTotal, "ulp") => value,
+        (Metric::Correct | Metric::OutRel, "%") => value / 100.0,
+        (Metric::Correct | Metric::OutRel, "") => value,
+        (Metric::EffectiveBits, "") => value,
+        (m, "") if m.is_cost() => value,
+        _ => {
+            return Err(bad_unit(format!("has the unit '{unit}'")));
+        }
+    };
+    if metric.is_cost() && value.fract() != 0.0 {
+        return Err(bad("a count of cells is a whole number"));
+    }
+    if metric == Metric::Correct && limit > 1.0 {
+        return Err(bad("a share of inputs is at most 100%"));
+    }
+    if metric == Metric::EffectiveBits && limit > 64.0 {
+        return Err(bad("effective bits are at most 64"));
+    }
+    Ok(Bound { metric, limit })
+}
+
+/// A bound of a budget expression as a parser receives it: its whole text (`part`), the
+/// metric's text (`lhs`), the operator and the limit's text (`rhs`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RawBound<'a> {
+    pub part: &'a str,
+    pub lhs: &'a str,
+    pub op: &'static str,
+    pub rhs: &'a str,
+}
+
+/// The skeleton of the budget parsers ([`Budget`], `scene::fit::ImageBudget`): the bounds of
+/// `s` ([`bound_parts`]), each split at the first of `ops` it holds and parsed by `bound`, with
+/// the expression's canonical text (the bounds joined by ` and `). Every error is one line
+/// under the key `budget`: why, in which bound, and `examples` of good ones.
+pub(crate) fn parse_bounds<B>(
+    s: &str,
+    ops: &[&'static str],
+    examples: &str,
+    bound: impl Fn(&RawBound<'_>, &dyn Fn(&str) -> Error) -> Result<B, Error>,
+) -> Result<(String, Vec<B>), Error> {
+    let bad = |part: &str, why: &str| Error::Config {
+        key: "budget".into(),
+        problem: format!("{why} in '{part}'; expected e.g. {examples}"),
+    };
+    let parts = bound_parts(s).map_err(|why| bad(s.trim(), &why))?;
+    let mut bounds = Vec::with_capacity(parts.len());
+    for part in &parts {
+        let part = part.as_str();
+        let Some((lhs, op, rhs)) = ops
+            .iter()
+            .find_map(|&op| part.split_once(op).map(|(l, r)| (l, op, r)))
+        else {
+            return Err(bad(part, &format!("no {}", ops.join(" or "))));
+        };
+        if ops.iter().any(|op| rhs.contains(op)) {
+            return Err(bad(part, "two bounds need ',' or 'and' between them"));
+        }
+        let raw = RawBound { part, lhs, op, rhs };
+        bounds.push(bound(&raw, &|why| bad(part, why))?);
+    }
+    // One canonical spelling: no newline or other separator survives into a report.
+    Ok((parts.join(" and "), bounds))
+}
+
 /// The bounds of a budget expression: the parts between `,` and the word `and`, each with its
 /// words joined by single spaces.
 ///
 /// # Errors
-/// An empty part (a separator at either end, or two in a row) is refused, with why; the
-/// parsers that call it ([`Budget`], `scene::fit::ImageBudget`) put it in their error.
-pub(crate) fn bound_parts(s: &str) -> Result<Vec<String>, String> {
+/// An empty part (a separator at either end, or two in a row) is refused, with why;
+/// [`parse_bounds`] puts it in its error.
+fn bound_parts(s: &str) -> Result<Vec<String>, String> {
     let mut parts = Vec::new();
     for piece in s.split(',') {
         let mut words: Vec<&str> = Vec::new();

@@ -1231,6 +1231,29 @@ pub fn closest(r: &OptimizeAll, synth: Option<Synthesise>) -> Result<Option<Clos
     }))
 }
 
+/// How many syntheses with yosys [`Request::run`] runs between two lines of progress.
+const SYNTHESES_PER_LINE: u64 = 10;
+
+/// A device limit as `--device` takes it: a device every answer must fit, or `none` (no
+/// limit). A type of its own, because clap reads `Option<Option<T>>` as a flag whose value may
+/// be left out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DeviceLimit(pub Option<Device>);
+
+impl std::str::FromStr for DeviceLimit {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<DeviceLimit, String> {
+        match s.trim() {
+            "none" => Ok(DeviceLimit(None)),
+            other => other
+                .parse::<Device>()
+                .map(|d| DeviceLimit(Some(d)))
+                .map_err(|e| format!("{e}, or none to lift the limit")),
+        }
+    }
+}
+
 /// What `specfx optimize` is asked, end to end: the search's settings as a face hands them
 /// over. [`Request::run`] resolves the device and the architecture, searches every algorithm
 /// whose floor can meet the budget, and proves the answer.
@@ -1377,7 +1400,7 @@ impl Request {
 
     /// Searches and proves: the f64 floor of every algorithm (`floors` hears them before the
     /// search), the search of those that can meet the budget (`done` hears each algorithm's
-    /// result, from the worker threads), then the answer's exhaustive check in its
+    /// result, from the worker threads, after its line of progress in the log), then the answer's exhaustive check in its
     /// architecture, its yosys figures for the budget's yosys ceilings, and the paper's
     /// datapath beside it. `synth` runs yosys (the library starts no process): the objective
     /// `yosys` and the yosys ceilings call it.
@@ -1396,6 +1419,35 @@ impl Request {
             device,
             fold_when_needed: self.chosen_arch().is_none(),
         });
+        // Each synthesis takes seconds to minutes and a search runs many: a line at the first
+        // and at every tenth, since nothing else would show for minutes off a terminal.
+        let syntheses = std::sync::atomic::AtomicU64::new(0);
+        let counted = |dp: &Datapath, arch: Arch, target: Target| {
+            let so_far = syntheses.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            if so_far == 0 {
+                log::info!(
+                    "optimize: synthesising with yosys on {} (seconds to minutes each, cached ones at once; a line every {SYNTHESES_PER_LINE})",
+                    target.name()
+                );
+            } else if so_far.is_multiple_of(SYNTHESES_PER_LINE) {
+                log::info!("optimize: {so_far} syntheses with yosys so far");
+            }
+            synth(dp, arch, target)
+        };
+        let synth: Synthesise = &counted;
+        // A line per algorithm searched: its cheapest cost, or that nothing met the budget.
+        let unit = self.unit();
+        let no_answer = match device {
+            Some(d) => format!("nothing meets the budget and fits the {}", d.full_name()),
+            None => "nothing meets the budget".to_string(),
+        };
+        let done = |a: Algorithm, r: &SearchResult| {
+            let found = r.best.as_ref().map_or(no_answer.clone(), |b| {
+                format!("{:.0} {unit} ({})", b.cost, self.objective)
+            });
+            log::info!("optimize: {a}: {found}");
+            done(a, r);
+        };
         let target = self.target;
         let objective = self.objective;
         let cost = |dp: &Datapath, arch: Arch| -> Result<f64, Error> {
@@ -1419,7 +1471,7 @@ impl Request {
             Some(synth),
             fit,
             self.depth,
-            done,
+            &done,
         )?;
         let Some(best) = &result.best else {
             let closest = closest(&result, Some(synth))?;

@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 
 use super::hdl::{write_stimulus, RunOpts};
 use super::Outcome;
@@ -18,24 +18,7 @@ use specfx::hdl::testbench::parse_log;
 use specfx::hdl::top_parameters;
 use specfx::nset::NSet;
 use specfx::tools;
-
-/// A Verilog simulator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Simulator {
-    /// Icarus Verilog (`iverilog -g2005`, `vvp`).
-    Icarus,
-    /// Verilator (`verilator --binary`).
-    Verilator,
-}
-
-impl From<Simulator> for tools::simulator::Simulator {
-    fn from(s: Simulator) -> Self {
-        match s {
-            Simulator::Icarus => tools::simulator::Simulator::Icarus,
-            Simulator::Verilator => tools::simulator::Simulator::Verilator,
-        }
-    }
-}
+use specfx::tools::simulator::Simulator;
 
 /// Arguments of `specfx cosim`.
 #[derive(Debug, Args)]
@@ -58,7 +41,7 @@ pub struct CosimArgs {
     #[arg(long, default_value = "interleaved", conflicts_with = "vectors")]
     pub(super) order: Order,
     /// The simulator: icarus or verilator. Default: icarus when installed, else verilator.
-    #[arg(long)]
+    #[arg(long, value_parser = super::named_values(&Simulator::ALL, Simulator::name, Simulator::help))]
     pub(super) sim: Option<Simulator>,
     #[command(flatten)]
     pub(super) run: RunOpts,
@@ -106,8 +89,8 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     if args.dpi {
         return super::cosim_dpi::run(args);
     }
-    let sim = choose_simulator(args.sim.map(Into::into))?;
-    if args.lint && !tools::simulator::Simulator::Verilator.installed() {
+    let sim = choose_simulator(args.sim)?;
+    if args.lint && !Simulator::Verilator.installed() {
         bail!("--lint: verilator not found on PATH (Debian/Ubuntu: apt-get install -y verilator)");
     }
     check_vcd_output(args)?;
@@ -122,8 +105,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
     }
     let work = tools::child::work_dir("cosim").context("cannot create a work directory")?;
     let wd = work.path();
-    let vectors = vector_dir(args, wd)?;
-    let opened = specfx::input::open_vectors(&vectors)?;
+    let (vectors, opened) = vector_dir(args, wd)?;
     let dp = specfx::pipeline::Datapath::new(opened.config.clone())
         .context("the manifest's configuration")?;
     let arch = dp.config().resolve_arch(args.run.arch);
@@ -159,7 +141,7 @@ pub fn run(args: &CosimArgs) -> Result<Outcome> {
             ""
         }
     );
-    if sim == tools::simulator::Simulator::Verilator {
+    if sim == Simulator::Verilator {
         log::info!("cosim: building with verilator (a minute or less)");
     }
     let out = tools::simulator::simulate(sim, wd, &tb, &rtl, &params, args.vcd.is_some())?;
@@ -228,8 +210,12 @@ fn check_vcd_output(args: &CosimArgs) -> Result<()> {
     Ok(())
 }
 
-/// The vectors: the `--vectors` directory, or written for `--config` into the work directory.
-fn vector_dir(args: &CosimArgs, wd: &std::path::Path) -> Result<PathBuf> {
+/// The vector directory to co-simulate and its vectors: --vectors, opened (its files
+/// verified), or the vectors of --config written into the work directory, handed over as made.
+fn vector_dir(
+    args: &CosimArgs,
+    wd: &std::path::Path,
+) -> Result<(PathBuf, specfx::input::VectorDir)> {
     if let Some(dir) = &args.vectors {
         if !dir.join("manifest.json").is_file() {
             bail!(
@@ -238,11 +224,11 @@ fn vector_dir(args: &CosimArgs, wd: &std::path::Path) -> Result<PathBuf> {
                 dir.display()
             );
         }
-        return Ok(dir.clone());
+        return Ok((dir.clone(), specfx::input::open_vectors(dir)?));
     }
     let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
     let dir = wd.join("vectors");
-    super::vectors::write_dir(
+    let (inputs, _) = super::vectors::write_dir(
         &dp,
         &dir,
         &args.cases,
@@ -251,7 +237,11 @@ fn vector_dir(args: &CosimArgs, wd: &std::path::Path) -> Result<PathBuf> {
         false,
         &[],
     )?;
-    Ok(dir)
+    let made = specfx::input::VectorDir {
+        config: dp.config().clone(),
+        inputs,
+    };
+    Ok((dir, made))
 }
 
 /// `verilator --lint-only -Wall` of `specfx_top` and the RTL with the top's parameters (the
@@ -334,10 +324,7 @@ fn compare_traces(
     }
 }
 
-fn choose_simulator(
-    asked: Option<tools::simulator::Simulator>,
-) -> Result<tools::simulator::Simulator> {
-    use tools::simulator::Simulator;
+fn choose_simulator(asked: Option<Simulator>) -> Result<Simulator> {
     let hint = |s: Simulator| {
         let (programs, package) = s.programs();
         format!(

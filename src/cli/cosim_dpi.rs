@@ -68,7 +68,7 @@ fn percent(p: f64) -> i64 {
 /// Runs `specfx cosim --dpi`. Exit code 1 when a vector failed or nothing was checked.
 pub fn run(args: &CosimArgs) -> Result<Outcome> {
     use tools::simulator::Simulator;
-    if args.sim == Some(super::cosim::Simulator::Icarus) {
+    if args.sim == Some(Simulator::Icarus) {
         bail!(
             "--dpi --sim icarus: Icarus Verilog has no DPI-C support (and no plan for it); the DPI testbench runs in Verilator (--sim verilator), and Icarus runs the vector testbench (without --dpi) and cocotb"
         );

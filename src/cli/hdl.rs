@@ -14,37 +14,6 @@ use specfx::hdl::rom::rom_verilog;
 use specfx::hdl::{render_parameters, ParamsFormat};
 use specfx::output::write_atomic;
 
-/// `--format` of `specfx hdl params`: the library's [`ParamsFormat`], with its help.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum FormatArg {
-    /// `specfx_params.vh`: `` `define SPECFX_<NAME> <value> `` lines for `specfx_dut.v`.
-    Define,
-    /// A JSON object `{"NAME": value, ...}` (cocotb, VUnit, FuseSoC scripts).
-    Json,
-    /// Icarus Verilog flags, one per line: `-P<top>.<NAME>=<value>`.
-    Iverilog,
-    /// Verilator flags, one per line: `-G<NAME>=<value>` (for the top module).
-    Verilator,
-    /// FuseSoC flags, one per line: `--<NAME>=<value>` (after the core's name in `fusesoc
-    /// run`; hdl_ref/specfx.core).
-    Fusesoc,
-    /// A Verilog instantiation of `specfx_top` with every parameter set.
-    Instance,
-}
-
-impl From<FormatArg> for ParamsFormat {
-    fn from(f: FormatArg) -> ParamsFormat {
-        match f {
-            FormatArg::Define => ParamsFormat::Define,
-            FormatArg::Json => ParamsFormat::Json,
-            FormatArg::Iverilog => ParamsFormat::Iverilog,
-            FormatArg::Verilator => ParamsFormat::Verilator,
-            FormatArg::Fusesoc => ParamsFormat::Fusesoc,
-            FormatArg::Instance => ParamsFormat::Instance,
-        }
-    }
-}
-
 /// Arguments of `specfx hdl`.
 #[derive(Debug, Args)]
 pub struct HdlArgs {
@@ -80,8 +49,9 @@ struct ParamsArgs {
     /// How to render the parameters of `specfx_top`: define (the `specfx_params.vh` header of
     /// `specfx_dut.v`), json, iverilog (`-P` flags), verilator (`-G` flags) or instance (a
     /// Verilog instantiation).
-    #[arg(long, default_value = "define")]
-    format: FormatArg,
+    #[arg(long, default_value = "define",
+          value_parser = super::named_values(&ParamsFormat::ALL, ParamsFormat::name, ParamsFormat::help))]
+    format: ParamsFormat,
     /// The module whose parameters the iverilog `-P` flags set.
     #[arg(long, default_value = "specfx_top", value_parser = verilog_identifier)]
     top: String,
@@ -209,14 +179,14 @@ fn params(args: &ParamsArgs) -> Result<Outcome> {
         &dp,
         dp.config().resolve_arch(args.arch),
         args.reset_data,
-        args.format.into(),
+        args.format,
         &args.top,
     );
     let inputs = match &args.vectors {
         Some(dir) => super::output::config_inputs_as("--vectors", &dir.to_string_lossy()),
         None => super::output::config_inputs_as("--config", &args.config),
     };
-    let own_header = match ParamsFormat::from(args.format) {
+    let own_header = match args.format {
         ParamsFormat::Define => Some("// specfx parameters: "),
         ParamsFormat::Instance => Some("// specfx_top for configuration "),
         _ => None,

@@ -439,6 +439,31 @@ fn missing_subcommand(
     )
 }
 
+/// A value parser over a library enum's values (`values`, each with its name and its help):
+/// clap lists them with their help in `--help`, man pages and completions, and refuses any
+/// other name, as for a `clap::ValueEnum`.
+fn named_values<T>(
+    values: &'static [T],
+    name: fn(T) -> &'static str,
+    help: fn(T) -> &'static str,
+) -> impl clap::builder::TypedValueParser<Value = T>
+where
+    T: Copy + Send + Sync + 'static,
+{
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(
+        values
+            .iter()
+            .map(|&v| PossibleValue::new(name(v)).help(help(v))),
+    )
+    .map(move |s| {
+        *values
+            .iter()
+            .find(|&&v| name(v) == s)
+            .expect("clap checked the name")
+    })
+}
+
 /// Parses the arguments, runs the command and maps the result to an exit code.
 pub fn main() -> ExitCode {
     output::install_interrupt_handler();

@@ -2,28 +2,25 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::Args;
 
 use super::Outcome;
-use specfx::analysis::budget_expr::{Bound, Budget};
-use specfx::analysis::optimize::{Algorithm, DepthSearch, Objective, Request, SearchResult};
+use specfx::analysis::budget_expr::Budget;
+use specfx::analysis::optimize::{
+    Algorithm, DepthSearch, DeviceLimit, Objective, Request, SearchResult,
+};
 use specfx::cycle::Arch;
-use specfx::hdl::cost::{CostFigures, Target};
-use specfx::hdl::pnr::Device;
+use specfx::hdl::cost::Target;
 use specfx::nset::NSet;
 use specfx::output::write_atomic;
 use specfx::pipeline::{Datapath, Variant};
-use specfx::reference::lobe::{K_RANGE, K_RANGE_TEXT};
-use specfx::report::optimize::{answer_header, write_answer, write_no_answer, Answer};
+use specfx::report::optimize::{answer_file, write_answer, write_no_answer, Answer};
 
 /// The first bytes of the configuration `specfx optimize` writes: a file that begins with
 /// them is an earlier result, replaced without `--force`.
 const OUT_HEADER: &str = "# specfx optimize:";
 use specfx::provenance::Provenance;
-
-/// How many syntheses with yosys `optimize` runs between two lines of progress.
-const SYNTHESES_PER_LINE: u64 = 10;
 
 /// Arguments of `specfx optimize`.
 #[derive(Debug, Args)]
@@ -82,25 +79,6 @@ pub struct OptimizeArgs {
     force: bool,
 }
 
-/// The value of `--device`: a device every answer must fit, or `none` (no limit). A type of
-/// its own, because clap reads `Option<Option<T>>` as a flag whose value may be left out.
-#[derive(Debug, Clone, Copy)]
-struct DeviceLimit(Option<Device>);
-
-impl std::str::FromStr for DeviceLimit {
-    type Err = String;
-
-    fn from_str(s: &str) -> std::result::Result<DeviceLimit, String> {
-        match s.trim() {
-            "none" => Ok(DeviceLimit(None)),
-            other => other
-                .parse::<Device>()
-                .map(|d| DeviceLimit(Some(d)))
-                .map_err(|e| format!("{e}, or none to lift the limit")),
-        }
-    }
-}
-
 /// Runs `specfx optimize`. Exit code 1 when no configuration meets the budget.
 pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
     let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
@@ -111,9 +89,6 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         Some(OUT_HEADER),
         args.force,
     )?;
-    if let Some(&k) = args.k.values().iter().find(|&&k| !K_RANGE.contains(&k)) {
-        bail!("--k: expected numbers of squarings in {K_RANGE_TEXT}, got {k}");
-    }
     let request = Request {
         base: dp.config().clone(),
         budget: args.budget.clone(),
@@ -126,28 +101,11 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         arch: args.arch,
         device: args.device.map(|DeviceLimit(d)| d),
     };
-    let device = request.device()?;
+    request.device()?; // Its refusals come before any work.
     let unit = request.unit();
     let hdl = super::hdl_ref::hdl_ref_dir(None);
-    // Each synthesis takes seconds to minutes and a search runs many: a line at the first and
-    // at every tenth, since nothing else would show for minutes off a terminal.
-    let syntheses = std::sync::atomic::AtomicU64::new(0);
-    let synth = |dp: &Datapath, arch: Arch, target: Target| -> Result<CostFigures, specfx::Error> {
-        let done = syntheses.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        if done == 0 {
-            log::info!(
-                "optimize: synthesising with yosys on {} (seconds to minutes each, cached ones at once; a line every {SYNTHESES_PER_LINE})",
-                target.name()
-            );
-        } else if done.is_multiple_of(SYNTHESES_PER_LINE) {
-            log::info!("optimize: {done} syntheses with yosys so far");
-        }
-        specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| CostFigures {
-            target,
-            luts: s.cost.luts,
-            dsps: s.cost.dsps,
-            ffs: s.cost.ffs,
-        })
+    let synth = |dp: &Datapath, arch: Arch, target: Target| {
+        specfx::tools::yosys::synthesise(dp, arch, target, &hdl).map(|s| s.cost.figures(target))
     };
     log::info!(
         "optimize: f64 floor of {} algorithms (k in {}, {}; depth {})",
@@ -169,15 +127,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             reachable,
         ));
     };
-    let no_answer = match device {
-        Some(d) => format!("nothing meets the budget and fits the {}", d.full_name()),
-        None => "nothing meets the budget".to_string(),
-    };
-    let done = |a: Algorithm, r: &SearchResult| {
-        let found = r.best.as_ref().map_or(no_answer.to_string(), |b| {
-            format!("{:.0} {unit} ({})", b.cost, args.objective)
-        });
-        log::info!("optimize: {a}: {found}");
+    let done = |_: Algorithm, _: &SearchResult| {
         if let Some(bar) = bar.get() {
             bar.inc(1);
         }
@@ -192,31 +142,14 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
         r.budget,
         r.n_evaluations
     )?;
-    let (Some(best), Some(proven)) = (&r.best, &found.proven) else {
+    let Some(answer) = Answer::of(&found, args.objective, &unit) else {
         super::output::print_with(|w| {
             write_no_answer(w, r, found.closest.as_ref(), super::terminal::table_width())
         })?;
         return Ok(Outcome::CheckFailed);
     };
-    let yosys: Vec<(&Bound, CostFigures)> = proven.yosys.iter().map(|(b, f)| (b, *f)).collect();
-    let answer = Answer {
-        result: r,
-        best,
-        dp: &proven.dp,
-        proof: &proven.proof,
-        objective: args.objective,
-        unit: &unit,
-        arch: proven.arch,
-        paper: (&proven.paper.0, &proven.paper.1),
-        yosys: &yosys,
-    };
     let provenance = Provenance::new(&request.inputs()?);
-    let text = format!(
-        "{}{}{}",
-        answer_header(OUT_HEADER, &answer),
-        provenance.comment(),
-        proven.config.to_toml()
-    );
+    let text = answer_file(OUT_HEADER, &answer, &provenance);
     write_atomic(&args.out, text.as_bytes())?;
     super::output::print_with(|w| {
         write_answer(w, &answer, &args.out, super::terminal::table_width())

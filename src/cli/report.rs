@@ -252,7 +252,7 @@ impl<'a> Report<'a> {
             .start("writing baseline's golden vectors (corner cases and 1000 random)");
         let vectors_dir = self.dir.join("vectors_baseline");
         let selection: specfx::golden::CaseSelection = "corner,random:1000".parse()?;
-        let (n_vectors, _) = super::vectors::write_dir(
+        let (cases, _) = super::vectors::write_dir(
             dp,
             &vectors_dir,
             &selection,
@@ -262,7 +262,7 @@ impl<'a> Report<'a> {
             &[],
         )?;
         self.written.push(vectors_dir);
-        Ok(n_vectors)
+        Ok(cases.len() as u64)
     }
 
     fn simulate(&mut self, dp: &Datapath) -> Result<Vec<specfx::cycle::sim::SimStats>> {

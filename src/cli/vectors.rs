@@ -54,7 +54,7 @@ pub struct VectorsArgs {
 /// Runs `specfx vectors`.
 pub fn run(args: &VectorsArgs) -> Result<Outcome> {
     let dp = specfx::input::load_datapath(&args.config, args.n.as_ref())?;
-    let (n, coverage) = write_dir(
+    let (cases, coverage) = write_dir(
         &dp,
         &args.out,
         &args.cases,
@@ -63,6 +63,7 @@ pub fn run(args: &VectorsArgs) -> Result<Outcome> {
         args.force,
         &super::output::config_inputs_as("--config", &args.config),
     )?;
+    let n = cases.len();
     super::output::outln!(
         "wrote {n} vectors ({}, {} order, seed {}) to {}",
         args.cases,
@@ -76,7 +77,8 @@ pub fn run(args: &VectorsArgs) -> Result<Outcome> {
 
 /// Writes a vector directory, staged ([`specfx::output::OutDir`]): complete or absent, an
 /// existing directory replaced only when it is an earlier vector directory (or empty, or with
-/// `force`), never one of `inputs`. Returns the number of vectors and their coverage.
+/// `force`), never one of `inputs`. Returns the vectors' inputs, (n, raw code of c) in file
+/// order, and their coverage.
 pub fn write_dir(
     dp: &Datapath,
     out: &Path,
@@ -85,7 +87,7 @@ pub fn write_dir(
     seed: u64,
     force: bool,
     inputs: &[(&str, PathBuf)],
-) -> Result<(u64, Coverage)> {
+) -> Result<(Vec<(u32, i64)>, Coverage)> {
     let chosen = cases::select(dp, selection, seed)
         .with_context(|| format!("config {}", dp.config().name))?;
     let mut cases = chosen.cases;
@@ -172,5 +174,5 @@ pub fn write_dir(
         out.display(),
         manifest.ports.len()
     );
-    Ok((cases.len() as u64, coverage))
+    Ok((cases, coverage))
 }

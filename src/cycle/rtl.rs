@@ -22,6 +22,7 @@
 //! constants from [`Datapath::constants`].
 
 use crate::cycle::{Arch, Op, RegisterView, Token, Word};
+use crate::pipeline::ports::PerN;
 use crate::pipeline::Datapath;
 
 /// The width of the testbench's `in_n` (`tb_specfx.v`'s `N_W`).
@@ -39,17 +40,12 @@ pub fn core_scope(arch: Arch) -> &'static str {
 /// `specfx hdl params` writes (`SPECFX_<X>_W`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Widths {
-    /// `c`, `in_c` and `in_threshold`.
+    /// `c`, `in_c` and the clamped input `c_cl` (the per-n ports' widths are
+    /// [`PerN::format`]'s).
     pub c: u32,
     /// The testbench's `in_n` (32 bits, whatever the largest n: `in_n.hex` words are
     /// zero-extended).
     pub n: u32,
-    /// `in_slope`.
-    pub slope: u32,
-    /// `in_offset`.
-    pub offset: u32,
-    /// `in_coef`.
-    pub coef: u32,
     /// `out_data`.
     pub out: u32,
     /// `d`.
@@ -70,18 +66,14 @@ impl Widths {
     /// use specfx::cycle::rtl::Widths;
     /// use specfx::pipeline::{Config, Datapath};
     /// let w = Widths::of(&Datapath::new(Config::baseline()).unwrap());
-    /// assert_eq!((w.c, w.n, w.slope, w.offset, w.coef, w.out), (16, 32, 11, 1, 24, 24));
+    /// assert_eq!((w.c, w.n, w.out), (16, 32, 24));
     /// assert_eq!(w.folded_x(), 18);
     /// ```
     pub fn of(dp: &Datapath) -> Widths {
         let cfg = dp.config();
-        let (slope, offset) = cfg.constant_formats();
         Widths {
             c: cfg.c.format.width(),
             n: TESTBENCH_N_W,
-            slope: slope.width(),
-            offset: offset.width(),
-            coef: cfg.coef.format.width(),
             out: cfg.out.format.width(),
             d: cfg.d.format.width(),
             t: cfg.t.format.width(),
@@ -130,80 +122,81 @@ pub fn pipelined_registers(
     while start < owner.len() {
         let op = owner[start];
         let end = start + owner[start..].iter().take_while(|&&o| o == op).count();
-        // The fields of this delay line's word, most significant first: (output name, width,
-        // value of a token).
-        type Field = (&'static str, u32, fn(&Datapath, &Token) -> i64);
-        let coef: fn(&Datapath, &Token) -> i64 = |dp, t| dp.constants()[t.n_idx].coef_raw;
-        let threshold: fn(&Datapath, &Token) -> i64 =
-            |dp, t| dp.constants()[t.n_idx].threshold.unwrap_or(0);
-        let offset: fn(&Datapath, &Token) -> i64 = |dp, t| dp.constants()[t.n_idx].offset_raw;
-        let slope: fn(&Datapath, &Token) -> i64 = |dp, t| dp.constants()[t.n_idx].slope_raw;
-        let c_cl: fn(&Datapath, &Token) -> i64 = |_, t| t.c;
-        let value: fn(&Datapath, &Token) -> i64 = |_, t| t.value;
-        let depth: fn(&Datapath, &Token) -> i64 = |dp, t| i64::from(dp.constants()[t.n_idx].depth);
-        let d_w = crate::pipeline::DEPTH_BITS;
-        let (prefix, delay, fields): (String, &str, Vec<Field>) = match op {
-            Op::Sub => (
-                String::new(),
-                "r_sub",
-                vec![
-                    ("depth_1", d_w, depth),
-                    ("coef_1", w.coef, coef),
-                    ("threshold_1", w.c, threshold),
-                    ("offset_1", w.offset, offset),
-                    ("slope_1", w.slope, slope),
-                    ("c_cl_1", w.c, c_cl),
-                    ("d_1", w.d, value),
-                ],
-            ),
+        // The delay line's word: the per-n constants the operations after it still read
+        // (`{field}{suffix}`, in the reverse of the ports' order), the clamped input where the
+        // paper cutoff still needs it (`c_cl{suffix}`), then the operation's value.
+        let (prefix, delay, suffix, constants, clamped, value): (
+            String,
+            &str,
+            &str,
+            &[PerN],
+            bool,
+            (&str, u32),
+        ) = match op {
+            Op::Sub => (String::new(), "r_sub", "_1", &PerN::ALL, true, ("d_1", w.d)),
             Op::MulT => (
                 String::new(),
                 "r_mul_t",
-                vec![
-                    ("depth_2", d_w, depth),
-                    ("coef_2", w.coef, coef),
-                    ("threshold_2", w.c, threshold),
-                    ("offset_2", w.offset, offset),
-                    ("c_cl_2", w.c, c_cl),
-                    ("t_2", w.t, value),
-                ],
+                "_2",
+                &[PerN::Offset, PerN::Threshold, PerN::Coef, PerN::Depth],
+                true,
+                ("t_2", w.t),
             ),
             Op::AddB => (
                 String::new(),
                 "r_add_b",
-                vec![
-                    ("depth_b", d_w, depth),
-                    ("coef_b", w.coef, coef),
-                    ("b_q", w.b, value),
-                ],
+                "_b",
+                &[PerN::Coef, PerN::Depth],
+                false,
+                ("b_q", w.b),
             ),
             Op::Square(i) => (
                 format!("g_square[{}].", i + 1),
                 "r_square",
-                vec![
-                    ("depth_q", d_w, depth),
-                    ("coef_q", w.coef, coef),
-                    ("y_q", w.squares[i], value),
-                ],
+                "_q",
+                &[PerN::Coef, PerN::Depth],
+                false,
+                ("y_q", w.squares[i]),
             ),
             // The output is the core's port out_data, which traces show with the ports.
-            Op::MulOut => (String::new(), "r_mul_out", vec![("", w.out, value)]),
+            Op::MulOut => (String::new(), "r_mul_out", "", &[], false, ("", w.out)),
         };
+        // The fields of the word, most significant first: (output name, width, value of a
+        // token).
+        let mut fields: Vec<Field> = constants
+            .iter()
+            .rev()
+            .map(|&p| Field::constant(dp, p, suffix))
+            .collect();
+        if clamped {
+            fields.push(Field {
+                name: format!("c_cl{suffix}"),
+                width: w.c,
+                holds: Holds::Clamped,
+            });
+        }
+        fields.push(Field {
+            name: value.0.to_string(),
+            width: value.1,
+            holds: Holds::Value,
+        });
         let word = |token: &Option<Token>| {
             token.as_ref().map(|t| {
-                let raw: Vec<(i64, u32)> = fields.iter().map(|f| (f.2(dp, t), f.1)).collect();
+                let raw: Vec<(i64, u32)> = fields.iter().map(|f| (f.raw(dp, t), f.width)).collect();
                 Word::concat(&raw)
             })
         };
         // The delay line's outputs (its last register's fields), in the RTL's order.
-        for f in fields.iter().rev().filter(|f| !f.0.is_empty()) {
+        for f in fields.iter().rev().filter(|f| !f.name.is_empty()) {
             regs.push(RegisterView {
-                name: format!("{prefix}{}", f.0),
-                width: f.1,
-                value: tokens[end - 1].as_ref().map(|t| Word::new(f.2(dp, t), f.1)),
+                name: format!("{prefix}{}", f.name),
+                width: f.width,
+                value: tokens[end - 1]
+                    .as_ref()
+                    .map(|t| Word::new(f.raw(dp, t), f.width)),
             });
         }
-        let width = fields.iter().map(|f| f.1).sum();
+        let width = fields.iter().map(|f| f.width).sum();
         for (s, token) in tokens[start..end].iter().enumerate() {
             regs.push(RegisterView {
                 name: format!("{prefix}{delay}.g_regs.g_stage[{s}].r"),
@@ -248,21 +241,60 @@ pub fn folded_registers(dp: &Datapath, state: &FoldedState) -> Vec<RegisterView>
         width,
         value: state.x.as_ref().map(|t| Word::new(f(t), width)),
     };
-    let nc = |t: &Token| &dp.constants()[t.n_idx];
+    let constant = |p: PerN| {
+        let f = Field::constant(dp, p, "_r");
+        of_x(&f.name, f.width, &|t| f.raw(dp, t))
+    };
     vec![
         known("busy", i64::from(state.busy), 1),
         known("step", state.step as i64, step_w),
         known("count", i64::from(state.count), count_w),
         of_x("x", w.folded_x(), &|t| t.value),
-        of_x("slope_r", w.slope, &|t| nc(t).slope_raw),
-        of_x("offset_r", w.offset, &|t| nc(t).offset_raw),
-        of_x("threshold_r", w.c, &|t| nc(t).threshold.unwrap_or(0)),
+        constant(PerN::Slope),
+        constant(PerN::Offset),
+        constant(PerN::Threshold),
         of_x("c_cl_r", w.c, &|t| t.c),
-        of_x("coef_r", w.coef, &|t| nc(t).coef_raw),
-        of_x("depth_r", crate::pipeline::DEPTH_BITS, &|t| {
-            i64::from(nc(t).depth)
-        }),
+        constant(PerN::Coef),
+        constant(PerN::Depth),
     ]
+}
+
+/// A field of a register of the RTL: its name, width and what it holds of a token.
+struct Field {
+    name: String,
+    width: u32,
+    holds: Holds,
+}
+
+/// What a field of a register holds of a token.
+#[derive(Clone, Copy)]
+enum Holds {
+    /// A per-n constant of the token's n.
+    Constant(PerN),
+    /// The clamped input code.
+    Clamped,
+    /// The value of the register's operation.
+    Value,
+}
+
+impl Field {
+    /// The field `{field}{suffix}` holding per-n constant `p`, as wide as its port.
+    fn constant(dp: &Datapath, p: PerN, suffix: &str) -> Field {
+        Field {
+            name: format!("{}{suffix}", p.field()),
+            width: p.format(dp).width(),
+            holds: Holds::Constant(p),
+        }
+    }
+
+    /// Its raw contents for token `t`.
+    fn raw(&self, dp: &Datapath, t: &Token) -> i64 {
+        match self.holds {
+            Holds::Constant(p) => p.raw(&dp.constants()[t.n_idx]),
+            Holds::Clamped => t.c,
+            Holds::Value => t.value,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -338,6 +338,32 @@ pub fn order(cases: &mut [(u32, i64)], order: Order, seed: u64) {
     }
 }
 
+/// The directed cases `specfx vectors` always writes (every n's corner cases, codes with a
+/// non-zero output, the inputs on and next to every stage's rounding boundary), interleaved
+/// with `seed`: what the C, DPI and Python faces hand a testbench.
+///
+/// # Examples
+/// ```
+/// let dp = specfx::load_datapath("baseline", None).unwrap();
+/// let cases = specfx::golden::cases::directed(&dp, 1).unwrap();
+/// // Every exponent's 1.0 is a corner case.
+/// assert!(cases.contains(&(16, dp.one_code())));
+/// assert!(cases.contains(&(1024, dp.one_code())));
+/// ```
+///
+/// # Errors
+/// As [`select`].
+pub fn directed(dp: &Datapath, seed: u64) -> Result<Vec<(u32, i64)>, Error> {
+    let sel = CaseSelection {
+        corner: true,
+        exhaustive: false,
+        random: 0,
+    };
+    let mut cases = select(dp, &sel, seed)?.cases;
+    order(&mut cases, Order::Interleaved, seed);
+    Ok(cases)
+}
+
 /// The directed cases of a selection: what the cutoff-switch analysis and the
 /// rounding-boundary search found (the manifest's `coverage.directed`).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]

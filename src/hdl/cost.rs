@@ -682,6 +682,18 @@ mod tests {
     }
 }
 
+impl YosysCost {
+    /// Its logic cells, DSP blocks and flip-flops on `target`, the one it was synthesised for.
+    pub fn figures(&self, target: Target) -> CostFigures {
+        CostFigures {
+            target,
+            luts: self.luts,
+            dsps: self.dsps,
+            ffs: self.ffs,
+        }
+    }
+}
+
 /// What one yosys synthesis gives: its figures, its version and the exact script it ran.
 #[derive(Debug, Clone)]
 pub struct Synthesis {

@@ -183,8 +183,7 @@ pub fn slope_is_pow2(cfg: &crate::pipeline::Config) -> bool {
         && cfg.n.values().iter().all(|n| n.is_power_of_two())
 }
 
-/// How `specfx hdl params` renders a configuration's parameters (the command line's
-/// `--format` values, with their help, are in `cli/hdl.rs`).
+/// How `specfx hdl params` renders a configuration's parameters (its `--format` values).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ParamsFormat {
     /// `specfx_params.vh`: `` `define SPECFX_<NAME> <value> `` lines for `specfx_dut.v`.
@@ -201,6 +200,54 @@ pub enum ParamsFormat {
     /// A Verilog instantiation of `specfx_top` with every parameter set.
     Instance,
 }
+
+impl ParamsFormat {
+    /// Every format, in the order `--help` lists them.
+    pub const ALL: [ParamsFormat; 6] = [
+        ParamsFormat::Define,
+        ParamsFormat::Json,
+        ParamsFormat::Iverilog,
+        ParamsFormat::Verilator,
+        ParamsFormat::Fusesoc,
+        ParamsFormat::Instance,
+    ];
+
+    /// Its name as `--format` takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ParamsFormat::Define => "define",
+            ParamsFormat::Json => "json",
+            ParamsFormat::Iverilog => "iverilog",
+            ParamsFormat::Verilator => "verilator",
+            ParamsFormat::Fusesoc => "fusesoc",
+            ParamsFormat::Instance => "instance",
+        }
+    }
+
+    /// What it writes, in one line (`--help`).
+    pub fn help(self) -> &'static str {
+        match self {
+            ParamsFormat::Define => {
+                "`specfx_params.vh`: `` `define SPECFX_<NAME> <value> `` lines for `specfx_dut.v`"
+            }
+            ParamsFormat::Json => "A JSON object `{\"NAME\": value, ...}` (cocotb, VUnit, FuseSoC scripts)",
+            ParamsFormat::Iverilog => "Icarus Verilog flags, one per line: `-P<top>.<NAME>=<value>`",
+            ParamsFormat::Verilator => {
+                "Verilator flags, one per line: `-G<NAME>=<value>` (for the top module)"
+            }
+            ParamsFormat::Fusesoc => {
+                "FuseSoC flags, one per line: `--<NAME>=<value>` (after the core's name in `fusesoc run`; hdl_ref/specfx.core)"
+            }
+            ParamsFormat::Instance => "A Verilog instantiation of `specfx_top` with every parameter set",
+        }
+    }
+}
+
+crate::names::named_enum!(
+    ParamsFormat,
+    "parameter format",
+    "define, json, iverilog, verilator, fusesoc or instance"
+);
 
 /// The parameters of [`top_parameters`] rendered in `format`; `top` names the module whose
 /// parameters Icarus's `-P` flags set (the testbench or `specfx_top`).

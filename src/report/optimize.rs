@@ -6,10 +6,11 @@ use std::io::Write;
 
 use crate::analysis::budget_expr::Bound;
 use crate::analysis::check::{CheckReport, OutputFigures};
-use crate::analysis::optimize::{Candidate, Closest, Objective, OptimizeAll};
+use crate::analysis::optimize::{Candidate, Closest, Objective, OptimizeAll, Outcome};
 use crate::cycle::Arch;
 use crate::hdl::cost::{analytic_cost, AnalyticCost, CostFigures, REPORTED_TARGETS};
 use crate::pipeline::Datapath;
+use crate::provenance::Provenance;
 use crate::report::table::{Align, TextTable};
 
 /// Why nothing meets the budget: every algorithm's f64 floor (a table fitted into `width`),
@@ -109,7 +110,7 @@ pub fn write_no_answer(
     Ok(())
 }
 
-/// What `optimize` found and proved, for [`write_answer`] and [`answer_header`].
+/// What `optimize` found and proved, for [`write_answer`] and [`answer_file`].
 pub struct Answer<'a> {
     /// The search.
     pub result: &'a OptimizeAll,
@@ -128,7 +129,37 @@ pub struct Answer<'a> {
     /// The paper's datapath serving the same exponents, and its output figures.
     pub paper: (&'a Datapath, &'a OutputFigures),
     /// Each yosys ceiling of the budget with the answer's yosys figures on its target.
-    pub yosys: &'a [(&'a Bound, CostFigures)],
+    pub yosys: &'a [(Bound, CostFigures)],
+}
+
+impl<'a> Answer<'a> {
+    /// The answer of a search, when it found one (and proved it): `None` when nothing met
+    /// the budget. `unit` is the cost's ([`Request::unit`](crate::analysis::optimize::Request::unit)).
+    pub fn of(found: &'a Outcome, objective: Objective, unit: &'a str) -> Option<Answer<'a>> {
+        let (best, proven) = (found.result.best.as_ref()?, found.proven.as_ref()?);
+        Some(Answer {
+            result: &found.result,
+            best,
+            dp: &proven.dp,
+            proof: &proven.proof,
+            objective,
+            unit,
+            arch: proven.arch,
+            paper: (&proven.paper.0, &proven.paper.1),
+            yosys: &proven.yosys,
+        })
+    }
+}
+
+/// The configuration file `optimize` writes: [`answer_header`] after `first` (the file's own
+/// header, `# specfx optimize:`), the provenance as comments, then the answer's TOML.
+pub fn answer_file(first: &str, a: &Answer<'_>, provenance: &Provenance) -> String {
+    format!(
+        "{}{}{}",
+        answer_header(first, a),
+        provenance.comment(),
+        a.dp.config().to_toml()
+    )
 }
 
 /// The depths of a per-n datapath as ranges of n: `m = 16 for n = 16..=21, m = 32 for ...`.

@@ -88,67 +88,56 @@ impl FromStr for ImageBudget {
     /// 0.01`, each over every covered pixel or one material's (`max_lsb[vessel] <= 4`),
     /// several joined by `and` or `,`.
     fn from_str(s: &str) -> Result<Self, Error> {
-        let bad = |part: &str, why: &str| {
-            Error::Config {
-            key: "budget".into(),
-            problem: format!(
-                "{why} in '{part}'; expected e.g. 'max_lsb <= 2 and differing <= 1% and flip <= 0.01' (metrics max_lsb, mean_lsb, differing, flip; metric[material] for one material)"
-            ),
-        }
-        };
-        let mut bounds = Vec::new();
-        let parts =
-            crate::analysis::budget_expr::bound_parts(s).map_err(|why| bad(s.trim(), &why))?;
-        for part in &parts {
-            let part = part.as_str();
-            let Some((lhs, rhs)) = part.split_once("<=") else {
-                return Err(bad(part, "no <="));
-            };
-            if rhs.contains("<=") {
-                return Err(bad(part, "two bounds need ',' or 'and' between them"));
-            }
-            let lhs = lhs.trim();
-            let (name, material) = match lhs.split_once('[') {
-                Some((name, rest)) => match rest.strip_suffix(']') {
-                    Some(m) if !m.trim().is_empty() => (name.trim(), Some(m.trim().to_string())),
-                    _ => return Err(bad(part, "a material is written metric[name]")),
-                },
-                None => (lhs, None),
-            };
-            let metric = match name {
-                "max_lsb" => ImageMetric::MaxLsb,
-                "mean_lsb" => ImageMetric::MeanLsb,
-                "differing" => ImageMetric::Differing,
-                "flip" => ImageMetric::Flip,
-                other => return Err(bad(part, &format!("unknown metric '{other}'"))),
-            };
-            let rhs = rhs.trim();
-            let (number, percent) = match rhs.strip_suffix('%') {
-                Some(n) if metric == ImageMetric::Differing => (n.trim(), true),
-                Some(_) => return Err(bad(part, "only differing takes a percentage")),
-                None => (rhs, false),
-            };
-            let value: f64 = number
-                .parse()
-                .ok()
-                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
-                .ok_or_else(|| bad(part, "no non-negative number"))?;
-            let limit = if percent { value / 100.0 } else { value };
-            if metric == ImageMetric::Differing && limit > 1.0 {
-                return Err(bad(part, "a share of pixels is at most 100% (or 1)"));
-            }
-            bounds.push(ImageBound {
-                metric,
-                material,
-                limit,
-            });
-        }
-        Ok(ImageBudget {
-            // One canonical spelling: no newline or other separator survives into a report.
-            text: parts.join(" and "),
-            bounds,
-        })
+        let (text, bounds) = crate::analysis::budget_expr::parse_bounds(
+            s,
+            &["<="],
+            "'max_lsb <= 2 and differing <= 1% and flip <= 0.01' (metrics max_lsb, mean_lsb, differing, flip; metric[material] for one material)",
+            parse_image_bound,
+        )?;
+        Ok(ImageBudget { text, bounds })
     }
+}
+
+/// One bound of an [`ImageBudget`]: `lhs <= rhs`, `bad` the error of a malformed one.
+fn parse_image_bound(
+    b: &crate::analysis::budget_expr::RawBound<'_>,
+    bad: &dyn Fn(&str) -> Error,
+) -> Result<ImageBound, Error> {
+    let lhs = b.lhs.trim();
+    let (name, material) = match lhs.split_once('[') {
+        Some((name, rest)) => match rest.strip_suffix(']') {
+            Some(m) if !m.trim().is_empty() => (name.trim(), Some(m.trim().to_string())),
+            _ => return Err(bad("a material is written metric[name]")),
+        },
+        None => (lhs, None),
+    };
+    let metric = match name {
+        "max_lsb" => ImageMetric::MaxLsb,
+        "mean_lsb" => ImageMetric::MeanLsb,
+        "differing" => ImageMetric::Differing,
+        "flip" => ImageMetric::Flip,
+        other => return Err(bad(&format!("unknown metric '{other}'"))),
+    };
+    let rhs = b.rhs.trim();
+    let (number, percent) = match rhs.strip_suffix('%') {
+        Some(n) if metric == ImageMetric::Differing => (n.trim(), true),
+        Some(_) => return Err(bad("only differing takes a percentage")),
+        None => (rhs, false),
+    };
+    let value: f64 = number
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| bad("no non-negative number"))?;
+    let limit = if percent { value / 100.0 } else { value };
+    if metric == ImageMetric::Differing && limit > 1.0 {
+        return Err(bad("a share of pixels is at most 100% (or 1)"));
+    }
+    Ok(ImageBound {
+        metric,
+        material,
+        limit,
+    })
 }
 
 impl fmt::Display for ImageBudget {

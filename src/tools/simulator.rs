@@ -29,6 +29,14 @@ impl Simulator {
         }
     }
 
+    /// What it is and how specfx runs it, in one line (`--help`).
+    pub fn help(self) -> &'static str {
+        match self {
+            Simulator::Icarus => "Icarus Verilog (`iverilog -g2005`, `vvp`)",
+            Simulator::Verilator => "Verilator (`verilator --binary`)",
+        }
+    }
+
     /// The programs it needs and the Debian package that has them.
     pub fn programs(self) -> (&'static [&'static str], &'static str) {
         match self {

@@ -1,11 +1,11 @@
 //! The fold of one exponent's exhaustive check over the stream's chunks ([`NFold`]): each
 //! stage's running figures, the shape and normalisation maxima, the cuts and monotonicity.
 
-use super::screen;
-use super::{
-    cos_n_of, dead_prefix_end, overflowed_chunks, reference_base, CodeColumns,
-    MonotonicityViolation, CHUNK, MAX_LISTED_VIOLATIONS,
+use super::codes::{
+    cos_n_of, dead_prefix_end, overflowed_chunks, reference_base, CodeColumns, CHUNK,
 };
+use super::report::{MonotonicityViolation, MAX_LISTED_VIOLATIONS};
+use super::screen;
 use crate::analysis::accumulate::MaxAt;
 use crate::analysis::column::{column_figures, Map, Raws, References};
 use crate::engine::{each_chunk_in, Chunk, Span};
