@@ -6,8 +6,8 @@
 //!
 //! - `tb_specfx`: `clk`, `rst`, `cycle` (the testbench's 32-bit `integer`), `in_n` and the
 //!   DUT's ports;
-//! - `tb_specfx.dut`: the ports of `specfx_dut` (`clk rst in_valid in_ready in_c in_slope
-//!   in_offset in_threshold in_coef in_depth out_valid out_ready out_data`);
+//! - `tb_specfx.dut`: the ports of `specfx_dut` (the table of the top's ports,
+//!   [`TOP_PORTS`]);
 //! - `tb_specfx.dut.g_pipelined.u_core` or `tb_specfx.dut.g_folded.u_core`: the same ports,
 //!   `advance` (pipelined), and every register of the core ([`crate::cycle::rtl`]).
 //!

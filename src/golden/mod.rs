@@ -77,7 +77,7 @@ pub fn n_format(config: &Config) -> Format {
 ///
 /// Inputs first: `in_c`, `in_n`, then the per-n constants a datapath reads from its ROM, one
 /// port each ([`PerN`], in the order of `specfx_top`'s ports; every configuration has all of
-/// them, so one testbench serves them all: `in_depth` is k for a fixed depth), then one probe
+/// them, so one testbench serves them all: the depth is k for a fixed depth), then one probe
 /// per stage before the coefficient, then `expected_out`.
 pub fn ports(dp: &Datapath) -> Vec<Port> {
     let cfg = dp.config();

@@ -186,8 +186,9 @@ pub fn device_check(dsps: u64, luts: u64, ffs: u64, device: Device) -> Vec<Strin
 /// The flip-flops the harness adds around the DUT: one per input bit and one per output bit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct HarnessBits {
-    /// DUT input bits: `rst`, `in_valid`, `out_ready`, `in_c`, `in_slope`, `in_offset`,
-    /// `in_threshold`, `in_coef`, and `in_depth` when some n bypasses a squaring stage.
+    /// DUT input bits: every input port of the table of the top's ports
+    /// ([`TOP_PORTS`](crate::pipeline::ports::TOP_PORTS)) but the clock, the depth only when
+    /// some n bypasses a squaring stage.
     pub inputs: u64,
     /// DUT output bits: `in_ready`, `out_valid`, `out_data`.
     pub outputs: u64,
@@ -213,7 +214,7 @@ impl HarnessBits {
 /// ```
 pub fn harness_bits(dp: &Datapath) -> HarnessBits {
     use crate::pipeline::ports::{Carries, Direction, PerN, TOP_PORTS};
-    // Every port but the clock; in_depth only where some n bypasses a squaring stage.
+    // Every port but the clock; the depth only where some n bypasses a squaring stage.
     let bits = |direction: Direction| -> u64 {
         TOP_PORTS
             .iter()

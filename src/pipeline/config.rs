@@ -83,8 +83,8 @@ pub struct MinimaxSpec {
     pub rounding: Rounding,
 }
 
-/// Width of the per-n depth field j(n) (1..=7) in the vectors, the ROM and the RTL's
-/// `in_depth` port.
+/// Width of the per-n depth field j(n) (1..=7) in the vectors, the ROM and the RTL's depth
+/// port ([`PerN::Depth`](crate::pipeline::ports::PerN::Depth)).
 pub const DEPTH_BITS: u32 = 3;
 
 /// How many of the k squaring stages square at each n: `j(n)`, with `m(n) = 2^j(n)`; the

@@ -19,6 +19,8 @@
 pub mod config;
 pub mod datapath;
 pub mod f64_walk;
+/// The batch kernels, their proofs and plan: performance internals (hidden from the docs).
+#[doc(hidden)]
 pub mod fast;
 pub mod ports;
 pub mod walk;
@@ -27,6 +29,7 @@ pub use config::{
     Arch, CoefSpec, Config, Depth, DepthStep, FormatSpec, LatencySpec, MinimaxSpec, StageSpec,
     Variant, DEPTH_BITS,
 };
+pub use fast::EventCounts;
 pub use datapath::{
     first_code_where, Datapath, NConstants, OutputScratch, ProbeColumns, Probes, StageInfo,
     MAX_STAGES,
