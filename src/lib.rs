@@ -71,8 +71,10 @@ pub mod output;
 pub mod pipeline;
 pub mod provenance;
 pub mod reference;
+#[cfg(feature = "report")]
 #[doc(hidden)]
 pub mod report;
+#[cfg(feature = "scene")]
 pub mod scene;
 #[doc(hidden)]
 pub mod tools;

@@ -44,7 +44,7 @@ pub const SPECFX_OFFSET: c_int = 1;
 pub const SPECFX_THRESHOLD: c_int = 2;
 /// The coefficient's raw code.
 pub const SPECFX_COEF: c_int = 3;
-/// The per-n depth j(n), the squarings n uses (on `specfx_top`'s depth port; k for a fixed
+/// The per-n depth j(n), the squarings n uses (`specfx_top`'s `in_depth`; k for a fixed
 /// depth).
 pub const SPECFX_DEPTH: c_int = 4;
 // The numbers are the library's order of the per-n constants (`PerN::ALL`), which

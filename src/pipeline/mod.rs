@@ -29,8 +29,8 @@ pub use config::{
     Arch, CoefSpec, Config, Depth, DepthStep, FormatSpec, LatencySpec, MinimaxSpec, StageSpec,
     Variant, DEPTH_BITS,
 };
-pub use fast::EventCounts;
 pub use datapath::{
     first_code_where, Datapath, NConstants, OutputScratch, ProbeColumns, Probes, StageInfo,
     MAX_STAGES,
 };
+pub use fast::EventCounts;
