@@ -880,6 +880,99 @@ pub fn split(n_points: u64, tasks: u64, shards_per_task: u64) -> Result<u64, Err
     Ok(shards)
 }
 
+/// What every job of a plan asks its scheduler beyond the resources: the partition (Slurm) or
+/// queue (LSF, SGE), the account (Slurm) or project (LSF, SGE), the quality of service
+/// (Slurm), and directives of the user's own, one line each after the scheduler's prefix
+/// (`#SBATCH`, `#BSUB`, `#$`).
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SchedulerOptions {
+    /// `--partition`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub partition: Option<String>,
+    /// `--account`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub account: Option<String>,
+    /// `--qos`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub qos: Option<String>,
+    /// `--directive`, in the order given.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub directives: Vec<String>,
+}
+
+impl SchedulerOptions {
+    /// Whether nothing is asked.
+    pub fn is_empty(&self) -> bool {
+        *self == SchedulerOptions::default()
+    }
+
+    /// Refuses what `emit`'s scripts have no place for (a quality of service outside Slurm;
+    /// any option for Kubernetes, whose Job the user edits, and for a shell), a name that is
+    /// empty or holds a space or a control character, and a directive that is empty, holds a
+    /// control character (a line break would end it) or starts with `#` (the prefix is
+    /// written).
+    pub fn check(&self, emit: Emit) -> Result<(), Error> {
+        let refuse = |option: &str, problem: String| {
+            Err(Error::Cluster {
+                option: option.into(),
+                problem,
+            })
+        };
+        let names = [
+            ("--partition", &self.partition),
+            ("--account", &self.account),
+            ("--qos", &self.qos),
+        ];
+        for (option, value) in names {
+            let Some(v) = value else { continue };
+            if v.is_empty() || v.chars().any(|c| c.is_whitespace() || c.is_control()) {
+                return refuse(
+                    option,
+                    format!(
+                        "expected a name without spaces or control characters, got '{}'",
+                        crate::error::OneLine(v)
+                    ),
+                );
+            }
+        }
+        for d in &self.directives {
+            if d.trim().is_empty() || d.chars().any(char::is_control) || d.starts_with('#') {
+                return refuse(
+                    "--directive",
+                    format!(
+                        "expected the text after the scheduler's prefix (e.g. --gres=gpu:1 for Slurm), one line, got '{}'",
+                        crate::error::OneLine(d)
+                    ),
+                );
+            }
+        }
+        let unsupported = match emit {
+            Emit::Slurm => None,
+            Emit::Lsf | Emit::Sge => self.qos.is_some().then_some("--qos"),
+            Emit::K8s | Emit::Shell => names
+                .iter()
+                .find(|(_, v)| v.is_some())
+                .map(|(o, _)| *o)
+                .or((!self.directives.is_empty()).then_some("--directive")),
+        };
+        match unsupported {
+            Some(option) => refuse(
+                option,
+                format!(
+                    "the {} scripts have no place for it{}",
+                    emit.name(),
+                    match emit {
+                        Emit::K8s => " (edit the Job's JSON)",
+                        Emit::Shell => " (the shell plan runs here, without a scheduler)",
+                        _ => " (a quality of service is Slurm's; give --directive)",
+                    }
+                ),
+            ),
+            None => Ok(()),
+        }
+    }
+}
+
 /// A sweep split for a cluster: what `sweep plan` writes scripts for.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Plan {
@@ -903,6 +996,9 @@ pub struct Plan {
     pub resources: Resources,
     /// The command that runs specfx in the scripts.
     pub specfx: String,
+    /// What every job asks its scheduler beyond the resources ([`Plan::with_scheduler`]).
+    #[serde(skip_serializing_if = "SchedulerOptions::is_empty")]
+    pub scheduler: SchedulerOptions,
 }
 
 impl Plan {
@@ -950,7 +1046,16 @@ impl Plan {
             point_cost,
             resources: resources(point_cost, points_per_task, threads),
             specfx: specfx.to_string(),
+            scheduler: SchedulerOptions::default(),
         })
+    }
+
+    /// The plan with `options` on every job, checked for its scheduler
+    /// ([`SchedulerOptions::check`]).
+    pub fn with_scheduler(mut self, options: SchedulerOptions) -> Result<Plan, Error> {
+        options.check(self.emit)?;
+        self.scheduler = options;
+        Ok(self)
     }
 
     /// The job's name: `specfx-sweep-` and the first 12 hex digits of the sweep's identity.

@@ -1036,8 +1036,8 @@ impl DeviceFit {
 
 /// Searches every reachable algorithm (in parallel, results combined in the floors' order) for
 /// the cheapest configuration meeting `budget`, costed by `cost` in the budget's architecture;
-/// `done(algorithm)` is called as each finishes. With a device (`fit`), an answer that does
-/// not fit it is no answer (it becomes the closest point, and a line of the minimality); when
+/// `done(algorithm, arch)` is called as each finishes, with the architecture of its pass. With
+/// a device (`fit`), an answer that does not fit it is no answer (it becomes the closest point, and a line of the minimality); when
 /// no algorithm's answer fits and `fit` allows it, the algorithms are searched again in the
 /// folded architecture (one shared multiplier, an initiation interval of k + 2 cycles), whose
 /// answers then compete. With [`DepthSearch::Auto`], the per-n algorithms among the floors are
@@ -1052,7 +1052,7 @@ pub fn optimize_all(
     synth: Option<Synthesise>,
     fit: Option<DeviceFit>,
     depth: DepthSearch,
-    done: &(dyn Fn(Algorithm, &SearchResult) + Sync),
+    done: &(dyn Fn(Algorithm, Arch, &SearchResult) + Sync),
 ) -> Result<OptimizeAll, Error> {
     use rayon::prelude::*;
     // Every algorithm's candidates share the input format: one cache of cos^n for all.
@@ -1113,7 +1113,7 @@ pub fn optimize_all(
                         r.best = None;
                     }
                 }
-                done(a, &r);
+                done(a, arch, &r);
                 Ok((r, note))
             })
             .collect()
@@ -1412,7 +1412,7 @@ impl Request {
         &self,
         synth: Synthesise,
         floors_found: &dyn Fn(&[AlgorithmFloor]),
-        done: &(dyn Fn(Algorithm, &SearchResult) + Sync),
+        done: &(dyn Fn(Algorithm, Arch, &SearchResult) + Sync),
     ) -> Result<Outcome, Error> {
         let device = self.device()?;
         let fit = device.map(|device| DeviceFit {
@@ -1441,12 +1441,12 @@ impl Request {
             Some(d) => format!("nothing meets the budget and fits the {}", d.full_name()),
             None => "nothing meets the budget".to_string(),
         };
-        let done = |a: Algorithm, r: &SearchResult| {
+        let done = |a: Algorithm, arch: Arch, r: &SearchResult| {
             let found = r.best.as_ref().map_or(no_answer.clone(), |b| {
                 format!("{:.0} {unit} ({})", b.cost, self.objective)
             });
-            log::info!("optimize: {a}: {found}");
-            done(a, r);
+            log::info!("optimize: {a}, {arch}: {found}");
+            done(a, arch, r);
         };
         let target = self.target;
         let objective = self.objective;

@@ -16,7 +16,8 @@ use super::output::{print_json, print_with};
 use super::Outcome;
 use specfx::analysis::cluster::{assign_dirs, parse_shard_spec, ShardSpec};
 use specfx::hdl::calibrate::{
-    calibration, fit, merge_records, read_records, sample, Calibration, Record, TargetFit,
+    calibration, fit, merge_records, read_records, sample, Calibration, Coefficients, Record,
+    TargetFit,
 };
 use specfx::hdl::cost::Target;
 use specfx::pipeline::Datapath;
@@ -32,7 +33,8 @@ pub struct CalibrateArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "ice40,xilinx,generic-fast"
+        default_value = "ice40,xilinx,generic-fast",
+        value_parser = super::named_values(&Target::ALL, Target::name, super::no_help)
     )]
     targets: Vec<Target>,
     /// Number of sampled configurations per target (default: the committed sample's, 320
@@ -386,6 +388,15 @@ fn calibrate(args: &CalibrateArgs, data: &Path, shard: Option<(u64, u64)>) -> Re
                 }
             )?;
             continue;
+        }
+        if plan.records.len() < Coefficients::COUNT {
+            log::warn!(
+                "calibrate {}: {} records for {} coefficients: the fit is underdetermined, and its error says nothing (synthesise at least {} with --count)",
+                target.name(),
+                plan.records.len(),
+                Coefficients::COUNT,
+                Coefficients::COUNT
+            );
         }
         let (coefficients, error) = fit(&plan.records, target)?;
         fits.push(TargetFit {

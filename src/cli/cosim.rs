@@ -38,7 +38,7 @@ pub struct CosimArgs {
     pub(super) cases: CaseSelection,
     /// Row order of the vectors written for --config: interleaved (n changes almost every
     /// vector, seeded) or sorted by n then c.
-    #[arg(long, default_value = "interleaved", conflicts_with = "vectors")]
+    #[arg(long, default_value = "interleaved", conflicts_with = "vectors", value_parser = super::named_values(&Order::ALL, Order::name, super::no_help))]
     pub(super) order: Order,
     /// The simulator: icarus or verilator. Default: icarus when installed, else verilator.
     #[arg(long, value_parser = super::named_values(&Simulator::ALL, Simulator::name, Simulator::help))]

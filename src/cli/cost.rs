@@ -21,10 +21,10 @@ pub struct CostArgs {
     config: String,
     /// Microarchitecture: pipelined or folded [default: the configuration's `arch` key, else
     /// pipelined].
-    #[arg(long)]
+    #[arg(long, value_parser = super::named_values(&Arch::ALL, Arch::name, super::no_help))]
     arch: Option<Arch>,
     /// Synthesis target: generic (gates and a CMOS transistor estimate), ice40 or xilinx.
-    #[arg(long, default_value = "ice40")]
+    #[arg(long, default_value = "ice40", value_parser = super::named_values(&Target::ALL, Target::name, super::no_help))]
     target: Target,
     /// The reference Verilog directory (default: $SPECFX_HDL_REF, else the hdl_ref/ of the
     /// source tree this binary was built from).

@@ -36,7 +36,7 @@ pub struct FitArgs {
     #[arg(long, default_value = "baseline")]
     config: String,
     /// Target of the reported cost (analytic and yosys): generic, ice40 or xilinx.
-    #[arg(long, default_value = "ice40")]
+    #[arg(long, default_value = "ice40", value_parser = super::named_values(&Target::ALL, Target::name, super::no_help))]
     target: Target,
     /// Only the analytic cost: do not run yosys.
     #[arg(long)]

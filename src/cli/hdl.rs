@@ -44,7 +44,7 @@ struct ParamsArgs {
     vectors: Option<PathBuf>,
     /// Microarchitecture: pipelined or folded [default: the configuration's `arch` key, else
     /// pipelined].
-    #[arg(long)]
+    #[arg(long, value_parser = super::named_values(&Arch::ALL, Arch::name, super::no_help))]
     arch: Option<Arch>,
     /// How to render the parameters of `specfx_top`: define (the `specfx_params.vh` header of
     /// `specfx_dut.v`), json, iverilog (`-P` flags), verilator (`-G` flags) or instance (a
@@ -86,7 +86,7 @@ struct RomArgs {
 pub struct RunOpts {
     /// Microarchitecture: pipelined or folded [default: the `arch` key of the configuration
     /// (of the vectors' manifest), else pipelined].
-    #[arg(long)]
+    #[arg(long, value_parser = super::named_values(&Arch::ALL, Arch::name, super::no_help))]
     pub arch: Option<Arch>,
     /// Seed of the bubble/stall patterns (`cosim`: also of the vectors it writes).
     #[arg(long, default_value_t = 1)]

@@ -142,6 +142,25 @@ pub fn init(verbosity: Verbosity, color: clap::ColorChoice) {
     }
 }
 
+/// The line a run ends with when it fails (`specfx: error: ...`): red where `color` (on a
+/// terminal, unless `NO_COLOR` is set or `--color never`), as the log's error lines.
+pub fn error_line(line: &str, color: bool) -> String {
+    format_line(log::Level::Error, line, color)
+}
+
+/// Whether this run's lines on stderr are coloured: [`init`]'s settings, or before it (an
+/// error in the arguments) the `--color` flag, `NO_COLOR` and whether stderr is a terminal.
+pub fn stderr_color() -> bool {
+    match SETTINGS.get() {
+        Some(s) => s.color,
+        None => color_enabled(
+            color_flag(std::env::args_os()),
+            no_color(std::env::var_os("NO_COLOR").as_deref()),
+            std::io::stderr().is_terminal(),
+        ),
+    }
+}
+
 /// The `log` backend: one line per record on stderr.
 struct StderrLogger;
 

@@ -213,13 +213,19 @@ const EXAMPLES: &[(&str, &str)] = &[
     ("man", "specfx man --out man/ && man -l man/specfx-cosim.1"),
 ];
 
+/// The widest help line: the terminal's width up to this, and this off a terminal.
+const HELP_WIDTH: usize = 100;
+
 /// The command-line definition, with each command's example and the exit codes.
 fn command() -> clap::Command {
     use clap::CommandFactory;
-    let mut cmd = Cli::command().after_help(
-        "Exit codes: 0 success; 1 the command ran but a check it performs failed; 2 bad input \
-         or an I/O error (one line on stderr, nothing written).",
-    );
+    let mut cmd = Cli::command()
+        .after_help(
+            "Exit codes: 0 success; 1 the command ran but a check it performs failed; 2 bad input \
+             or an I/O error (one line on stderr, nothing written).",
+        )
+        // Help wrapped to the terminal's width, at most 100 columns (100 off a terminal).
+        .max_term_width(HELP_WIDTH);
     cmd = negative_values(cmd);
     for (name, example) in EXAMPLES {
         let help = format!("Example:\n  {example}");
@@ -287,6 +293,23 @@ fn completions(args: &CompletionsArgs) -> anyhow::Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
+/// No help for a value of [`named_values`]: `--help` lists the names alone.
+fn no_help<T>(_: T) -> &'static str {
+    ""
+}
+
+/// Every subcommand of `cmd` at any depth, named for its page: `specfx-sweep`, then
+/// `specfx-sweep-plan` and `specfx-sweep-merge` after it.
+fn subcommand_pages(cmd: &clap::Command, prefix: &str) -> Vec<(String, clap::Command)> {
+    let mut pages = Vec::new();
+    for sub in cmd.get_subcommands() {
+        let name = format!("{prefix}-{}", sub.get_name());
+        pages.push((name.clone(), sub.clone().name(name.clone())));
+        pages.extend(subcommand_pages(sub, &name));
+    }
+    pages
+}
+
 fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
     let cmd = command();
     let render = |c: clap::Command| -> anyhow::Result<Vec<u8>> {
@@ -306,10 +329,8 @@ fn man(args: &ManArgs) -> anyhow::Result<Outcome> {
             // Every page is rendered and every file checked before the first is written: a
             // file of the same name that is not a specfx manual page is kept (unless --force).
             let mut pages = vec![(dir.join("specfx.1"), render(cmd.clone())?)];
-            for sub in cmd.get_subcommands() {
-                let name = format!("specfx-{}", sub.get_name());
-                let page = render(sub.clone().name(name.clone()))?;
-                pages.push((dir.join(format!("{name}.1")), page));
+            for (name, sub) in subcommand_pages(&cmd, "specfx") {
+                pages.push((dir.join(format!("{name}.1")), render(sub)?));
             }
             let names: Vec<String> = pages
                 .iter()
@@ -439,29 +460,67 @@ fn missing_subcommand(
     )
 }
 
-/// A value parser over a library enum's values (`values`, each with its name and its help):
-/// clap lists them with their help in `--help`, man pages and completions, and refuses any
-/// other name, as for a `clap::ValueEnum`.
+/// A value parser over a library enum's values (`values`, each with its name and its help, or
+/// [`no_help`]): clap lists them (with their help) in `--help`, man pages and the shell
+/// completions, which complete the values rather than file names. A name is taken in any case,
+/// as the library's own parsers take it; any other value is refused with clap's error, which
+/// lists the names.
 fn named_values<T>(
     values: &'static [T],
     name: fn(T) -> &'static str,
     help: fn(T) -> &'static str,
-) -> impl clap::builder::TypedValueParser<Value = T>
+) -> NamedValues<T>
 where
     T: Copy + Send + Sync + 'static,
 {
-    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-    PossibleValuesParser::new(
-        values
-            .iter()
-            .map(|&v| PossibleValue::new(name(v)).help(help(v))),
-    )
-    .map(move |s| {
-        *values
-            .iter()
-            .find(|&&v| name(v) == s)
-            .expect("clap checked the name")
-    })
+    NamedValues { values, name, help }
+}
+
+/// The parser [`named_values`] makes.
+#[derive(Clone)]
+struct NamedValues<T: 'static> {
+    values: &'static [T],
+    name: fn(T) -> &'static str,
+    help: fn(T) -> &'static str,
+}
+
+impl<T: Copy + Send + Sync + 'static> NamedValues<T> {
+    fn possible(&self) -> impl Iterator<Item = clap::builder::PossibleValue> + '_ {
+        self.values.iter().map(|&v| match (self.help)(v) {
+            "" => clap::builder::PossibleValue::new((self.name)(v)),
+            help => clap::builder::PossibleValue::new((self.name)(v)).help(help),
+        })
+    }
+}
+
+impl<T: Copy + Send + Sync + 'static> clap::builder::TypedValueParser for NamedValues<T> {
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        if let Some(&v) = value.to_str().and_then(|s| {
+            self.values
+                .iter()
+                .find(|&&v| (self.name)(v).eq_ignore_ascii_case(s))
+        }) {
+            return Ok(v);
+        }
+        // Not a name: clap's own error, with the names.
+        match clap::builder::PossibleValuesParser::new(self.possible()).parse_ref(cmd, arg, value) {
+            Err(e) => Err(e),
+            Ok(_) => unreachable!("the value is none of the names"),
+        }
+    }
+
+    fn possible_values(
+        &self,
+    ) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        Some(Box::new(self.possible()))
+    }
 }
 
 /// Parses the arguments, runs the command and maps the result to an exit code.
@@ -482,10 +541,14 @@ pub fn main() -> ExitCode {
         // it takes, not a page of help.
         Err(e) if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
             use std::io::Write as _;
+            let message = missing_subcommand(&command(), std::env::args_os().skip(1));
             let _ = writeln!(
                 std::io::stderr(),
-                "specfx: error: {}",
-                missing_subcommand(&command(), std::env::args_os().skip(1))
+                "{}",
+                logging::error_line(
+                    &format!("specfx: error: {message}"),
+                    logging::stderr_color()
+                )
             );
             return ExitCode::from(2);
         }
@@ -493,10 +556,11 @@ pub fn main() -> ExitCode {
             // A closed or full stderr is no reason to panic: the exit code still tells.
             {
                 use std::io::Write as _;
+                let line = format!("specfx: {}", one_line(&e.render().to_string()));
                 let _ = writeln!(
                     std::io::stderr(),
-                    "specfx: {}",
-                    one_line(&e.render().to_string())
+                    "{}",
+                    logging::error_line(&line, logging::stderr_color())
                 );
             }
             return ExitCode::from(2);
@@ -504,7 +568,11 @@ pub fn main() -> ExitCode {
     };
     if let Err(e) = check_thread_count(std::env::var_os("RAYON_NUM_THREADS").as_deref()) {
         use std::io::Write as _;
-        let _ = writeln!(std::io::stderr(), "specfx: error: {e}");
+        let _ = writeln!(
+            std::io::stderr(),
+            "{}",
+            logging::error_line(&format!("specfx: error: {e}"), logging::stderr_color())
+        );
         return ExitCode::from(2);
     }
     logging::init(
@@ -557,7 +625,14 @@ pub fn main() -> ExitCode {
                 });
             {
                 use std::io::Write as _;
-                let _ = writeln!(std::io::stderr(), "specfx: error: {err:#}{complete}");
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "{}",
+                    logging::error_line(
+                        &format!("specfx: error: {err:#}{complete}"),
+                        logging::stderr_color()
+                    )
+                );
             }
             ExitCode::from(2)
         }

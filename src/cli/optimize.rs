@@ -38,10 +38,10 @@ pub struct OptimizeArgs {
     n: Option<NSet>,
     /// Cost to minimise: analytic (the calibrated model's logic cells on --target, instant) or
     /// yosys (yosys's count on --target, seconds per candidate).
-    #[arg(long, default_value = "analytic")]
+    #[arg(long, default_value = "analytic", value_parser = super::named_values(&Objective::ALL, Objective::name, super::no_help))]
     objective: Objective,
     /// Target whose logic cells are minimised: ice40 (LUTs), xilinx (LUTs) or generic (gates).
-    #[arg(long, default_value = "ice40")]
+    #[arg(long, default_value = "ice40", value_parser = super::named_values(&Target::ALL, Target::name, super::no_help))]
     target: Target,
     /// Numbers of squarings to try (each is searched only if its f64 floor can meet the
     /// budget).
@@ -63,7 +63,7 @@ pub struct OptimizeArgs {
     /// Microarchitecture costed: pipelined or folded. Left out: the base configuration's `arch`
     /// key; without one, pipelined, and folded for an algorithm whose pipelined answer does
     /// not fit the device. The answer's TOML records the one it was costed with (`arch`).
-    #[arg(long)]
+    #[arg(long, value_parser = super::named_values(&Arch::ALL, Arch::name, super::no_help))]
     arch: Option<Arch>,
     /// The device every answer must fit (its DSP blocks, LUTs and flip-flops, by the analytic
     /// model): up5k (iCE40), or none to lift the limit (hx8k, without DSP blocks, is refused:
@@ -127,7 +127,7 @@ pub fn run(args: &OptimizeArgs) -> Result<Outcome> {
             reachable,
         ));
     };
-    let done = |_: Algorithm, _: &SearchResult| {
+    let done = |_: Algorithm, _: Arch, _: &SearchResult| {
         if let Some(bar) = bar.get() {
             bar.inc(1);
         }

@@ -22,10 +22,10 @@ pub struct TimingArgs {
     config: String,
     /// Microarchitecture: pipelined or folded [default: the configuration's `arch` key, else
     /// pipelined].
-    #[arg(long)]
+    #[arg(long, value_parser = super::named_values(&Arch::ALL, Arch::name, super::no_help))]
     arch: Option<Arch>,
     /// Device: up5k (iCE40 UltraPlus UP5K, SG48, 8 DSPs) or hx8k (iCE40 HX8K, CT256, no DSPs).
-    #[arg(long, default_value = "up5k")]
+    #[arg(long, default_value = "up5k", value_parser = super::named_values(&Device::ALL, Device::name, super::no_help))]
     device: Device,
     /// The reference Verilog directory (default: $SPECFX_HDL_REF, else the hdl_ref/ of the
     /// source tree this binary was built from).

@@ -29,10 +29,10 @@ fn parse_k(s: &str) -> Result<u32, String> {
 pub struct CoefArgs {
     /// Normalisation form: phong, phong_modified, blinn_phong, blinn_phong_modified,
     /// blinn_phong_ndf, blinn_phong_heightfield.
-    #[arg(long, default_value = "phong")]
+    #[arg(long, default_value = "phong", value_parser = super::named_values(&Form::ALL, Form::name, super::no_help))]
     form: Form,
     /// Coefficient source: classic (cos^n), paper (Table 1 as printed), exact (cs_m).
-    #[arg(long, default_value = "exact")]
+    #[arg(long, default_value = "exact", value_parser = super::named_values(&CoefSource::ALL, CoefSource::name, super::no_help))]
     source: CoefSource,
     /// Exponents, e.g. 64 or 16..=1024 or 1,2,16..32.
     #[arg(long, default_value = "16,64,256,1024")]

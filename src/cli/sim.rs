@@ -29,7 +29,7 @@ pub struct SimArgs {
     config: String,
     /// Microarchitecture: pipelined or folded [default: the configuration's `arch` key, else
     /// pipelined].
-    #[arg(long)]
+    #[arg(long, value_parser = super::named_values(&Arch::ALL, Arch::name, super::no_help))]
     arch: Option<Arch>,
     /// Cycles to simulate.
     #[arg(long, default_value_t = 10_000)]
@@ -45,7 +45,7 @@ pub struct SimArgs {
     stall: f64,
     /// Input stream: random (n and c uniform, seeded) or sweep (every code up to 1.0 for each
     /// n in turn, as the co-simulation's sorted order streams them).
-    #[arg(long, default_value = "random")]
+    #[arg(long, default_value = "random", value_parser = super::named_values(&Stream::ALL, Stream::name, super::no_help))]
     stream: Stream,
     /// Exponents, replacing the configuration's set.
     #[arg(long)]

@@ -11,7 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use super::Outcome;
 use specfx::analysis::cluster::{
-    assign_dirs, parse_shard_spec, Emit, Plan, PointCost, ShardSpec, MAX_SHARDS_PER_TASK, MAX_TASKS,
+    assign_dirs, parse_shard_spec, Emit, Plan, PointCost, SchedulerOptions, ShardSpec,
+    MAX_SHARDS_PER_TASK, MAX_TASKS,
 };
 use specfx::analysis::sweep::{
     check_shard_complete, check_shards, mark_pareto, same_space, Evaluator, GivenShard, LogUse,
@@ -84,7 +85,7 @@ pub struct PlanArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=MAX_SHARDS_PER_TASK))]
     shards_per_task: u64,
     /// The scheduler: slurm, lsf, sge, k8s or shell.
-    #[arg(long, default_value = "slurm")]
+    #[arg(long, default_value = "slurm", value_parser = super::named_values(&Emit::ALL, Emit::name, super::no_help))]
     emit: Emit,
     /// Threads (CPUs) each task requests and uses.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=256))]
@@ -92,6 +93,19 @@ pub struct PlanArgs {
     /// The command the scripts run specfx with (a path on the cluster's nodes).
     #[arg(long, default_value = "specfx")]
     specfx: String,
+    /// The partition (Slurm) or queue (LSF, SGE) every job is submitted to.
+    #[arg(long)]
+    partition: Option<String>,
+    /// The account (Slurm) or project (LSF, SGE) every job is charged to.
+    #[arg(long)]
+    account: Option<String>,
+    /// The quality of service of every job (Slurm).
+    #[arg(long)]
+    qos: Option<String>,
+    /// A line of your own for every job script, after the scheduler's prefix (`--directive
+    /// --gres=gpu:1` writes `#SBATCH --gres=gpu:1`); repeat it for more.
+    #[arg(long, allow_hyphen_values = true)]
+    directive: Vec<String>,
     /// Seconds a point takes, instead of timing three points of the space here (the scripts
     /// are then the same bytes on every machine).
     #[arg(long, value_parser = parse_seconds)]
@@ -116,6 +130,14 @@ fn parse_seconds(s: &str) -> Result<f64, String> {
 
 /// Runs `specfx sweep plan`.
 fn plan(args: &PlanArgs) -> Result<Outcome> {
+    // What the scripts ask the scheduler, refused before any work.
+    let scheduler = SchedulerOptions {
+        partition: args.partition.clone(),
+        account: args.account.clone(),
+        qos: args.qos.clone(),
+        directives: args.directive.clone(),
+    };
+    scheduler.check(args.emit)?;
     let (space, text) = match &args.space {
         None => (Space::builtin(), DEFAULT_SPACE.to_string()),
         Some(path) => {
@@ -158,8 +180,9 @@ fn plan(args: &PlanArgs) -> Result<Outcome> {
         point_cost,
         args.threads,
         &args.specfx,
-    )?;
-    let inputs = space
+    )?
+    .with_scheduler(scheduler.clone())?;
+    let mut inputs = space
         .recorded(Inputs::new("sweep plan"))
         .option("emit", args.emit.name())
         .option("tasks", plan.tasks.to_string())
@@ -168,6 +191,19 @@ fn plan(args: &PlanArgs) -> Result<Outcome> {
         .option("specfx", args.specfx.clone())
         .option("seconds_per_point", point_cost.seconds)
         .option("peak_mib", point_cost.peak_mib.to_string());
+    // Recorded only when given: a plan without them keeps the provenance it had.
+    for (key, value) in [
+        ("partition", &scheduler.partition),
+        ("account", &scheduler.account),
+        ("qos", &scheduler.qos),
+    ] {
+        if let Some(v) = value {
+            inputs = inputs.option(key, v.clone());
+        }
+    }
+    if !scheduler.directives.is_empty() {
+        inputs = inputs.option("directives", scheduler.directives.clone());
+    }
     let mut files = specfx::report::cluster::plan_files(&plan, &text)?;
     files.extend(Provenance::new(&inputs).files());
     match out_dir {

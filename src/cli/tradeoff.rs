@@ -32,7 +32,7 @@ pub struct TradeoffArgs {
     n: NSet,
     /// Also synthesise the fixed-point datapaths with yosys for this target (ice40, xilinx,
     /// generic, generic-fast): a few seconds each.
-    #[arg(long)]
+    #[arg(long, value_parser = super::named_values(&specfx::hdl::cost::Target::ALL, specfx::hdl::cost::Target::name, super::no_help))]
     yosys: Option<specfx::hdl::cost::Target>,
     /// The error budgets of the frontier (shape_total, in lsb8): at each, every algorithm's
     /// cheapest datapath found by the optimiser (pipelined, no device limit), charted against

@@ -44,7 +44,7 @@ pub struct VectorsArgs {
     seed: u64,
     /// Row order: interleaved (a seeded random permutation, so n changes on most rows) or
     /// sorted (by n, then c).
-    #[arg(long, default_value = "interleaved")]
+    #[arg(long, default_value = "interleaved", value_parser = super::named_values(&Order::ALL, Order::name, super::no_help))]
     order: Order,
     /// Replace an existing directory that is not an earlier vector directory.
     #[arg(long)]

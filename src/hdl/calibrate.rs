@@ -204,6 +204,13 @@ pub struct Coefficients {
     pub ff_per_register_bit: f64,
 }
 
+impl Coefficients {
+    /// How many coefficients a fit determines: one per logic feature, and the flip-flops per
+    /// register bit. A fit over fewer records is underdetermined: its error (0 then) says
+    /// nothing about the model.
+    pub const COUNT: usize = Features::LOGIC + 1;
+}
+
 /// How well a fitted model matches the records.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct FitError {

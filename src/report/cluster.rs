@@ -118,6 +118,34 @@ fn header(plan: &Plan, what: &str) -> String {
     )
 }
 
+/// The scheduler's lines for the plan's [`SchedulerOptions`](crate::analysis::cluster::SchedulerOptions)
+/// (partition or queue, account or project, quality of service, the user's directives), after
+/// the resources of every job script.
+fn scheduler_lines(plan: &Plan) -> String {
+    let o = &plan.scheduler;
+    let (prefix, partition, account, qos) = match plan.emit {
+        Emit::Slurm => ("#SBATCH", "--partition=", "--account=", "--qos="),
+        Emit::Lsf => ("#BSUB", "-q ", "-P ", ""),
+        Emit::Sge => ("#$", "-q ", "-A ", ""),
+        // SchedulerOptions::check refuses every option for these.
+        Emit::K8s | Emit::Shell => return String::new(),
+    };
+    let mut lines = String::new();
+    for (flag, value) in [
+        (partition, &o.partition),
+        (account, &o.account),
+        (qos, &o.qos),
+    ] {
+        if let Some(v) = value {
+            lines += &format!("{prefix} {flag}{v}\n");
+        }
+    }
+    for d in &o.directives {
+        lines += &format!("{prefix} {d}\n");
+    }
+    lines
+}
+
 fn script(text: String) -> Vec<u8> {
     text.into_bytes()
 }
@@ -134,9 +162,10 @@ fn slurm(plan: &Plan) -> Vec<File> {
          #SBATCH --time={minutes}\n\
          #SBATCH --requeue\n\
          #SBATCH --output=%x-%A_%a.out\n\
-         {header}set -euo pipefail\n\
+         {options}{header}set -euo pipefail\n\
          export RAYON_NUM_THREADS={threads}\n\
          {cmd}\n",
+        options = scheduler_lines(plan),
         last = plan.tasks - 1,
         threads = r.threads,
         mem = r.memory_mib,
@@ -151,8 +180,9 @@ fn slurm(plan: &Plan) -> Vec<File> {
          #SBATCH --mem=512M\n\
          #SBATCH --time=30\n\
          #SBATCH --output=%x-%j.out\n\
-         {header}set -euo pipefail\n\
+         {options}{header}set -euo pipefail\n\
          {cmd}\n",
+        options = scheduler_lines(plan),
         header = header(plan, "The merge of the sweep's shards, after the array"),
         cmd = merge_command(plan),
     );
@@ -210,9 +240,10 @@ fn lsf(plan: &Plan) -> Vec<File> {
          #BSUB -W {minutes}\n\
          #BSUB -r\n\
          #BSUB -o {name}-%J_%I.out\n\
-         {header}set -euo pipefail\n\
+         {options}{header}set -euo pipefail\n\
          export RAYON_NUM_THREADS={threads}\n\
          {cmd}\n",
+        options = scheduler_lines(plan),
         tasks = plan.tasks,
         threads = r.threads,
         mem = r.memory_mib,
@@ -227,8 +258,9 @@ fn lsf(plan: &Plan) -> Vec<File> {
          #BSUB -n 1\n\
          #BSUB -W 30\n\
          #BSUB -o {name}-merge-%J.out\n\
-         {header}set -euo pipefail\n\
+         {options}{header}set -euo pipefail\n\
          {cmd}\n",
+        options = scheduler_lines(plan),
         header = header(plan, "The merge of the sweep's shards, after the array"),
         cmd = merge_command(plan),
     );
@@ -259,7 +291,7 @@ fn sge(plan: &Plan) -> Vec<File> {
          #$ -l h_vmem={per_slot}M,h_rt={seconds}\n\
          #$ -r y\n\
          #$ -j y\n\
-         {header}# (h_vmem is per slot: {mem} MiB over {threads} slots.)\n\
+         {options}{header}# (h_vmem is per slot: {mem} MiB over {threads} slots.)\n\
          set -euo pipefail\n\
          export RAYON_NUM_THREADS={threads}\n\
          {cmd}\n",
@@ -268,6 +300,7 @@ fn sge(plan: &Plan) -> Vec<File> {
         per_slot = r.memory_mib.div_ceil(u64::from(r.threads)),
         mem = r.memory_mib,
         seconds = r.time_s,
+        options = scheduler_lines(plan),
         header = header(plan, "The sweep's SGE array job"),
         cmd = sweep_command(plan),
     );
@@ -278,8 +311,9 @@ fn sge(plan: &Plan) -> Vec<File> {
          #$ -cwd\n\
          #$ -l h_rt=1800\n\
          #$ -j y\n\
-         {header}set -euo pipefail\n\
+         {options}{header}set -euo pipefail\n\
          {cmd}\n",
+        options = scheduler_lines(plan),
         header = header(plan, "The merge of the sweep's shards, after the array"),
         cmd = merge_command(plan),
     );
@@ -449,6 +483,95 @@ mod tests {
         }
         assert!(!is_plan_file("shards") && !is_plan_file("merged"));
         assert!(!is_plan_file("specfx-sweep-ababab-12_3.out"));
+    }
+
+    #[test]
+    fn scheduler_options_reach_every_job_script_in_the_schedulers_words() {
+        use crate::analysis::cluster::SchedulerOptions;
+        let options = |qos: Option<&str>| SchedulerOptions {
+            partition: Some("gpu".into()),
+            account: Some("proj-7".into()),
+            qos: qos.map(str::to_string),
+            directives: vec!["--gres=gpu:1".into(), "--exclusive".into()],
+        };
+        let want: [(Emit, &[&str], usize); 3] = [
+            (
+                Emit::Slurm,
+                &[
+                    "#SBATCH --partition=gpu\n",
+                    "#SBATCH --account=proj-7\n",
+                    "#SBATCH --qos=high\n",
+                    "#SBATCH --gres=gpu:1\n#SBATCH --exclusive\n",
+                ],
+                2,
+            ),
+            (
+                Emit::Lsf,
+                &[
+                    "#BSUB -q gpu\n",
+                    "#BSUB -P proj-7\n",
+                    "#BSUB --gres=gpu:1\n",
+                ],
+                2,
+            ),
+            (
+                Emit::Sge,
+                &["#$ -q gpu\n", "#$ -A proj-7\n", "#$ --exclusive\n"],
+                2,
+            ),
+        ];
+        for (emit, lines, jobs) in want {
+            let qos = (emit == Emit::Slurm).then_some("high");
+            let p = plan(emit, "specfx").with_scheduler(options(qos)).unwrap();
+            let files = plan_files(&p, "").unwrap();
+            // The array's script and the merge's (the first two after the space).
+            for (name, bytes) in &files[1..=jobs] {
+                let text = String::from_utf8(bytes.clone()).unwrap();
+                for line in lines {
+                    assert!(text.contains(line), "{emit:?} {name}: {line:?} in {text}");
+                }
+            }
+            // Without options the scripts are as they were: no such line.
+            let plain = plan_files(&plan(emit, "specfx"), "").unwrap();
+            let text = String::from_utf8(plain[1].1.clone()).unwrap();
+            assert!(!text.contains("gpu"), "{text}");
+        }
+        // What a scheduler's scripts have no place for is refused, naming the option.
+        for (emit, opts, option) in [
+            (Emit::Lsf, options(Some("high")), "--qos"),
+            (Emit::Sge, options(Some("high")), "--qos"),
+            (Emit::K8s, options(None), "--partition"),
+            (
+                Emit::Shell,
+                SchedulerOptions {
+                    directives: vec!["-x".into()],
+                    ..SchedulerOptions::default()
+                },
+                "--directive",
+            ),
+        ] {
+            let e = plan(emit, "specfx")
+                .with_scheduler(opts)
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with(option) && !e.contains('\n'), "{emit:?}: {e}");
+        }
+        for bad in [
+            SchedulerOptions {
+                partition: Some("two words".into()),
+                ..SchedulerOptions::default()
+            },
+            SchedulerOptions {
+                directives: vec!["--x\n#SBATCH --y".into()],
+                ..SchedulerOptions::default()
+            },
+            SchedulerOptions {
+                directives: vec!["#SBATCH --x".into()],
+                ..SchedulerOptions::default()
+            },
+        ] {
+            assert!(plan(Emit::Slurm, "specfx").with_scheduler(bad).is_err());
+        }
     }
 
     #[test]

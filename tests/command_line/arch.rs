@@ -35,7 +35,7 @@ fn json(args: &[&str]) -> serde_json::Value {
 fn the_answer_records_its_architecture_and_cost_reads_it() {
     let out = temp_path("k6.toml");
     let out_s = out.to_str().unwrap();
-    let stdout = ok_stdout(&[
+    let o = specfx(&[
         "optimize",
         "--n",
         "64",
@@ -46,7 +46,21 @@ fn the_answer_records_its_architecture_and_cost_reads_it() {
         "--out",
         out_s,
     ]);
+    let (stdout, stderr) = (
+        String::from_utf8(o.stdout).unwrap(),
+        String::from_utf8(o.stderr).unwrap(),
+    );
+    assert!(o.status.success(), "{stderr}");
     assert!(stdout.contains("best: k = 6, minimax, folded"), "{stdout}");
+    // The progress names each pass's architecture: the pipelined answer does not fit the
+    // UP5K, the folded one does.
+    let pipelined = stderr
+        .lines()
+        .position(|l| l.starts_with("optimize: k = 6 minimax, pipelined: nothing meets"));
+    let folded = stderr
+        .lines()
+        .position(|l| l.starts_with("optimize: k = 6 minimax, folded: "));
+    assert!(pipelined.is_some() && folded > pipelined, "{stderr}");
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.lines().any(|l| l == "arch = \"folded\""), "{text}");
     let folded = json(&["cost", "--config", out_s, "--analytic-only", "--json"]);

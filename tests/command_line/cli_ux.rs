@@ -231,6 +231,97 @@ fn no_color_means_no_escape_anywhere() {
     let _ = std::fs::remove_file(&space);
 }
 
+/// Help is wrapped: off a terminal, no line of any command's help (nested ones too) is wider
+/// than 100 columns.
+#[test]
+fn help_fits_100_columns() {
+    let help = text(&run(&["--help"], &[]).stdout);
+    let commands: Vec<String> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        // A command's line; a description wrapped onto the next line is indented further.
+        .filter(|l| !l.starts_with("   "))
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .filter(|c| c != "help")
+        .collect();
+    let mut pages = vec![(vec![], help)];
+    for c in &commands {
+        let page = text(&run(&[c.as_str(), "--help"], &[]).stdout);
+        for sub in page
+            .lines()
+            .skip_while(|l| !l.starts_with("Commands:"))
+            .skip(1)
+            .take_while(|l| l.starts_with("  "))
+            // A command's line; a description wrapped onto the next line is indented further.
+            .filter(|l| !l.starts_with("   "))
+            .filter_map(|l| l.split_whitespace().next())
+            .filter(|s| *s != "help")
+        {
+            let nested = text(&run(&[c.as_str(), sub, "--help"], &[]).stdout);
+            pages.push((vec![c.clone(), sub.to_string()], nested));
+        }
+        pages.push((vec![c.clone()], page));
+    }
+    assert!(pages.len() > 30, "{}", pages.len());
+    for (args, page) in &pages {
+        for line in page.lines() {
+            assert!(
+                line.chars().count() <= 100,
+                "specfx {} --help: a line of {} columns: {line}",
+                args.join(" "),
+                line.chars().count()
+            );
+        }
+    }
+}
+
+/// The line a failed run ends with is red on a terminal (here a real one, util-linux `script`'s
+/// pseudo-terminal), and plain off one, with `NO_COLOR` or `--color never`; the same for an
+/// error in the arguments, which comes before the logger.
+#[test]
+fn error_lines_are_red_on_a_terminal_only() {
+    let red = "\x1b[31mspecfx: error: ";
+    for args in [
+        &["check", "--config", "/nonexistent.toml"][..],
+        &["vectorz"][..],
+    ] {
+        let forced = run(&[&["--color", "always"][..], args].concat(), &[]);
+        assert!(
+            text(&forced.stderr).starts_with(red),
+            "{args:?}: {:?}",
+            text(&forced.stderr)
+        );
+        assert_eq!(forced.status.code(), Some(2));
+        let plain = run(args, &[]);
+        assert!(
+            text(&plain.stderr).starts_with("specfx: error: "),
+            "{:?}",
+            text(&plain.stderr)
+        );
+        // On a terminal: red, unless NO_COLOR is set.
+        let command = std::iter::once(env!("CARGO_BIN_EXE_specfx"))
+            .chain(args.iter().copied())
+            .collect::<Vec<_>>()
+            .join(" ");
+        for (no_color, want_red) in [("", true), ("1", false)] {
+            let o = std::process::Command::new("script")
+                .args(["-qec", &command, "/dev/null"])
+                .env("NO_COLOR", no_color)
+                .output()
+                .expect("script (util-linux) runs");
+            let out = text(&o.stdout);
+            assert_eq!(
+                out.contains(red),
+                want_red,
+                "NO_COLOR={no_color:?} {args:?}: {out:?}"
+            );
+            assert!(out.contains("specfx: error: "), "{out:?}");
+        }
+    }
+}
+
 #[test]
 fn verbose_says_more_than_the_default() {
     let space = space_file("verbose-space.toml");
@@ -290,6 +381,8 @@ fn completions_and_manual_pages_cover_every_command() {
         .skip_while(|l| !l.starts_with("Commands:"))
         .skip(1)
         .take_while(|l| l.starts_with("  "))
+        // A command's line; a description wrapped onto the next line is indented further.
+        .filter(|l| !l.starts_with("   "))
         .filter_map(|l| l.split_whitespace().next().map(str::to_string))
         .filter(|c| c != "help")
         .collect();
@@ -300,6 +393,20 @@ fn completions_and_manual_pages_cover_every_command() {
     assert!(script.contains("_specfx()"), "a bash completion function");
     for c in &commands {
         assert!(script.contains(c.as_str()), "completion of {c}");
+    }
+    // Enum flags complete their values, not file names.
+    for values in [
+        "pipelined folded",
+        "slurm lsf sge k8s shell",
+        "analytic yosys",
+        "icarus verilator",
+        "interleaved sorted",
+        "define json iverilog verilator fusesoc instance",
+    ] {
+        assert!(
+            script.contains(&format!("compgen -W \"{values}\"")),
+            "the values {values} in the bash completions"
+        );
     }
     let page = text(&run(&["man"], &[]).stdout);
     assert!(page.contains(".TH specfx 1"), "{page}");
@@ -325,6 +432,38 @@ fn completions_and_manual_pages_cover_every_command() {
     assert!(forced.status.success(), "{}", text(&forced.stderr));
     for c in &commands {
         let page = std::fs::read_to_string(dir.join(format!("specfx-{c}.1"))).unwrap();
+        assert!(page.contains(&format!(".TH specfx-{c} 1")), "{c}");
+    }
+    // The nested subcommands too (`sweep plan`, `hdl params`, ...), from each command's help.
+    let mut nested = Vec::new();
+    for c in &commands {
+        let help = text(&run(&[c.as_str(), "--help"], &[]).stdout);
+        nested.extend(
+            help.lines()
+                .skip_while(|l| !l.starts_with("Commands:"))
+                .skip(1)
+                .take_while(|l| l.starts_with("  "))
+                // A command's line; a description wrapped onto the next line is indented further.
+                .filter(|l| !l.starts_with("   "))
+                .filter_map(|l| l.split_whitespace().next())
+                .filter(|s| *s != "help")
+                .map(|s| format!("{c}-{s}")),
+        );
+    }
+    for want in [
+        "sweep-plan",
+        "sweep-merge",
+        "hdl-params",
+        "hdl-rom",
+        "hdl-stimulus",
+        "trace-compare",
+        "calibrate-merge",
+    ] {
+        assert!(nested.iter().any(|n| n == want), "{want} in {nested:?}");
+    }
+    for c in &nested {
+        let page = std::fs::read_to_string(dir.join(format!("specfx-{c}.1")))
+            .unwrap_or_else(|e| panic!("specfx-{c}.1: {e}"));
         assert!(page.contains(&format!(".TH specfx-{c} 1")), "{c}");
     }
     let again = run(&["man", "--out", dir.to_str().unwrap()], &[]);

@@ -268,11 +268,16 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     v
 }
 
-/// `specfx sweep plan --emit slurm` of `space` into `out` with `tasks` tasks of 2 shards.
+/// `specfx sweep plan --emit slurm` of `space` into `out` with `tasks` tasks of 2 shards, on
+/// the test cluster's partition and with a directive of the user's own, which sbatch takes.
 fn plan(space: &Path, out: &Path, tasks: &str) {
     specfx(&[
         "sweep",
         "plan",
+        "--partition",
+        "test",
+        "--directive",
+        "--comment=specfx-test",
         "--space",
         space.to_str().unwrap(),
         "--emit",

@@ -106,6 +106,43 @@ fn dsp_count_follows_yosys() {
     }
 }
 
+/// A fit over fewer records than coefficients says so: its error of 0 is no evidence.
+#[test]
+fn a_fit_over_fewer_records_than_coefficients_is_warned_about() {
+    let data = tempfile::tempdir().unwrap();
+    let committed = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/calibration/ice40.jsonl"
+    ))
+    .unwrap();
+    let four: String = committed
+        .lines()
+        .take(4)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(data.path().join("ice40.jsonl"), four).unwrap();
+    let args = ["calibrate", "--targets", "ice40", "--fit-only", "--data"];
+    let o = specfx(&[&args[..], &[data.path().to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("calibrate ice40: 4 records for ")
+                && l.contains("coefficients: the fit is underdetermined")),
+        "{err}"
+    );
+    // The committed records are enough: no warning.
+    let o = specfx(&[
+        "calibrate",
+        "--targets",
+        "ice40",
+        "--fit-only",
+        "--data",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/data/calibration"),
+    ]);
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("underdetermined"));
+}
+
 #[test]
 fn calibrate_fit_only_refits_the_committed_records() {
     // --fit-only on the committed records runs no yosys and prints the fit, equal to the
