@@ -231,35 +231,30 @@ fn no_color_means_no_escape_anywhere() {
     let _ = std::fs::remove_file(&space);
 }
 
+/// The commands a help page lists in its "Commands:" block, `help` left out (a description
+/// wrapped onto the next line is indented further than a command's line).
+fn commands_of(help: &str) -> Vec<String> {
+    help.lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter(|l| !l.starts_with("   "))
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .filter(|c| c != "help")
+        .collect()
+}
+
 /// Help is wrapped: off a terminal, no line of any command's help (nested ones too) is wider
 /// than 100 columns.
 #[test]
 fn help_fits_100_columns() {
     let help = text(&run(&["--help"], &[]).stdout);
-    let commands: Vec<String> = help
-        .lines()
-        .skip_while(|l| !l.starts_with("Commands:"))
-        .skip(1)
-        .take_while(|l| l.starts_with("  "))
-        // A command's line; a description wrapped onto the next line is indented further.
-        .filter(|l| !l.starts_with("   "))
-        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
-        .filter(|c| c != "help")
-        .collect();
+    let commands = commands_of(&help);
     let mut pages = vec![(vec![], help)];
     for c in &commands {
         let page = text(&run(&[c.as_str(), "--help"], &[]).stdout);
-        for sub in page
-            .lines()
-            .skip_while(|l| !l.starts_with("Commands:"))
-            .skip(1)
-            .take_while(|l| l.starts_with("  "))
-            // A command's line; a description wrapped onto the next line is indented further.
-            .filter(|l| !l.starts_with("   "))
-            .filter_map(|l| l.split_whitespace().next())
-            .filter(|s| *s != "help")
-        {
-            let nested = text(&run(&[c.as_str(), sub, "--help"], &[]).stdout);
+        for sub in commands_of(&page) {
+            let nested = text(&run(&[c.as_str(), sub.as_str(), "--help"], &[]).stdout);
             pages.push((vec![c.clone(), sub.to_string()], nested));
         }
         pages.push((vec![c.clone()], page));
@@ -375,17 +370,7 @@ fn existing_single_line_errors_are_unchanged_by_the_flags() {
 #[test]
 fn completions_and_manual_pages_cover_every_command() {
     // The commands, from the binary's own help (its "Commands:" block).
-    let help = text(&run(&["--help"], &[]).stdout);
-    let commands: Vec<String> = help
-        .lines()
-        .skip_while(|l| !l.starts_with("Commands:"))
-        .skip(1)
-        .take_while(|l| l.starts_with("  "))
-        // A command's line; a description wrapped onto the next line is indented further.
-        .filter(|l| !l.starts_with("   "))
-        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
-        .filter(|c| c != "help")
-        .collect();
+    let commands = commands_of(&text(&run(&["--help"], &[]).stdout));
     assert!(commands.len() > 20, "{commands:?}");
     let bash = run(&["completions", "bash"], &[]);
     assert!(bash.status.success());
@@ -438,17 +423,7 @@ fn completions_and_manual_pages_cover_every_command() {
     let mut nested = Vec::new();
     for c in &commands {
         let help = text(&run(&[c.as_str(), "--help"], &[]).stdout);
-        nested.extend(
-            help.lines()
-                .skip_while(|l| !l.starts_with("Commands:"))
-                .skip(1)
-                .take_while(|l| l.starts_with("  "))
-                // A command's line; a description wrapped onto the next line is indented further.
-                .filter(|l| !l.starts_with("   "))
-                .filter_map(|l| l.split_whitespace().next())
-                .filter(|s| *s != "help")
-                .map(|s| format!("{c}-{s}")),
-        );
+        nested.extend(commands_of(&help).iter().map(|s| format!("{c}-{s}")));
     }
     for want in [
         "sweep-plan",
