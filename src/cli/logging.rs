@@ -148,6 +148,13 @@ pub fn error_line(line: &str, color: bool) -> String {
     format_line(log::Level::Error, line, color)
 }
 
+/// Writes the line a failed run ends with ([`error_line`]) to stderr, coloured as this run's
+/// lines are ([`stderr_color`]); a closed or full stderr is no reason to panic (the exit code
+/// still tells).
+pub fn print_error_line(line: &str) {
+    let _ = writeln!(std::io::stderr(), "{}", error_line(line, stderr_color()));
+}
+
 /// Whether this run's lines on stderr are coloured: [`init`]'s settings, or before it (an
 /// error in the arguments) the `--color` flag, `NO_COLOR` and whether stderr is a terminal.
 pub fn stderr_color() -> bool {

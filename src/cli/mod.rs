@@ -540,39 +540,18 @@ pub fn main() -> ExitCode {
         // A command without its subcommand is an error like any other: one line naming what
         // it takes, not a page of help.
         Err(e) if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-            use std::io::Write as _;
             let message = missing_subcommand(&command(), std::env::args_os().skip(1));
-            let _ = writeln!(
-                std::io::stderr(),
-                "{}",
-                logging::error_line(
-                    &format!("specfx: error: {message}"),
-                    logging::stderr_color()
-                )
-            );
+            logging::print_error_line(&format!("specfx: error: {message}"));
             return ExitCode::from(2);
         }
         Err(e) => {
             // A closed or full stderr is no reason to panic: the exit code still tells.
-            {
-                use std::io::Write as _;
-                let line = format!("specfx: {}", one_line(&e.render().to_string()));
-                let _ = writeln!(
-                    std::io::stderr(),
-                    "{}",
-                    logging::error_line(&line, logging::stderr_color())
-                );
-            }
+            logging::print_error_line(&format!("specfx: {}", one_line(&e.render().to_string())));
             return ExitCode::from(2);
         }
     };
     if let Err(e) = check_thread_count(std::env::var_os("RAYON_NUM_THREADS").as_deref()) {
-        use std::io::Write as _;
-        let _ = writeln!(
-            std::io::stderr(),
-            "{}",
-            logging::error_line(&format!("specfx: error: {e}"), logging::stderr_color())
-        );
+        logging::print_error_line(&format!("specfx: error: {e}"));
         return ExitCode::from(2);
     }
     logging::init(
@@ -623,17 +602,7 @@ pub fn main() -> ExitCode {
                 .map_or(String::new(), |dir| {
                     format!(" (the result in {} is complete)", dir.display())
                 });
-            {
-                use std::io::Write as _;
-                let _ = writeln!(
-                    std::io::stderr(),
-                    "{}",
-                    logging::error_line(
-                        &format!("specfx: error: {err:#}{complete}"),
-                        logging::stderr_color()
-                    )
-                );
-            }
+            logging::print_error_line(&format!("specfx: error: {err:#}{complete}"));
             ExitCode::from(2)
         }
     }
